@@ -1,0 +1,2 @@
+"""CLI subcommands.  Each module here defines ``register(subparsers)``, which adds one or
+more subcommands whose ``func(args) -> int`` does the work; :mod:`mlc.cli` discovers them."""

@@ -1,0 +1,1 @@
+"""File formats shared by several stages: YAML with source lines, schema validation."""

@@ -1,0 +1,148 @@
+"""Validate loaded data against the JSON Schemas shipped inside the package.
+
+mlc ships real JSON Schema (draft 2020-12) documents, so other tools can use
+them, and validates with this small implementation of the keywords those
+schemas use, so that every error quotes ``file:line`` of the offending value
+(the test-suite cross-checks the schemas with the ``jsonschema`` package).
+
+Supported keywords: ``type``, ``properties``, ``required``,
+``additionalProperties``, ``patternProperties``, ``items``, ``prefixItems``,
+``minItems``, ``maxItems``, ``enum``, ``const``, ``minimum``, ``maximum``,
+``exclusiveMinimum``, ``exclusiveMaximum``, ``pattern``, ``$ref`` (to
+``#/$defs/...``), ``oneOf`` and ``anyOf`` (first branch error reported),
+``description``/``title``/``$schema``/``$id``/``$comment`` (ignored).
+"""
+from __future__ import annotations
+
+import json
+import math
+import re
+from functools import lru_cache
+from importlib import resources
+
+from mlc.errors import InternalError, Loc, MlcError
+from mlc.io.yamlsrc import loc_of
+
+_TYPES = {
+    "object": lambda v: isinstance(v, dict),
+    "array": lambda v: isinstance(v, list),
+    "string": lambda v: isinstance(v, str),
+    "boolean": lambda v: isinstance(v, bool),
+    "integer": lambda v: isinstance(v, int) and not isinstance(v, bool),
+    "number": lambda v: isinstance(v, (int, float)) and not isinstance(v, bool),
+    "null": lambda v: v is None,
+}
+
+
+@lru_cache(maxsize=None)
+def load_schema(name: str) -> dict:
+    """Load ``mlc/schemas/<name>.schema.json`` from the installed package."""
+    text = resources.files("mlc").joinpath("schemas", f"{name}.schema.json").read_text("utf-8")
+    return json.loads(text)
+
+
+def _path_str(path) -> str:
+    return "".join(f"[{p}]" if isinstance(p, int) else f".{p}" for p in path).lstrip(".") or "(top level)"
+
+
+class _Fail(Exception):
+    def __init__(self, msg, loc, path):
+        self.msg, self.loc, self.path = msg, loc, path
+
+
+def validate(data, schema: dict, filename: str = "<input>") -> None:
+    """Raise :class:`MlcError` at ``file:line`` if ``data`` does not match ``schema``."""
+    root = schema
+    try:
+        _check(data, schema, root, [], getattr(data, "loc", None) or Loc(filename))
+    except _Fail as f:
+        raise MlcError(f"{_path_str(f.path)}: {f.msg}", f.loc) from None
+
+
+def _check(v, s, root, path, loc):
+    if "$ref" in s:
+        ref = s["$ref"]
+        if not ref.startswith("#/$defs/"):
+            raise InternalError(f"unsupported $ref {ref}")
+        _check(v, root["$defs"][ref[len("#/$defs/"):]], root, path, loc)
+    if "type" in s:
+        types = s["type"] if isinstance(s["type"], list) else [s["type"]]
+        if not any(_TYPES[t](v) for t in types):
+            raise _Fail(f"expected {' or '.join(types)}, got {_describe(v)}", loc, path)
+    if isinstance(v, (int, float)) and not isinstance(v, bool):
+        if not math.isfinite(v):
+            raise _Fail(f"expected a finite number, got {v}", loc, path)
+        if "minimum" in s and v < s["minimum"]:
+            raise _Fail(f"must be >= {s['minimum']}, got {v}", loc, path)
+        if "maximum" in s and v > s["maximum"]:
+            raise _Fail(f"must be <= {s['maximum']}, got {v}", loc, path)
+        if "exclusiveMinimum" in s and v <= s["exclusiveMinimum"]:
+            raise _Fail(f"must be > {s['exclusiveMinimum']}, got {v}", loc, path)
+        if "exclusiveMaximum" in s and v >= s["exclusiveMaximum"]:
+            raise _Fail(f"must be < {s['exclusiveMaximum']}, got {v}", loc, path)
+    if "enum" in s and v not in s["enum"]:
+        raise _Fail(f"must be one of {', '.join(map(repr, s['enum']))}, got {v!r}", loc, path)
+    if "const" in s and v != s["const"]:
+        raise _Fail(f"must be {s['const']!r}, got {v!r}", loc, path)
+    if isinstance(v, str) and "pattern" in s and not re.search(s["pattern"], v):
+        raise _Fail(f"{v!r} does not match the pattern {s['pattern']}", loc, path)
+    if isinstance(v, dict):
+        for key in s.get("required", []):
+            if key not in v:
+                raise _Fail(f"missing required key {key!r}", loc, path)
+        props = s.get("properties", {})
+        pats = s.get("patternProperties", {})
+        addl = s.get("additionalProperties", True)
+        for key, item in v.items():
+            iloc = loc_of(v, key) or loc
+            sub = path + [key]
+            if key in props:
+                _check(item, props[key], root, sub, iloc)
+                continue
+            matched = False
+            for pat, ps in pats.items():
+                if re.search(pat, str(key)):
+                    matched = True
+                    _check(item, ps, root, sub, iloc)
+            if matched:
+                continue
+            if addl is False:
+                allowed = ", ".join(sorted(props)) or "none"
+                raise _Fail(f"unknown key {key!r} (allowed: {allowed})", iloc, path)
+            if isinstance(addl, dict):
+                _check(item, addl, root, sub, iloc)
+    if isinstance(v, list):
+        if "minItems" in s and len(v) < s["minItems"]:
+            raise _Fail(f"expected at least {s['minItems']} items, got {len(v)}", loc, path)
+        if "maxItems" in s and len(v) > s["maxItems"]:
+            raise _Fail(f"expected at most {s['maxItems']} items, got {len(v)}", loc, path)
+        prefix = s.get("prefixItems", [])
+        for i, item in enumerate(v):
+            iloc = loc_of(v, i) or loc
+            if i < len(prefix):
+                _check(item, prefix[i], root, path + [i], iloc)
+            elif "items" in s and s["items"] is not False:
+                _check(item, s["items"], root, path + [i], iloc)
+    for key in ("oneOf", "anyOf"):
+        if key in s:
+            first = None
+            for branch in s[key]:
+                try:
+                    _check(v, branch, root, path, loc)
+                    break
+                except _Fail as f:
+                    first = first or f
+            else:
+                raise first
+
+
+def _describe(v) -> str:
+    if isinstance(v, bool):
+        return f"boolean {v}"
+    if v is None:
+        return "null"
+    if isinstance(v, dict):
+        return "a mapping"
+    if isinstance(v, list):
+        return "a list"
+    return f"{type(v).__name__} {v!r}"

@@ -1,0 +1,137 @@
+"""Scene files: YAML, format version 1 (docs/scene-format.md, mlc/schemas/scene.schema.json).
+
+``parse_scene(text, filename)`` is pure: text in, checked :class:`Scene` out, every
+error at ``file:line``.  ``scene_to_data``/``dump_scene`` give the stable text form
+(fixed key order, numbers at full precision) used for golden tests.
+"""
+from __future__ import annotations
+
+import numpy as np
+import yaml
+
+from mlc.errors import MlcError
+from mlc.io import yamlsrc
+from mlc.io.atomic import write_text
+from mlc.io.schema import load_schema, validate
+from mlc.scene.model import Body, Bond, Box, Muscle, Probe, Scene
+
+FORMAT_VERSION = 1
+_IDQ = [1.0, 0.0, 0.0, 0.0]
+
+
+def parse_scene(text: str, filename: str = "<scene>") -> Scene:
+    data = yamlsrc.load(text, filename)
+    if not isinstance(data, dict):
+        raise MlcError("a scene file must be a YAML mapping", filename)
+    if "mlc_scene" not in data:
+        raise MlcError("not an mlc scene: missing 'mlc_scene: 1'", getattr(data, "loc", filename))
+    validate(data, load_schema("scene"), filename)
+    return scene_from_data(data, filename)
+
+
+def load_scene(path) -> Scene:
+    try:
+        with open(path, encoding="utf-8") as f:
+            text = f.read()
+    except OSError as e:
+        raise MlcError(f"cannot read scene: {e.strerror}", str(path)) from None
+    return parse_scene(text, str(path))
+
+
+def scene_from_data(data, filename: str = "<scene>") -> Scene:
+    def loc(container, key):
+        return yamlsrc.loc_of(container, key)
+
+    bodies = []
+    for i, b in enumerate(data["bodies"]):
+        boxes = [Box(np.array(x["size"], float), np.array(x.get("center", [0, 0, 0]), float),
+                     np.array(x.get("orientation", _IDQ), float)) for x in b["boxes"]]
+        sites = {k: np.array(v, float) for k, v in (b.get("sites") or {}).items()}
+        bodies.append(Body(b["name"], np.array(b["position"], float),
+                           np.array(b.get("orientation", _IDQ), float), boxes, sites, loc(data["bodies"], i)))
+    bonds = [Bond(x["name"], x["sites"][0], x["sites"][1], float(x.get("k", 1.0)), float(x.get("rest", 0.0)),
+                  float(x.get("tolerance", 0.0)), x.get("kind", "bond"), x.get("joint"), loc(data["bonds"], i))
+             for i, x in enumerate(data.get("bonds") or [])]
+    muscles = [Muscle(x["name"], x["input"], x["sites"][0], x["sites"][1], float(x["rest"]),
+                      float(x["actuated"]), float(x.get("k", 1.0)), loc(data["muscles"], i))
+               for i, x in enumerate(data.get("muscles") or [])]
+    probes = [Probe(x["name"], x["output"], x["sites"][0], x["sites"][1], float(x["rest"]),
+                    float(x["actuated"]), loc(data["probes"], i))
+              for i, x in enumerate(data.get("probes") or [])]
+    tt = data.get("truth_table")
+    scene = Scene(
+        name=data["name"], bodies=bodies, bonds=bonds, muscles=muscles, probes=probes,
+        inputs=list(data.get("inputs") or []), outputs=list(data.get("outputs") or []),
+        truth_table=dict(tt) if tt is not None else None, meta=_plain(data.get("meta") or {}),
+        units={"sigma": 1.0, "k0": 1.0, "gamma": 1.0, **(data.get("units") or {})}, source=filename,
+    )
+    return scene.check()
+
+
+def _plain(v):
+    if isinstance(v, dict):
+        return {k: _plain(x) for k, x in v.items()}
+    if isinstance(v, list):
+        return [_plain(x) for x in v]
+    return v
+
+
+def _num(x) -> float:
+    x = float(x)
+    return 0.0 if x == 0 else x    # no "-0.0" in the text form
+
+
+def _vec(v) -> list[float]:
+    return [_num(x) for x in np.asarray(v, float).ravel()]
+
+
+def scene_to_data(scene: Scene) -> dict:
+    """The scene as plain data with a fixed key order (the stable text form)."""
+    out = {"mlc_scene": FORMAT_VERSION, "name": scene.name, "units": dict(scene.units),
+           "inputs": list(scene.inputs), "outputs": list(scene.outputs)}
+    if scene.truth_table is not None:
+        out["truth_table"] = dict(sorted(scene.truth_table.items()))
+    if scene.meta:
+        out["meta"] = scene.meta
+    out["bodies"] = [{
+        "name": b.name, "position": _vec(b.position), "orientation": _vec(b.orientation),
+        "boxes": [{"size": _vec(x.size), "center": _vec(x.center), "orientation": _vec(x.orientation)}
+                  for x in b.boxes],
+        "sites": {k: _vec(v) for k, v in b.sites.items()},
+    } for b in scene.bodies]
+    out["bonds"] = []
+    for x in scene.bonds:
+        d = {"name": x.name, "sites": [x.a, x.b], "k": _num(x.k), "rest": _num(x.rest),
+             "tolerance": _num(x.tolerance), "kind": x.kind}
+        if x.joint:
+            d["joint"] = x.joint
+        out["bonds"].append(d)
+    out["muscles"] = [{"name": m.name, "input": m.input, "sites": [m.a, m.b], "k": _num(m.k),
+                       "rest": _num(m.rest), "actuated": _num(m.actuated)} for m in scene.muscles]
+    out["probes"] = [{"name": p.name, "output": p.output, "sites": [p.a, p.b],
+                      "rest": _num(p.rest), "actuated": _num(p.actuated)} for p in scene.probes]
+    return out
+
+
+class _Dumper(yaml.SafeDumper):
+    pass
+
+
+def _repr_list(dumper, data):
+    flow = all(isinstance(x, (int, float, str)) for x in data) and len(data) <= 4
+    return dumper.represent_sequence("tag:yaml.org,2002:seq", data, flow_style=flow)
+
+
+_Dumper.add_representer(list, _repr_list)
+
+
+def dump_scene(scene: Scene) -> str:
+    """Stable YAML text of a scene (round-trips through :func:`parse_scene`)."""
+    scene.check()
+    header = ("# mlc scene, format version 1 (docs/scene-format.md).\n"
+              "# Units: sigma = 1 (length), k0 = 1 (stiffness), gamma = 1 (drag).\n")
+    return header + yaml.dump(scene_to_data(scene), Dumper=_Dumper, sort_keys=False, width=120)
+
+
+def write_scene(scene: Scene, path) -> None:
+    write_text(path, dump_scene(scene))

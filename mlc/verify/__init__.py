@@ -1,0 +1,1 @@
+"""Static verification: mechanical equilibrium of a scene in each input state."""

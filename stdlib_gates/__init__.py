@@ -1,0 +1,1 @@
+"""The standard gate library of mlc, as data (one YAML file per gate)."""
