@@ -136,7 +136,7 @@ def solve_core(din: float, h: float) -> CoreSolution:
     sol = _solve(din, h)
     if sol is None:
         rng = accessible_din_range(h)
-        acc = (f"for h={h} the accessible range is {rng[0]:.3f} <= din <= {rng[1]:.3f}"
+        acc = (f"for h={h} the accessible range is 0 < din <= {rng[1]:.3f}"
                if rng else f"no din is accessible for h={h}; try h between 1.05 and 4")
         raise MlcError(f"the logic core has no physical solution at din={din}, h={h}", "--din/--h", acc)
     return sol

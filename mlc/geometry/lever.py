@@ -116,7 +116,8 @@ def solve_lever(lin: float, lout: float, dlin: float, dlout: float, l: float,
         raise MlcError(f"unknown lever type {type!r}", "--type", "use open or crossed")
     if type != need:
         what = "inverts" if type == "open" else "keeps"
-        raise MlcError(f"an {type}-hinge lever {what} the signal direction, but dlin={dlin} and "
+        article = "an" if type == "open" else "a"
+        raise MlcError(f"{article} {type}-hinge lever {what} the signal direction, but dlin={dlin} and "
                        f"dlout={dlout} ask for the opposite", "--type", f"use --type {need}")
     sign = 1 if type == "crossed" else -1
     lin1, lout1 = lin + dlin, lout + dlout

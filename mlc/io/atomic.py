@@ -20,6 +20,9 @@ def atomic_path(path, suffix: str | None = None):
         raise MlcError(f"output directory {directory} does not exist", str(path), "create it first")
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix or path.suffix or ".tmp", dir=directory)
     os.close(fd)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)       # mkstemp makes 0600; outputs follow the umask
     try:
         yield Path(tmp)
         os.replace(tmp, path)

@@ -1,0 +1,78 @@
+"""Scene model and its YAML form: round trip, schema errors at file:line, check() invariants."""
+import numpy as np
+import pytest
+
+from mlc.errors import MlcError
+from mlc.gates.library import gate_scene
+from mlc.scene.io import dump_scene, parse_scene
+
+
+def test_round_trip_is_stable():
+    s = gate_scene("NAND", "expand")
+    text = dump_scene(s)
+    s2 = parse_scene(text, "nand.yaml")
+    assert dump_scene(s2) == text
+    a, b = s.arrays(), s2.arrays()
+    assert np.array_equal(a.site_local, b.site_local) and np.array_equal(a.bond_i, b.bond_i)
+
+
+def test_arrays_shapes():
+    a = gate_scene("AND", "contract").arrays()
+    assert a.pos.shape == (8, 3) and a.quat.shape == (8, 4)
+    assert len(a.bond_i) == 17 and len(a.muscle_i) == 2 and len(a.probe_i) == 1
+    assert a.pos.flags.c_contiguous and a.site_local.dtype == np.float64
+    assert list(a.muscle_lengths([1, 0])) == [0.5, 1.0]
+
+
+def _minimal(extra_body="", bond_sites="[p.x, q.y]", quat="[1, 0, 0, 0]"):
+    return f"""mlc_scene: 1
+name: t
+inputs: [m]
+outputs: [o]
+bodies:
+  - name: p
+    position: [0, 0, 0]
+    orientation: {quat}
+    boxes: [{{size: [1, 0.5, 0.01]}}]
+    sites: {{x: [0.5, 0, 0]}}
+  - name: q
+    position: [1, 0, 0]
+    boxes: [{{size: [1, 0.5, 0.01]}}]
+    sites: {{y: [-0.5, 0, 0]}}
+{extra_body}bonds:
+  - {{name: b0, sites: {bond_sites}, kind: hinge}}
+muscles:
+  - {{name: m0, input: m, sites: [p.x, q.y], rest: 1, actuated: 1.5}}
+probes:
+  - {{name: o, output: o, sites: [p.x, q.y], rest: 1, actuated: 1.5}}
+"""
+
+
+def test_minimal_scene_parses():
+    s = parse_scene(_minimal(), "t.yaml")
+    assert [b.name for b in s.bodies] == ["p", "q"]
+
+
+@pytest.mark.parametrize("text, line, words", ids=range(9), argvalues=[
+    (_minimal(bond_sites="[p.x, q.nope]"), 16, "no site 'nope'"),
+    (_minimal(bond_sites="[p.x, z.y]"), 16, "no body named 'z'"),
+    (_minimal(quat="[1, 1, 0, 0]"), 6, "not a unit quaternion"),
+    (_minimal().replace("size: [1, 0.5, 0.01]", "size: [1, -0.5, 0.01]", 1), 9, "must be > 0"),
+    (_minimal().replace("kind: hinge", "kind: spring"), 16, "must be one of"),
+    (_minimal().replace("rest: 1, actuated: 1.5}\nprobes", "rest: .nan, actuated: 1.5}\nprobes"), 18, "finite"),
+    (_minimal().replace("input: m,", "input: w,"), 18, "not in inputs"),
+    (_minimal().replace("name: t\n", "name: t\nextra: 1\n"), 3, "unknown key 'extra'"),
+    (_minimal().replace("bonds:\n", "bonds:\n  - [\n"), 17, "YAML syntax error"),
+])
+def test_malformed_scene_reports_file_line(text, line, words):
+    assert text != _minimal()
+    with pytest.raises(MlcError) as e:
+        parse_scene(text, "bad.yaml")
+    msg = str(e.value)
+    assert words in msg
+    assert msg.startswith(f"bad.yaml:{line}"), msg
+
+
+def test_same_body_bond_rejected():
+    with pytest.raises(MlcError, match="same body"):
+        parse_scene(_minimal(bond_sites="[p.x, p.x]"), "t.yaml")
