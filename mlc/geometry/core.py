@@ -28,7 +28,6 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from mlc.errors import MlcError
 
@@ -103,6 +102,7 @@ def _f(phi, din: float, h: float):
 
 
 def _roots(din: float, h: float) -> list[float]:
+    from scipy.optimize import brentq  # lazy: keeps `import mlc...` fast
     ph = np.linspace(1e-6, np.pi / 2 - 1e-6, _SCAN)
     v = _f(ph, din, h)
     roots = []

@@ -38,7 +38,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from mlc.errors import MlcError
 
@@ -110,6 +109,8 @@ def solve_lever(lin: float, lout: float, dlin: float, dlout: float, l: float,
             raise MlcError(f"the signal must be non-zero, got {v}", name)
         if rest + v <= 0:
             raise MlcError(f"the actuated length {rest}+({v}) is not positive", name)
+    from scipy.optimize import brentq  # lazy: keeps `import mlc...` fast
+
     need = lever_type_for(dlin, dlout)
     type = type or need
     if type not in LEVER_TYPES:

@@ -166,10 +166,14 @@ class Scene:
 
     # -- lookup -------------------------------------------------------------
     def body(self, name: str) -> Body:
-        for b in self.bodies:
-            if b.name == name:
-                return b
-        raise KeyError(name)
+        """The body named ``name`` (KeyError if none); O(1) through a name index that is
+        rebuilt whenever ``bodies`` has changed."""
+        idx = self.__dict__.get("_by_name")
+        key = (id(self.bodies), len(self.bodies))
+        if idx is None or idx[0] != key or name not in idx[1] or idx[1][name].name != name:
+            idx = (key, {b.name: b for b in self.bodies})
+            self.__dict__["_by_name"] = idx
+        return idx[1][name]
 
     def site_world(self, ref: str) -> np.ndarray:
         body, site = ref.split(".", 1)

@@ -1,0 +1,1137 @@
+"""Scene -> printable parts: solids built with manifold3d CSG, in millimetres.
+
+Every rigid body becomes one part: its slabs (thickened to the profile's slab thickness)
+with the knuckles of its hinges and holes (or lugs) at its muscle/probe attachment sites.
+Every universal joint becomes one more part: a hub with two perpendicular pins (paper
+Fig. 4).  docs/printing.md describes the design for users.
+
+Hinges (print-in-place, paper "3D printing of NAND gate")
+--------------------------------------------------------
+The hinge joints of a scene are grouped by axis: joints whose axes lie on one line form
+one *hinge axis* (the hinge at point ``c`` of a gate joins three bodies and appears as
+two pairwise joints).  Along the axis, knuckles alternate: the *pin owner* (the first
+body of the axis) holds both end knuckles and a pin through the whole span; each other
+body holds one knuckle between them with a hole of radius ``pin + clearance``:
+
+    [owner | gap | body 2 | gap | body 3 | gap | owner]
+
+With ``pin: cone`` each knuckle instead carries a 45 degree cone on its upper face, seated
+in a recess (the cone offset by the clearance) of the next knuckle.  Knuckles are
+cylinders of radius ``R = pin/2 + clearance + min_wall`` and at least ``min_feature``
+long (the span grows past the slab width if needed; the slab is widened by a *yoke plate*
+to carry it).
+
+Trimming
+--------
+1. Around every knuckle of another body, a body's slab is cut back to the axis's *trim
+   radius* ``rho >= R + clearance``: slab mid-planes are sampled and, in every logic state,
+   each pair of points of two bodies closer than thickness + clearance must lose one point.
+2. A slab running *along* an axis would be severed: it gets a bridge around the other
+   knuckles, on the side no other body swings through.
+3. What still comes closer than the clearance (as printed) or intersects (in a logic state)
+   is trimmed last (:func:`_resolve`): one of the two parts loses the other's region, grown
+   by 1.5 x clearance, never its knuckles or pins.
+4. Attachment holes are drilled last, where the trimmed slab has room (:func:`_drill`).
+
+Universal joint
+---------------
+A separate part at the bond point: a hub of two crossed cylinders and two crossed pins,
+one along each body's hinge direction.  Each body holds a yoke: two knuckles with holes
+at the ends of its pin, beyond the hub, or one knuckle on one side with a cap on the pin
+when the other body's arm passes the other side.  Around the hub each body is trimmed to
+the radius the other yoke sweeps.
+
+Pitfalls handled here: every cylinder gets ``circular_segments`` explicitly; every hole
+and clearance cutter is scaled by ``1/cos(pi/n)`` so the inscribed polygon keeps the full
+clearance.
+"""
+from __future__ import annotations
+
+import itertools
+from dataclasses import dataclass, field
+
+import manifold3d as mf
+import numpy as np
+
+from mlc.errors import MlcError
+from mlc.geometry.rotation import quat_to_matrix
+from mlc.mesh.profiles import PAPER_SLAB_MM, Profile
+from mlc.scene.model import Scene
+
+_TOL = 1e-3  # sigma: tolerance for "same point / same line"
+
+
+# --------------------------------------------------------------------------- primitives
+def _perp_frame(d) -> np.ndarray:
+    """A rotation matrix whose third column is the unit vector ``d``."""
+    d = np.asarray(d, float) / np.linalg.norm(d)
+    a = np.array([1.0, 0, 0]) if abs(d[0]) < 0.9 else np.array([0, 1.0, 0])
+    e1 = np.cross(d, a)
+    e1 /= np.linalg.norm(e1)
+    e2 = np.cross(d, e1)
+    return np.column_stack([e1, e2, d])
+
+
+def _affine(R, t) -> np.ndarray:
+    m = np.zeros((3, 4))
+    m[:, :3] = R
+    m[:, 3] = t
+    return m
+
+
+def cylinder(origin, direction, s0, s1, radius, segments, cutter=False) -> mf.Manifold:
+    """A cylinder on the line ``origin + s*direction`` for ``s0 <= s <= s1``.
+
+    ``cutter=True`` scales the radius by ``1/cos(pi/n)`` so the polygon's inscribed circle
+    has the nominal radius (holes and clearance cuts never shrink)."""
+    if s1 <= s0 or radius <= 0:
+        return mf.Manifold()
+    r = radius / np.cos(np.pi / segments) if cutter else radius
+    d = np.asarray(direction, float) / np.linalg.norm(direction)
+    c = mf.Manifold.cylinder(float(s1 - s0), float(r), -1.0, int(segments))
+    return c.transform(_affine(_perp_frame(d), np.asarray(origin, float) + s0 * d))
+
+
+def cone(origin, direction, s0, s1, r0, r1, segments, cutter=False) -> mf.Manifold:
+    """A truncated cone on a line, radius ``r0`` at ``s0`` and ``r1`` at ``s1``."""
+    k = 1 / np.cos(np.pi / segments) if cutter else 1.0
+    d = np.asarray(direction, float) / np.linalg.norm(direction)
+    if s1 < s0:
+        s0, s1, r0, r1 = s1, s0, r1, r0
+    c = mf.Manifold.cylinder(float(s1 - s0), float(r0 * k), float(r1 * k), int(segments))
+    return c.transform(_affine(_perp_frame(d), np.asarray(origin, float) + s0 * d))
+
+
+def box(center, R, size) -> mf.Manifold:
+    """A box of full edge lengths ``size`` with centre ``center`` and orientation ``R``."""
+    c = mf.Manifold.cube([float(s) for s in size], True)
+    return c.transform(_affine(R, center))
+
+
+def union(items) -> mf.Manifold:
+    items = [m for m in items if not m.is_empty()]
+    if not items:
+        return mf.Manifold()
+    return mf.Manifold.batch_boolean(items, mf.OpType.Add) if len(items) > 1 else items[0]
+
+
+def subtract(a, items) -> mf.Manifold:
+    items = [m for m in items if not m.is_empty()]
+    if not items or a.is_empty():
+        return a
+    return mf.Manifold.batch_boolean([a] + items, mf.OpType.Subtract)
+
+
+# --------------------------------------------------------------------------- data
+@dataclass
+class SlabBox:
+    center: np.ndarray   # world, mm (rest)
+    R: np.ndarray        # world orientation of the box axes
+    size: np.ndarray     # mm, thickness already replaced
+    normal_axis: int     # index of the thickness axis
+
+
+@dataclass
+class HingeAxis:
+    name: str                 # joint names joined by "+"
+    joints: list
+    origin: np.ndarray        # mm, world rest: the span's midpoint
+    direction: np.ndarray     # unit
+    span: float               # mm, knuckle span along the axis
+    bodies: list              # body names; bodies[0] owns the pin
+    intervals: dict           # body -> list of (s0, s1) knuckle intervals (s from origin)
+    knuckle: float            # knuckle length
+    R: float                  # knuckle radius
+    r_pin: float
+    r_hole: float
+    rho: float = 0.0          # trim radius around other bodies' knuckles
+    layout: list = field(default_factory=list)   # body of each knuckle, in axis order
+    scene_span: float = 0.0   # mm, span given by the scene (distance of the bond ends)
+
+    @property
+    def owner(self) -> str:
+        return self.bodies[0]
+
+
+@dataclass
+class YokeLayout:
+    """One axis of a universal joint: intervals along the axis (mm from the joint point)."""
+
+    mode: str                 # "both" (knuckles on both sides of the hub) or "+"/"-" (one side, capped)
+    own: list                 # the body's knuckles
+    caps: list                # the joint part's end caps (one-sided yokes)
+    pin: tuple                # extent of the joint part's pin
+    cut: tuple                # range where the body is trimmed away from the axis (except its knuckles)
+    plate: tuple = (0.0, 0.0)  # range of the yoke plate joining the knuckles to the slab
+
+    @property
+    def extent(self) -> float:
+        return max(abs(x) for iv in self.own + self.caps for x in iv)
+
+
+@dataclass
+class UJoint:
+    name: str                 # joint name in the scene
+    part: str                 # name of the joint part
+    center: np.ndarray        # mm
+    bodies: tuple             # (C, O)
+    axes: tuple               # (u, v): unit, u fixed in C, v fixed in O (rest world)
+    layouts: tuple            # (YokeLayout of C along u, YokeLayout of O along v)
+    hub: float                # hub length (both axes)
+    R: float
+    r_pin: float
+    r_hole: float
+    rho: tuple                # trim radius of C around u and of O around v
+
+
+@dataclass
+class Part:
+    name: str
+    kind: str                 # "body" | "joint"
+    solid: mf.Manifold        # world rest frame, mm
+    partners: list = field(default_factory=list)   # names of parts it is jointed to
+
+
+@dataclass
+class Assembly:
+    scene: Scene
+    profile: Profile
+    parts: list
+    axes: list
+    ujoints: list
+    notes: list
+    features: list            # (what, value_mm, minimum_mm)
+    slab_thickness: float
+    poses: dict | None = None  # state -> (pos (N,3), quat (N,4)) in sigma, as given to build()
+    orient: np.ndarray = field(default_factory=lambda: np.eye(4))  # world -> print frame (mm)
+
+    def part(self, name: str) -> Part:
+        for p in self.parts:
+            if p.name == name:
+                return p
+        raise KeyError(name)
+
+    def body_transform(self, body_index: int, pos, quat) -> np.ndarray:
+        """4x4 transform (mm) taking the rest pose of a body to the pose (pos, quat) in sigma."""
+        s = self.profile.sigma_mm
+        b = self.scene.bodies[body_index]
+        R0 = quat_to_matrix(b.orientation)
+        R1 = quat_to_matrix(quat)
+        Rr = R1 @ R0.T
+        T = np.eye(4)
+        T[:3, :3] = Rr
+        T[:3, 3] = s * np.asarray(pos, float) - Rr @ (s * np.asarray(b.position, float))
+        return T
+
+    def part_transforms(self, pos, quat) -> dict:
+        """Rest -> posed 4x4 transforms (mm) of every part for body poses (pos, quat)."""
+        idx = {b.name: i for i, b in enumerate(self.scene.bodies)}
+        out = {}
+        for p in self.parts:
+            if p.kind == "body":
+                i = idx[p.name]
+                out[p.name] = self.body_transform(i, pos[i], quat[i])
+        for u in self.ujoints:
+            Tc = out[u.bodies[0]]
+            To = out[u.bodies[1]]
+            uu = Tc[:3, :3] @ u.axes[0]
+            vv = To[:3, :3] @ u.axes[1]
+            F1 = _ortho(uu, vv)
+            F0 = _ortho(u.axes[0], u.axes[1])
+            # the hub sits where the two bodies' copies of the joint point are (their mean)
+            c = 0.5 * (Tc[:3, :3] @ u.center + Tc[:3, 3] + To[:3, :3] @ u.center + To[:3, 3])
+            T = np.eye(4)
+            T[:3, :3] = F1 @ F0.T
+            T[:3, 3] = c - T[:3, :3] @ u.center
+            out[u.part] = T
+        return out
+
+
+def _ortho(u, v) -> np.ndarray:
+    u = u / np.linalg.norm(u)
+    v = v - np.dot(v, u) * u
+    v = v / np.linalg.norm(v)
+    return np.column_stack([u, v, np.cross(u, v)])
+
+
+def transform_solid(solid: mf.Manifold, T) -> mf.Manifold:
+    return solid.transform(np.asarray(T, float)[:3, :4])
+
+
+# --------------------------------------------------------------------------- build
+def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
+                   resolve: bool = True) -> Assembly:
+    """Build the printable parts of ``scene`` (rest pose) for ``profile``.
+
+    ``poses`` maps logic states to body poses ``(pos, quat)`` (sigma); hinge trim radii
+    are chosen so that slabs clear each other in every one of them."""
+    prof = profile
+    s = prof.sigma_mm
+    n = prof.circular_segments
+    c = prof.clearance
+    g = prof.knuckle_gap
+    notes: list[str] = []
+    features: list = []
+    bodies = {b.name: b for b in scene.bodies}
+
+    # -- slab thickness: the profile decides -----------------------------------
+    scene_t = min(float(np.min(bx.size)) for b in scene.bodies for bx in b.boxes) * s
+    t = max(prof.slab_thickness, scene_t)
+    if scene_t < prof.min_wall:
+        notes.append(
+            f"slab thickness: the scene's slabs are {scene_t:.3g} mm ({scene_t / s:.3g} sigma; the paper printed "
+            f"{PAPER_SLAB_MM} mm), below this profile's minimum wall {prof.min_wall:g} mm: printed at {t:g} mm "
+            f"(profile slab_thickness)")
+    features.append(("slab thickness", t, prof.min_wall))
+
+    # -- slab boxes in world (mm) ----------------------------------------------
+    slabs: dict[str, list[SlabBox]] = {}
+    for b in scene.bodies:
+        Rb = quat_to_matrix(b.orientation)
+        lst = []
+        for bx in b.boxes:
+            R = Rb @ quat_to_matrix(bx.orientation)
+            size = np.asarray(bx.size, float) * s
+            k = int(np.argmin(size))
+            size[k] = max(size[k], t)
+            lst.append(SlabBox(s * (np.asarray(b.position, float) + Rb @ np.asarray(bx.center, float)), R, size, k))
+        slabs[b.name] = lst
+
+    r_pin = max(prof.pin_diameter, prof.min_feature) / 2
+    r_hole = r_pin + c
+    R = r_hole + prof.min_wall
+    R = max(R, t / 2 + prof.min_wall / 2)
+    kmin = max(prof.min_feature, 0.0)
+    cones = prof.pin == "cone"
+    r_cone = 0.0
+    if cones:
+        # 45 degree cone pins: a cone on one knuckle in a conical recess of the next; the
+        # recess is the cone offset by the clearance (its apex moves by c*sqrt(2))
+        r_cone = max(prof.min_feature / 2 + g + c, r_pin)
+        R = max(R, r_cone + c * np.sqrt(2) + prof.min_wall)
+        features.append(("cone pin diameter", 2 * r_cone, prof.min_feature))
+        features.append(("knuckle wall around a cone recess", R - r_cone - c * np.sqrt(2), prof.min_wall))
+    else:
+        features.append(("pin diameter", 2 * r_pin, prof.min_feature))
+        features.append(("knuckle wall", R - r_hole, prof.min_wall))
+
+    # -- group hinge joints by axis ------------------------------------------
+    joints = scene.joints()
+    lines = []  # (p, d, [joint names], set(bodies), ends (sigma))
+    for jname, bonds in joints.items():
+        kind = bonds[0].kind
+        if kind != "hinge":
+            continue
+        if len(bonds) != 2:
+            raise MlcError(f"hinge {jname} has {len(bonds)} bonds; a printable hinge needs two (its axis ends)",
+                           bonds[0].loc or scene.source or scene.name)
+        ends = [0.5 * (scene.site_world(bd.a) + scene.site_world(bd.b)) for bd in bonds]
+        d = ends[1] - ends[0]
+        L = float(np.linalg.norm(d))
+        if L < _TOL:
+            raise MlcError(f"hinge {jname}: its two bonds are at the same point, so it has no axis",
+                           bonds[0].loc or scene.source or scene.name, "place the bonds at the two ends of the axis")
+        d = d / L
+        pair = {bd.a.split(".")[0] for bd in bonds} | {bd.b.split(".")[0] for bd in bonds}
+        for ln in lines:
+            p, dd = ln[0], ln[1]
+            if abs(abs(np.dot(d, dd)) - 1) < 1e-6 and np.linalg.norm(np.cross(ends[0] - p, dd)) < _TOL:
+                ln[2].append(jname)
+                for bn in sorted(pair):
+                    if bn not in ln[3]:
+                        ln[3].append(bn)
+                ln[4].extend(ends)
+                break
+        else:
+            order = []
+            for bd in bonds:
+                for ref in (bd.a, bd.b):
+                    bn = ref.split(".")[0]
+                    if bn not in order:
+                        order.append(bn)
+            lines.append([ends[0], d, [jname], order, list(ends)])
+
+    axes: list[HingeAxis] = []
+    for p, d, jn, blist, ends in lines:
+        proj = [float(np.dot(e - p, d)) for e in ends]
+        lo, hi = min(proj), max(proj)
+        mid = p + d * 0.5 * (lo + hi)
+        L = (hi - lo) * s
+        nk = len(blist) + (1 if len(blist) >= 2 else 0)
+        S = max(L, nk * kmin + (nk - 1) * g)
+        k = (S - (nk - 1) * g) / nk
+        layout = [blist[0]] + blist[1:] + [blist[0]]
+        if cones:
+            # the recess of a cone must leave a wall at the far end of its knuckle
+            k_need = r_cone + c * np.sqrt(2) - g + prof.min_wall
+            if k < k_need:
+                S = nk * k_need + (nk - 1) * g
+                k = k_need
+        intervals: dict[str, list] = {bn: [] for bn in blist}
+        for i, bn in enumerate(layout):
+            a0 = -S / 2 + i * (k + g)
+            intervals[bn].append((a0, a0 + k))
+        ax = HingeAxis("+".join(jn), jn, mid * s, d, S, list(blist), intervals, k, R, r_pin, r_hole,
+                       scene_span=L, layout=list(layout))
+        axes.append(ax)
+        features.append((f"knuckle length ({ax.name})", k, prof.min_feature))
+        if S > L + 1e-9:
+            notes.append(f"hinge {ax.name}: knuckles need {S:.3g} mm, more than the slab width {L:.3g} mm: "
+                         f"the slabs are widened to the knuckle span there")
+
+    state_T = _state_transforms(scene, prof, poses)
+    h = _sample_step(t, c, s)
+
+    # -- universal joints: a hub with two crossed pins; each body a yoke --------------
+    #    (both sides of the hub, or one side with a cap on the pin when the other body's
+    #    arm passes the other side); the layout with the smallest trim radii wins
+    ujoints: list[UJoint] = []
+    reach = R + c + 2 * R + 0.25 * s
+    base_samples = {bn: _slab_samples(slabs[bn], h) for bn in slabs}
+    for jname, bonds in joints.items():
+        if bonds[0].kind != "universal":
+            continue
+        bd = bonds[0]
+        cb, ob = bd.a.split(".")[0], bd.b.split(".")[0]
+        center = 0.5 * (scene.site_world(bd.a) + scene.site_world(bd.b)) * s
+        u = _hinge_dir(cb, axes, slabs, center)
+        v = _hinge_dir(ob, axes, slabs, center)
+        if abs(np.dot(u, v)) > 0.95:
+            w = np.mean([sb.center for sb in slabs[ob]], axis=0) - center
+            v = np.cross(u, w)
+            if np.linalg.norm(v) < 1e-9:
+                v = _perp_frame(u)[:, 0]
+        v = v - np.dot(v, u) * u
+        v /= np.linalg.norm(v)
+        hub = 2 * (R + c)
+        ky = max(kmin, R)
+        cap = max(kmin, prof.min_wall)
+        W = (_extent_along(slabs[cb], center, u), _extent_along(slabs[ob], center, v))
+        best = None
+        for modes in (("both", "both"), ("+", "both"), ("-", "both"), ("both", "+"), ("both", "-")):
+            lays = tuple(_yoke_layout(m, hub, g, ky, cap, W[i], s) for i, m in enumerate(modes))
+            part_name = jname if jname not in bodies else f"joint_{jname}"
+            uj = UJoint(jname, part_name, center, (cb, ob), (u, v), lays, hub, R, r_pin, r_hole,
+                        (float(np.hypot(lays[1].extent, R)) + c, float(np.hypot(lays[0].extent, R)) + c))
+            smp = dict(base_samples)
+            for side, bn in enumerate(uj.bodies):
+                smp[bn] = np.concatenate([smp[bn], _slab_samples(
+                    _yoke_plates(slabs[bn], center, uj.axes[side], [lays[side].plate], uj.rho[side] + reach, t), h)])
+            need = _ujoint_trim(uj, smp, state_T, t, c, h)
+            rho = (max(uj.rho[0], need[0]), max(uj.rho[1], need[1]))
+            score = (rho[0] + rho[1], modes != ("both", "both"))
+            if best is None or score < best[0]:
+                uj.rho = rho
+                best = (score, uj)
+        uj = best[1]
+        ujoints.append(uj)
+        if uj.layouts[0].mode != "both" or uj.layouts[1].mode != "both":
+            notes.append(f"universal joint {jname}: one-sided yoke ({uj.layouts[0].mode} on {cb}, "
+                         f"{uj.layouts[1].mode} on {ob}) with a capped pin, clear of the other arm")
+        ks = [iv[1] - iv[0] for lay in uj.layouts for iv in lay.own + lay.caps]
+        features.append((f"yoke knuckle length ({jname})", min(ks), prof.min_feature))
+        features.append((f"hub length ({jname})", hub, prof.min_feature))
+
+    # -- yoke plates: widen slabs to the knuckle span near an axis ------------------
+    plates: dict[str, list[SlabBox]] = {b.name: [] for b in scene.bodies}
+    for ax in axes:
+        if ax.span > ax.scene_span + 1e-9:
+            for bn in ax.bodies:
+                plates[bn] += _yoke_plates(slabs[bn], ax.origin, ax.direction, [(-ax.span / 2, ax.span / 2)],
+                                           reach, t)
+    for uj in ujoints:
+        for side, bn in enumerate(uj.bodies):
+            plates[bn] += _yoke_plates(slabs[bn], uj.center, uj.axes[side], [uj.layouts[side].plate],
+                                       uj.rho[side] + reach, t)
+    shapes = {bn: slabs[bn] + plates[bn] for bn in slabs}
+    samples = {bn: _slab_samples(shapes[bn], h) for bn in shapes}
+
+    # -- trim radii: in every logic state, slabs of the bodies at an axis clear each other
+    #    outside the radius inside which only the knuckle's own body has material
+    for ax in axes:
+        ax.rho = _trim_radius(ax, samples, state_T, t, c, h, s, notes)
+
+    # -- muscle and probe attachment holes -------------------------------------------
+    lug_hole = max(prof.min_feature, 0.08 * s) / 2
+    lug_out = lug_hole + prof.min_wall
+    lugs: dict[str, list] = {b.name: [] for b in scene.bodies}
+    for kind, items in (("muscle", scene.muscles), ("probe", scene.probes)):
+        for it in items:
+            for ref in (it.a, it.b):
+                bn = ref.split(".")[0]
+                p = scene.site_world(ref) * s
+                if any(np.allclose(p, q[3]) for q in lugs[bn]):
+                    continue
+                if _near_axis(bn, p, axes, ujoints, R + c + lug_out):
+                    notes.append(f"{kind} {it.name}: site {ref} is at a joint; no attachment hole there")
+                    continue
+                centre, nrm, ring, sb = _attachment(slabs[bn], p, lug_out, t)
+                lugs[bn].append((centre, nrm, ring, p, sb, f"{kind} {it.name} ({ref})"))
+    if any(lugs.values()):
+        features.append(("attachment hole diameter", 2 * lug_hole, prof.min_feature))
+        features.append(("attachment hole wall", lug_out - lug_hole, prof.min_wall))
+
+    # -- assemble body solids ----------------------------------------------------------
+    parts: list[Part] = []
+    protected: dict[str, mf.Manifold] = {}
+    soft: dict[str, mf.Manifold] = {}
+    for b in scene.bodies:
+        bn = b.name
+        solid = union([box(sb.center, sb.R, sb.size) for sb in shapes[bn]])
+        my_axes = [ax for ax in axes if bn in ax.bodies]
+        my_uj = [(uj, 0 if uj.bodies[0] == bn else 1) for uj in ujoints if bn in uj.bodies]
+        # 1. clear the other bodies' knuckles
+        cuts = []
+        for ax in my_axes:
+            for a0, a1 in _ext(_complement(ax.intervals[bn], -ax.span / 2, ax.span / 2), ax.span, t):
+                cuts.append(cylinder(ax.origin, ax.direction, a0, a1, ax.rho, n, cutter=True))
+        for uj, side in my_uj:
+            lay = uj.layouts[side]
+            for a0, a1 in _complement(lay.own, *lay.cut):
+                cuts.append(cylinder(uj.center, uj.axes[side], a0, a1, uj.rho[side], n, cutter=True))
+        cut_solid = _clean(subtract(solid, cuts))
+        if len(cut_solid.decompose()) > len(_clean(solid).decompose()):
+            # a slab running along an axis is severed by the clearance around another body's
+            # knuckle: bridge around it on the side no other body ever swings through
+            bridges = []
+            base_n = len(_clean(solid).decompose())
+            for ax in my_axes:
+                own = ax.intervals[bn]
+                axis_cuts = [cylinder(ax.origin, ax.direction, a0, a1, ax.rho, n, cutter=True)
+                             for a0, a1 in _ext(_complement(own, -ax.span / 2, ax.span / 2), ax.span, t)]
+                if len(_clean(subtract(solid, axis_cuts)).decompose()) <= base_n:
+                    continue
+                for a0, a1 in _complement(own, -ax.span / 2, ax.span / 2):
+                    if any(o1 <= a0 + 1e-9 for _, o1 in own) and any(o0 >= a1 - 1e-9 for o0, _ in own):
+                        bridges.append(_bridge(ax, bn, a0, a1, samples, state_T, t, prof))
+                        notes.append(f"hinge {ax.name}: {bn} bridges around the other knuckles "
+                                     f"({np.degrees(bridges[-1][1]):.0f} degrees from them)")
+            solid = _clean(subtract(union([solid] + [x for x, _ in bridges]), cuts)) if bridges else cut_solid
+        else:
+            solid = cut_solid
+        # 2. own knuckles, attachment rings
+        keep = []
+        for ax in my_axes:
+            for a0, a1 in ax.intervals[bn]:
+                keep.append(cylinder(ax.origin, ax.direction, a0, a1, R, n))
+        for uj, side in my_uj:
+            for a0, a1 in uj.layouts[side].own:
+                keep.append(cylinder(uj.center, uj.axes[side], a0, a1, R, n))
+        # rings where the slab is too narrow for a hole; holes inside slabs are drilled last,
+        # where the slab has room for them after trimming
+        rings = [cylinder(x[0], x[1], -t / 2, t / 2, lug_out, n) for x in lugs[bn] if x[2]]
+        male, recess = [], []
+        if cones:
+            cr = r_cone + c * np.sqrt(2)
+            for ax in my_axes:
+                seq = sorted((iv, b2) for b2, ivs in ax.intervals.items() for iv in ivs)
+                for (iv0, b0), (iv1, b1) in zip(seq, seq[1:]):
+                    face = iv0[1]          # the cone grows from the end face of the lower knuckle
+                    if b0 == bn:
+                        male.append(cone(ax.origin, ax.direction, face - 1e-3, face + r_cone, r_cone + 1e-3, 0.0, n))
+                    if b1 == bn:
+                        recess.append(cone(ax.origin, ax.direction, face - 1e-3, face + cr, cr + 1e-3, 0.0, n,
+                                           cutter=True))
+        keep += male
+        solid = union([solid] + keep + rings)
+        # 3. holes: non-owner knuckles, yoke knuckles, attachment holes
+        holes = []
+        holes += recess
+        for ax in my_axes:
+            if ax.owner != bn and not cones:
+                for a0, a1 in ax.intervals[bn]:
+                    holes.append(cylinder(ax.origin, ax.direction, a0 - g / 2, a1 + g / 2, r_hole, n, cutter=True))
+        for uj, side in my_uj:
+            for a0, a1 in uj.layouts[side].own:
+                holes.append(cylinder(uj.center, uj.axes[side], a0 - g / 2, a1 + g / 2, r_hole, n, cutter=True))
+        for x in lugs[bn]:
+            if x[2]:
+                holes.append(cylinder(x[0], x[1], -t - 1, t + 1, lug_hole, n, cutter=True))
+        solid = subtract(solid, holes)
+        # 4. the owner's pin
+        pins = [cylinder(ax.origin, ax.direction, -ax.span / 2, ax.span / 2, r_pin, n)
+                for ax in my_axes if ax.owner == bn and not cones]
+        solid = _clean(union([solid] + pins))
+        protected[bn] = union(keep + pins + rings)
+        # the spot where the attachment hole would go (0.85 mm in from the site), kept if possible
+        spots = [cylinder(_spot(x[4], x[0], lug_out), x[1], -t, t, lug_out + c, n) for x in lugs[bn] if not x[2]]
+        soft[bn] = union([protected[bn]] + spots)
+        partners = sorted({o for ax in my_axes for o in ax.bodies if o != bn}
+                          | {uj.part for uj, _ in my_uj})
+        parts.append(Part(bn, "body", solid, partners))
+
+    for uj in ujoints:
+        u, v = uj.axes
+        pieces = [cylinder(uj.center, u, -uj.hub / 2, uj.hub / 2, R, n),
+                  cylinder(uj.center, v, -uj.hub / 2, uj.hub / 2, R, n)]
+        for side, lay in enumerate(uj.layouts):
+            pieces.append(cylinder(uj.center, uj.axes[side], lay.pin[0], lay.pin[1], r_pin, n))
+            pieces += [cylinder(uj.center, uj.axes[side], a0, a1, R, n) for a0, a1 in lay.caps]
+        parts.append(Part(uj.part, "joint", union(pieces), list(uj.bodies)))
+        protected[uj.part] = parts[-1].solid
+
+    for jname, bonds in joints.items():
+        if bonds[0].kind not in ("hinge", "universal"):
+            notes.append(f"joint {jname} ({bonds[0].kind}) is not printed as a joint")
+    if cones and ujoints:
+        notes.append("pin: cone pins on the hinges; the universal joint keeps straight pins in its yokes")
+
+    asm = Assembly(scene, prof, parts, axes, ujoints, notes, features, t, poses)
+    if resolve:
+        _resolve(asm, protected, soft, state_T)
+    _drill(asm, lugs, lug_hole, lug_out, t)
+    asm.orient = _orientation(asm)
+    return asm
+
+
+# --------------------------------------------------------------------------- helpers
+def _complement(own, lo, hi):
+    """Intervals of ``[lo, hi]`` not covered by a body's own knuckles (gaps included): the
+    cut reaches exactly to the faces of its own knuckles."""
+    out = []
+    cur = lo
+    for a0, a1 in sorted(own):
+        if a0 > cur:
+            out.append((cur, a0))
+        cur = max(cur, a1)
+    if hi > cur:
+        out.append((cur, hi))
+    return out
+
+
+def _state_transforms(scene, prof, poses):
+    """[(state, {body: 4x4})] for the given poses (mm)."""
+    if not poses:
+        return []
+    s = prof.sigma_mm
+    out = []
+    for st, (pos, quat) in poses.items():
+        Ts = {}
+        for i, b in enumerate(scene.bodies):
+            R0 = quat_to_matrix(b.orientation)
+            R1 = quat_to_matrix(quat[i])
+            Rr = R1 @ R0.T
+            T = np.eye(4)
+            T[:3, :3] = Rr
+            T[:3, 3] = s * np.asarray(pos[i], float) - Rr @ (s * np.asarray(b.position, float))
+            Ts[b.name] = T
+        out.append((st, Ts))
+    return out
+
+
+def _sample_step(t, c, s) -> float:
+    """Spacing of the slab sample points: fine against the clearance and slab thickness."""
+    return float(np.clip(max(min(t, c), 0.015 * s), 0.05, 0.5))
+
+
+def _slab_samples(sbs, h) -> np.ndarray:
+    """Points on the mid-planes of slab boxes, spaced at most ``h`` apart."""
+    pts = []
+    for sb in sbs:
+        ax = [i for i in range(3) if i != sb.normal_axis]
+        m0 = max(2, int(np.ceil(sb.size[ax[0]] / h)) + 1)
+        m1 = max(2, int(np.ceil(sb.size[ax[1]] / h)) + 1)
+        a, b = np.meshgrid(np.linspace(-0.5, 0.5, m0) * sb.size[ax[0]],
+                           np.linspace(-0.5, 0.5, m1) * sb.size[ax[1]], indexing="ij")
+        loc = np.zeros((a.size, 3))
+        loc[:, ax[0]] = a.ravel()
+        loc[:, ax[1]] = b.ravel()
+        pts.append(sb.center + loc @ sb.R.T)
+    return np.concatenate(pts) if pts else np.zeros((0, 3))
+
+
+def _axis_coords(origin, d, pts):
+    rel = pts - origin
+    a = rel @ d
+    r = np.linalg.norm(rel - a[:, None] * d, axis=1)
+    return a, r
+
+
+def _axis_angles(ax: HingeAxis, pts, r_lo, r_hi):
+    E = _perp_frame(ax.direction)
+    rel = pts - ax.origin
+    a = rel @ ax.direction
+    x, y = rel @ E[:, 0], rel @ E[:, 1]
+    r = np.hypot(x, y)
+    keep = (np.abs(a) <= ax.span / 2 + 1e-6) & (r >= r_lo) & (r <= r_hi)
+    return np.arctan2(y[keep], x[keep])
+
+
+def _in_frame_of(A, B, pts, Ts):
+    """Points of body B (rest world) as seen in body A's rest frame in a posed state."""
+    if Ts is None:
+        return pts
+    M = np.linalg.inv(Ts[A]) @ Ts[B]
+    return pts @ M[:3, :3].T + M[:3, 3]
+
+
+def _inside(s, intervals):
+    out = np.zeros(len(s), bool)
+    for a0, a1 in intervals:
+        out |= (s >= a0) & (s <= a1)
+    return out
+
+
+def _close_pairs(pa, pb, thr):
+    """Pairs (i, j) of points of ``pa`` and ``pb`` closer than ``thr``: each point with its
+    nearest partner (both ways) -- enough to see every point that has a close partner, and far
+    fewer pairs than all of them (the final trims and the checks see the exact solids)."""
+    from scipy.spatial import cKDTree
+    if len(pa) == 0 or len(pb) == 0:
+        return np.zeros(0, int), np.zeros(0, int)
+    ta, tb = cKDTree(pa), cKDTree(pb)
+    d1, j1 = tb.query(pa, k=1, distance_upper_bound=thr)
+    d2, i2 = ta.query(pb, k=1, distance_upper_bound=thr)
+    a = np.isfinite(d1)
+    b = np.isfinite(d2)
+    ii = np.concatenate([np.nonzero(a)[0], i2[b]]).astype(int)
+    jj = np.concatenate([j1[a], np.nonzero(b)[0]]).astype(int)
+    return ii, jj
+
+
+def _trim_radius(ax: HingeAxis, samples, state_T, t, c, h, s, notes) -> float:
+    """Radius around the axis inside which only the knuckle's own body has material.
+
+    In every state (bodies posed relative to each other), every pair of slab points of two
+    bodies of the axis closer than ``t + c`` (mid-plane distance, plus the sampling step)
+    must lose one of its points: a point is removed when it lies on another body's stretch
+    of the axis and within the trim radius."""
+    base = ax.R + c
+    cap = ax.R + c + 0.5 * s
+    thr = t + c + h
+    need = 0.0
+    states = state_T or [("rest", None)]
+    near = {}
+    for bn in ax.bodies:
+        a, r = _axis_coords(ax.origin, ax.direction, samples[bn])
+        keep = (np.abs(a) <= ax.span / 2 + thr) & (r <= cap + thr)
+        near[bn] = (samples[bn][keep], a[keep], r[keep], ~_inside(a[keep], ax.intervals[bn]))
+    for _, Ts in states:
+        for i, A in enumerate(ax.bodies):
+            for B in ax.bodies[i + 1:]:
+                pa, sa, ra, ea = near[A]
+                pb, sb_, rb, eb = near[B]
+                ii, jj = _close_pairs(pa, _in_frame_of(A, B, pb, Ts), thr)
+                if len(ii) == 0:
+                    continue
+                req = np.minimum(np.where(ea[ii], ra[ii], np.inf), np.where(eb[jj], rb[jj], np.inf))
+                req = req[np.isfinite(req)]
+                if len(req):
+                    need = max(need, float(req.max()) + h)
+    rho = max(base, need)
+    if rho > cap:
+        notes.append(f"hinge {ax.name}: slabs stay close far from the axis; trim radius capped at "
+                     f"{cap:.3g} mm (needs {rho:.3g} mm)")
+        rho = cap
+    return float(rho)
+
+
+def _yoke_layout(mode, hub, g, k, cap, W, s) -> YokeLayout:
+    if mode == "both":
+        S = max(W, hub + 2 * g + 2 * k)
+        k2 = (S - hub - 2 * g) / 2
+        return YokeLayout(mode, [(-S / 2, -S / 2 + k2), (S / 2 - k2, S / 2)], [], (-S / 2, S / 2), (-S / 2, S / 2),
+                          (-S / 2, S / 2))
+    sg = 1.0 if mode == "+" else -1.0
+    a0 = hub / 2 + g
+    own = (a0, a0 + k)
+    caps = (a0 + k + g, a0 + k + g + cap)
+    f = (lambda iv: (iv[0], iv[1])) if sg > 0 else (lambda iv: (-iv[1], -iv[0]))
+    big = 10 * s + 10 * (hub + k + cap)
+    pin = f((-hub / 2, caps[1]))
+    o = f(own)
+    return YokeLayout(mode, [o], [f(caps)], pin, (-big, big), (min(o[0], -W / 2), max(o[1], W / 2)))
+
+
+def _ujoint_trim(uj: UJoint, samples, state_T, t, c, h):
+    """Trim radii of the two yokes of a universal joint so their slabs clear in every state:
+    each pair of close slab points (C, O) loses the point that needs the smaller radius."""
+    C, O = uj.bodies
+    thr = t + c + h
+    coords = []
+    for side, bn in enumerate((C, O)):
+        lay = uj.layouts[side]
+        a, r = _axis_coords(uj.center, uj.axes[side], samples[bn])
+        # only points a trim radius can reach matter here (the rest is left to the final trims)
+        keep = np.linalg.norm(samples[bn] - uj.center, axis=1) <= 2 * lay.extent + uj.rho[side] + 4 * uj.R
+        elig = (a >= lay.cut[0]) & (a <= lay.cut[1]) & ~_inside(a, lay.own)
+        coords.append((samples[bn][keep], r[keep], elig[keep]))
+    (pc, rc, ec), (po, ro, eo) = coords
+    VC, VO = [], []
+    for _, Ts in (state_T or [("rest", None)]):
+        ii, jj = _close_pairs(pc, _in_frame_of(C, O, po, Ts), thr)
+        if len(ii):
+            VC.append(np.where(ec[ii], rc[ii] + h, np.inf))
+            VO.append(np.where(eo[jj], ro[jj] + h, np.inf))
+    need = [0.0, 0.0]
+    if not VC:
+        return need[0], need[1]
+    vc, vo = np.concatenate(VC), np.concatenate(VO)
+    ok = np.isfinite(vc) | np.isfinite(vo)          # pairs no trim can separate are left to the checks
+    vc, vo = vc[ok], vo[ok]
+    if len(vc) == 0:
+        return need[0], need[1]
+    # every close pair is settled by C (need_c >= vc) or by O (need_o >= vo): choose the split
+    # minimising need_c + need_o -- the k pairs with the largest vc go to O
+    order = np.argsort(-vc, kind="stable")
+    vcs, vos = vc[order], vo[order]
+    pm = np.concatenate([[0.0], np.maximum.accumulate(vos)])      # need_o if the first k go to O
+    nc = np.concatenate([vcs, [0.0]])                                # need_c for the rest
+    cost = nc + pm
+    k = int(np.argmin(cost))
+    need = [float(nc[k]), float(pm[k])]
+    return need[0], need[1]
+
+
+def _bridge(ax: HingeAxis, bn, a0, a1, samples, state_T, t, prof):
+    """A plate carrying body ``bn`` around the other bodies' knuckles on ``[a0, a1]``:
+    in the direction (about the axis) farthest from every other body in every state."""
+    far = 3 * ax.R + 2 * t + 0.5 * prof.sigma_mm
+    foreign = []
+    for o in ax.bodies:
+        if o == bn:
+            continue
+        for _, Ts in (state_T or [("rest", None)]):
+            foreign.append(_axis_angles(ax, _in_frame_of(bn, o, samples[o], Ts), ax.R, far))
+    fa = np.concatenate(foreign) if foreign else np.zeros(0)
+    cand = np.linspace(-np.pi, np.pi, 144, endpoint=False)
+    if len(fa):
+        score = np.abs(((cand[:, None] - fa[None, :]) + np.pi) % (2 * np.pi) - np.pi).min(axis=1)
+    else:
+        score = np.full_like(cand, np.pi)
+    th = float(cand[int(np.argmax(score))])
+    E = _perp_frame(ax.direction)
+    e = np.cos(th) * E[:, 0] + np.sin(th) * E[:, 1]
+    w = max(prof.min_wall, t)
+    reach = ax.rho + w
+    Rm = np.column_stack([ax.direction, e, np.cross(ax.direction, e)])
+    center = ax.origin + ax.direction * 0.5 * (a0 + a1) + e * reach / 2
+    return box(center, Rm, [a1 - a0 + 2 * w, reach, t]), float(score.max())
+
+
+def _ext(intervals, span, t):
+    """Extend cut intervals that end at the span's ends a little further (no coplanar faces)."""
+    out = []
+    for a0, a1 in intervals:
+        if abs(a0 + span / 2) < 1e-9:
+            a0 -= t
+        if abs(a1 - span / 2) < 1e-9:
+            a1 += t
+        out.append((a0, a1))
+    return out
+
+
+def _clean(solid: mf.Manifold) -> mf.Manifold:
+    """Drop slivers (pieces of negligible volume) left by booleans on touching faces."""
+    if solid.is_empty():
+        return solid
+    pieces = solid.decompose()
+    if len(pieces) <= 1:
+        return solid
+    vols = [p.volume() for p in pieces]
+    big = max(vols)
+    keep = [p for p, v in zip(pieces, vols) if v > max(1e-4, 2e-3 * big)]
+    return union(keep)
+
+
+def _attachment(sbs, p, lug_out, t):
+    """Where the attachment hole for a site goes: inside the nearest slab when it is wide
+    enough (ring=False; drilled last, at the free spot of that slab nearest to the site),
+    else a ring around the site."""
+    sb = min(sbs, key=lambda x: np.linalg.norm(x.center - p))
+    nrm = sb.R[:, sb.normal_axis]
+    inplane = [i for i in range(3) if i != sb.normal_axis]
+    if all(sb.size[i] >= 2 * lug_out for i in inplane):
+        return p, nrm, False, sb
+    return p, nrm, True, sb
+
+
+def _spot(sb, p, lug_out):
+    """The point of a slab nearest to ``p`` with room for a hole ring of radius ``lug_out``."""
+    q = sb.R.T @ (p - sb.center)
+    for i in range(3):
+        lim = max(sb.size[i] / 2 - lug_out, 0.0) if i != sb.normal_axis else 0.0
+        q[i] = float(np.clip(q[i], -lim, lim))
+    return sb.center + sb.R @ q
+
+
+def _ring_clear(asm: "Assembly", part: "Part", ring) -> bool:
+    """True if ``ring`` (in ``part``'s rest frame) keeps the clearance from every other part as
+    printed and meets none in any logic state."""
+    c = asm.profile.clearance
+    rb = np.asarray(ring.bounding_box())
+    Ts = [asm.part_transforms(pos, quat) for pos, quat in (asm.poses or {}).values()]
+    for other in asm.parts:
+        if other is part:
+            continue
+        if _bb_near(rb, np.asarray(other.solid.bounding_box()), 2 * c) and ring.min_gap(other.solid, c) < c - 1e-6:
+            return False
+        for T in Ts:
+            o = transform_solid(other.solid, np.linalg.inv(T[part.name]) @ T[other.name])
+            if _bb_near(rb, np.asarray(o.bounding_box()), 0.0) and (ring ^ o).volume() > 1e-6:
+                return False
+    return True
+
+
+def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t) -> None:
+    """Drill each attachment hole inside its slab, at the spot nearest to the site where a
+    full ring of material (``min_wall``) surrounds the hole."""
+    n = asm.profile.circular_segments
+    for part in asm.parts:
+        for site, nrm, ring, _, sb, label in lugs.get(part.name, []):
+            if ring:
+                continue
+            inplane = [i for i in range(3) if i != sb.normal_axis]
+            step = lug_out / 3
+            axes_ = []
+            for i in inplane:
+                lim = sb.size[i] / 2 - lug_out
+                axes_.append(np.linspace(-lim, lim, max(1, int(2 * lim / step) + 1)) if lim > 0 else np.zeros(1))
+            g0, g1 = np.meshgrid(*axes_, indexing="ij")
+            loc = np.zeros((g0.size, 3))
+            loc[:, inplane[0]] = g0.ravel()
+            loc[:, inplane[1]] = g1.ravel()
+            cands = sb.center + loc @ sb.R.T
+            order = np.argsort(np.linalg.norm(cands - site, axis=1))
+            # the hole needs its wall in the slab's plane; a face shaved by a trim is acceptable,
+            # so the test disc is the middle half of the slab's thickness
+            disc = cylinder(np.zeros(3), nrm, -t / 4, t / 4, lug_out, n)
+            full = disc.volume()
+            for k in order[:400]:
+                c = cands[k]
+                if (disc.translate(c.tolist()) - part.solid).volume() <= 1e-3 * full:
+                    part.solid = subtract(part.solid, [cylinder(c, nrm, -t - 1, t + 1, lug_hole, n, cutter=True)])
+                    off = float(np.linalg.norm(c - site))
+                    if off > 1e-6:
+                        asm.notes.append(f"{label}: attachment hole {off:.2f} mm from the site, inside the slab")
+                    break
+            else:
+                # no room inside the trimmed slab: a ring (lug) of full thickness around the site,
+                # or further along the arm, where it clears every other part in every state
+                L = max(inplane, key=lambda i: sb.size[i])
+                along = [c for c in cands[order] if abs((sb.R.T @ (c - sb.center))[[i for i in inplane
+                                                                                      if i != L][0]]) < step]
+                for c in [site] + along[:10]:
+                    ringd = cylinder(c, nrm, -t / 2, t / 2, lug_out, n)
+                    if _ring_clear(asm, part, ringd):
+                        part.solid = subtract(union([part.solid, ringd]),
+                                              [cylinder(c, nrm, -t - 1, t + 1, lug_hole, n, cutter=True)])
+                        asm.notes.append(f"{label}: no room inside the trimmed slab; a ring lug "
+                                         f"{np.linalg.norm(c - site):.2f} mm from the site instead")
+                        break
+                else:
+                    asm.notes.append(f"{label}: no room for an attachment hole in the trimmed slab, "
+                                     f"nor for a ring at the site")
+                    asm.features.append((f"room for the attachment hole of {label}", 0.0, 2 * lug_out))
+
+
+def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T) -> None:
+    """Trim slabs that still come closer than the clearance (as printed) or intersect (in a
+    logic state): from one of the two parts, cut the other part grown by the clearance, in
+    every state where they meet, never touching knuckles, pins or attachment rings.  The part
+    trimmed is one whose trim settles the conflict, stays in one piece and loses less."""
+    c = asm.profile.clearance
+    if c <= 0:
+        return
+    grow = 1.5 * c
+    # 26 directions (faces, edges, corners of a cube): a close polyhedral stand-in for a ball
+    dirs = [np.array(v, float) / np.linalg.norm(v) for v in itertools.product((-1, 0, 1), repeat=3) if any(v)]
+    poses = asm.poses or {}
+    parts = asm.parts
+    Ts = [asm.part_transforms(pos, quat) for pos, quat in poses.values()]
+
+    def conflicts_of(pairs):
+        out: dict = {}
+        boxes = [np.asarray(p.solid.bounding_box()) for p in parts]
+        for i, j in pairs:
+            if _bb_near(boxes[i], boxes[j], 2 * c) and parts[i].solid.min_gap(parts[j].solid, c) < c - 1e-6:
+                out.setdefault((i, j), []).append(None)
+        for T in Ts:
+            posed = {}
+            for i, j in pairs:
+                for k in (i, j):
+                    if k not in posed:
+                        posed[k] = transform_solid(parts[k].solid, T[parts[k].name])
+                bi, bj = np.asarray(posed[i].bounding_box()), np.asarray(posed[j].bounding_box())
+                if _bb_near(bi, bj, 0.0) and (posed[i] ^ posed[j]).volume() > 1e-6:
+                    out.setdefault((i, j), []).append(T)
+        return out
+
+    def settled(X, Xs, Y, sts):
+        for T in sts:
+            M = np.eye(4) if T is None else np.linalg.inv(T[X.name]) @ T[Y.name]
+            Yp = transform_solid(Y.solid, M)
+            if T is None:
+                if Xs.min_gap(Yp, c) < c - 1e-6:
+                    return False
+            elif (Xs ^ Yp).volume() > 1e-6:
+                return False
+        return True
+
+    pairs = [(i, j) for i in range(len(parts)) for j in range(i + 1, len(parts))]
+    for _ in range(4):
+        conflicts = conflicts_of(pairs)
+        if not conflicts:
+            return
+        changed = set()
+        for (i, j), sts in conflicts.items():
+            A, B = parts[i], parts[j]
+            cands = []
+            for X, Y in ((A, B), (B, A)):
+                if X.kind == "joint":
+                    continue
+                hard = protected.get(X.name)
+                soft = soft_protected.get(X.name)
+                # first keep the spot of the attachment hole too (soft), then only the joints (hard)
+                for lost, guard in ((False, soft), (True, hard)):
+                    if guard is None:
+                        continue
+                    keep = X.solid ^ guard
+                    for g_ in (grow, 2.0 * c, 2.5 * c):
+                        trimmed = _trim_by(X, Y, sts, g_, dirs, keep, 0.5 * c)
+                        if trimmed is None:
+                            break
+                        ok = settled(X, trimmed, Y, sts)
+                        if ok:
+                            break
+                    if trimmed is None:
+                        continue
+                    removed = X.solid.volume() - trimmed.volume()
+                    if removed <= 1e-9:
+                        continue
+                    cands.append((not ok, len(trimmed.decompose()) != 1, lost, removed, X, trimmed, Y))
+                    if ok:
+                        break
+            if not cands:
+                continue
+            unsettled, split, lost, removed, X, trimmed, Y = min(cands, key=lambda x: x[:4])
+            X.solid = trimmed
+            changed.add(parts.index(X))
+            asm.notes.append(f"trimmed {removed:.3g} mm^3 from {X.name} to clear {Y.name}"
+                             + (f" in {len([s for s in sts if s is not None])} logic state(s)"
+                                if any(s is not None for s in sts) else " as printed"))
+        if not changed:
+            return
+        pairs = [(i, j) for i, j in pairs if i in changed or j in changed]
+
+
+def _trim_by(X, Y, sts, grow, dirs, keep, state_grow):
+    """X less Y grown (union of translated copies) in each of the states ``sts`` -- by ``grow``
+    as printed (None), by a third of it in a logic state -- restricted to where the two meet;
+    X's protected material ``keep`` stays."""
+    ks = []
+    xb = np.asarray(X.solid.bounding_box())
+    for T in sts:
+        M = np.eye(4) if T is None else np.linalg.inv(T[X.name]) @ T[Y.name]
+        Yp = transform_solid(Y.solid, M)
+        yb = np.asarray(Yp.bounding_box())
+        if T is None:
+            lo, hi = np.maximum(xb[:3], yb[:3] - 2 * grow), np.minimum(xb[3:], yb[3:] + 2 * grow)
+        else:
+            ib = np.asarray((X.solid ^ Yp).bounding_box())
+            lo, hi = ib[:3], ib[3:]
+        lo, hi = lo - 3 * grow, hi + 3 * grow
+        if np.any(hi <= lo):
+            continue
+        crop = mf.Manifold.cube((hi - lo).tolist()).translate(lo.tolist())
+        Yc = Yp ^ crop                  # only the part of Y near the conflict matters
+        if Yc.is_empty():
+            continue
+        # as printed the gap must reach the clearance; in a logic state it need only be positive
+        g_ = grow if T is None else state_grow
+        ks += [Yc] + [Yc.translate((g_ * d).tolist()) for d in dirs]
+    if not ks:
+        return None
+    return _clean(union([X.solid - union(ks), keep]))
+
+
+def _bb_near(a, b, margin) -> bool:
+    return bool(np.all(a[:3] <= b[3:] + margin) and np.all(b[:3] <= a[3:] + margin))
+
+
+def _hinge_dir(bn, axes, slabs, center) -> np.ndarray:
+    mine = [ax for ax in axes if bn in ax.bodies]
+    if mine:
+        return mine[0].direction.copy()
+    near = min(slabs[bn], key=lambda sb: np.linalg.norm(sb.center - center))
+    order = np.argsort(near.size)
+    return near.R[:, order[1]].copy()   # the width direction (middle dimension)
+
+
+def _extent_along(sbs, center, d) -> float:
+    near = min(sbs, key=lambda sb: np.linalg.norm(sb.center - center))
+    return float(np.sum(np.abs(near.R.T @ d) * near.size))
+
+
+def _yoke_plates(sbs, origin, d, intervals, reach, t):
+    """Plates (as slab boxes) widening a body's slabs over ``intervals`` of an axis."""
+    out = []
+    for sb in sbs:
+        rel = sb.center - origin
+        perp = rel - np.dot(rel, d) * d
+        nrm = sb.R[:, sb.normal_axis]
+        w = perp - np.dot(perp, nrm) * nrm
+        if np.linalg.norm(w) < 1e-6:
+            continue
+        w = w / np.linalg.norm(w)
+        half = 0.5 * np.sum(np.abs(sb.R.T @ w) * sb.size)
+        if np.linalg.norm(perp) - half > t:     # this slab does not reach the axis
+            continue
+        reach_b = min(reach, 2 * half)
+        Rm = np.column_stack([d, w, np.cross(d, w)])
+        for a0, a1 in intervals:
+            out.append(SlabBox(origin + d * 0.5 * (a0 + a1) + w * reach_b / 2, Rm,
+                               np.array([a1 - a0, reach_b, t]), 2))
+    return out
+
+
+def _near_axis(bn, p, axes, ujoints, dist) -> bool:
+    for ax in axes:
+        if bn in ax.bodies:
+            rel = p - ax.origin
+            a = np.dot(rel, ax.direction)
+            if abs(a) <= ax.span / 2 + dist and np.linalg.norm(rel - a * ax.direction) < dist:
+                return True
+    for uj in ujoints:
+        if bn in uj.bodies and np.linalg.norm(p - uj.center) < dist + max(x.extent for x in uj.layouts):
+            return True
+    return False
+
+
+def _orientation(asm: Assembly) -> np.ndarray:
+    """World -> print frame: hinge axes flat on the bed (``axes_flat``) or as modelled;
+    then the assembly is centred on the bed origin and rests on z = 0."""
+    dirs = [ax.direction for ax in asm.axes] + [a for uj in asm.ujoints for a in uj.axes]
+    Rm = np.eye(3)
+    if asm.profile.orient == "axes_flat" and dirs:
+        cands = [np.array(v, float) for v in np.eye(3)]
+        for i in range(len(dirs)):
+            for j in range(i + 1, len(dirs)):
+                cr = np.cross(dirs[i], dirs[j])
+                if np.linalg.norm(cr) > 1e-3:
+                    cands.append(cr / np.linalg.norm(cr))
+        for d in dirs[:8]:
+            F = _perp_frame(d)
+            cands += [F[:, 0], F[:, 1]]
+        best = min(cands, key=lambda z: (round(sum(abs(float(np.dot(z, d))) for d in dirs), 6)))
+        from mlc.geometry.rotation import rotation_between
+        Rm = rotation_between(best, [0, 0, 1.0])
+    lo = np.full(3, np.inf)
+    hi = np.full(3, -np.inf)
+    for p in asm.parts:
+        if p.solid.is_empty():
+            continue
+        bb = np.asarray(transform_solid(p.solid, _h(Rm, np.zeros(3))).bounding_box())
+        lo = np.minimum(lo, bb[:3])
+        hi = np.maximum(hi, bb[3:])
+    if not np.all(np.isfinite(lo)):
+        return np.eye(4)
+    shift = np.array([-(lo[0] + hi[0]) / 2, -(lo[1] + hi[1]) / 2, -lo[2]])
+    return _h(Rm, shift)
+
+
+def _h(R, t) -> np.ndarray:
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = t
+    return T

@@ -1,0 +1,261 @@
+"""The printability report, computed on every export.
+
+Checks (each one can fail; a failed check makes ``mlc stl`` exit non-zero unless --force):
+
+``watertight``   every part is a closed, oriented 2-manifold with positive volume
+``part_count``   the pieces printed = rigid bodies + joint parts (no body split in two,
+                 no two parts fused)
+``min_gap``      the smallest gap between two distinct parts, as printed, is at least the
+                 clearance (manifold3d ``min_gap``)
+``states``       no two parts intersect with the bodies posed at every given pose: the
+                 equilibrium of every logic state and points on the way to them (static
+                 verification, see mlc.mesh.pipeline.state_poses), joint parts following
+                 their bodies
+``retention``    every jointed part displaced by 1.5 x clearance in each of six directions
+                 (along and across its axis) runs into a joint partner: nothing falls out
+``features``     every feature is at least the profile's minimum (slab, knuckle wall, pin,
+                 knuckle length, lug hole)
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mlc.mesh.build import Assembly, _perp_frame, box, transform_solid, union
+
+VOL_EPS = 1e-6    # mm^3: intersections smaller than this are numerical contact, not overlap
+GAP_EPS = 1e-6    # mm
+
+
+@dataclass
+class Check:
+    name: str
+    ok: bool
+    value: object = None
+    limit: object = None
+    detail: str = ""
+    failures: list = field(default_factory=list)
+
+    def to_dict(self) -> dict:
+        d = {"name": self.name, "ok": self.ok, "value": self.value, "limit": self.limit, "detail": self.detail}
+        if self.failures:
+            d["failures"] = self.failures[:20]
+            d["failure_count"] = len(self.failures)
+        return d
+
+
+@dataclass
+class Report:
+    scene: str
+    profile: dict
+    parts: list
+    checks: list
+    notes: list
+    seconds: float = 0.0
+    outputs: list = field(default_factory=list)
+    size_mm: list | None = None     # print-frame bounding box of the whole assembly
+
+    @property
+    def ok(self) -> bool:
+        return all(c.ok for c in self.checks)
+
+    def check(self, name) -> Check:
+        for c in self.checks:
+            if c.name == name:
+                return c
+        raise KeyError(name)
+
+    def to_dict(self) -> dict:
+        return {"scene": self.scene, "ok": self.ok, "profile": self.profile, "parts": self.parts,
+                "checks": [c.to_dict() for c in self.checks], "notes": self.notes, "size_mm": self.size_mm,
+                "seconds": round(self.seconds, 3), "outputs": self.outputs}
+
+    def text(self) -> str:
+        lines = [f"printability report: {self.scene} (profile {self.profile['name']}, sigma = "
+                 f"{self.profile['sigma_mm']:g} mm, clearance {self.profile['clearance']:g} mm)"]
+        for c in self.checks:
+            lines.append(f"  [{'ok' if c.ok else 'FAIL'}] {c.name}: {c.detail}")
+            for f in c.failures[:5]:
+                lines.append(f"         - {f}")
+            if len(c.failures) > 5:
+                lines.append(f"         ... {len(c.failures) - 5} more")
+        for n in self.notes:
+            lines.append(f"  note: {n}")
+        size = f", {' x '.join(f'{x:.1f}' for x in self.size_mm)} mm" if self.size_mm else ""
+        lines.append(f"  {'PASS' if self.ok else 'FAIL'}: {len(self.parts)} parts, "
+                     f"{sum(p['volume_mm3'] for p in self.parts):.1f} mm^3{size}")
+        return "\n".join(lines)
+
+
+def _bbox(solid, T=None):
+    s = solid if T is None else transform_solid(solid, T)
+    b = np.asarray(s.bounding_box(), float)
+    return b[:3], b[3:]
+
+
+def _pairs(boxes, margin):
+    """Index pairs whose boxes (lo, hi) come within ``margin``."""
+    if len(boxes) < 2:
+        return []
+    lo = np.array([b[0] for b in boxes])
+    hi = np.array([b[1] for b in boxes])
+    ok = np.all((lo[:, None, :] <= hi[None, :, :] + margin) & (lo[None, :, :] <= hi[:, None, :] + margin), axis=2)
+    i, j = np.nonzero(np.triu(ok, 1))
+    return list(zip(i.tolist(), j.tolist()))
+
+
+def check_assembly(asm: Assembly, poses: dict | None = None) -> Report:
+    """Run every check of the module docstring on ``asm`` (``poses`` default: ``asm.poses``)."""
+    t0 = time.perf_counter()
+    prof = asm.profile
+    c = prof.clearance
+    poses = asm.poses if poses is None else poses
+    parts = asm.parts
+    checks = []
+
+    # -- watertight ------------------------------------------------------------
+    info = []
+    bad = []
+    pieces = 0
+    for p in parts:
+        vol = float(p.solid.volume())
+        st = str(p.solid.status()).split(".")[-1]
+        comps = len(p.solid.decompose()) if not p.solid.is_empty() else 0
+        pieces += comps
+        m = p.solid.to_mesh()
+        tri = np.asarray(m.tri_verts)
+        edges_ok = _closed(tri)
+        info.append({"name": p.name, "kind": p.kind, "volume_mm3": round(vol, 4), "pieces": comps,
+                     "triangles": int(len(tri))})
+        if p.solid.is_empty() or vol <= 0 or st != "NoError" or not edges_ok:
+            bad.append(f"{p.name}: volume {vol:.4g} mm^3, status {st}, closed {edges_ok}")
+    checks.append(Check("watertight", not bad, len(parts) - len(bad), len(parts),
+                        f"{len(parts) - len(bad)}/{len(parts)} parts closed with positive volume", bad))
+
+    # -- part count --------------------------------------------------------------
+    expected = len(asm.scene.bodies) + len(asm.ujoints)
+    split = [f"{i['name']} is in {i['pieces']} pieces" for i in info if i["pieces"] != 1]
+    checks.append(Check("part_count", pieces == expected and not split, pieces, expected,
+                        f"{pieces} pieces printed, expected {len(asm.scene.bodies)} bodies + "
+                        f"{len(asm.ujoints)} joint parts = {expected}", split))
+
+    # -- min gap at rest -------------------------------------------------------------
+    boxes = [_bbox(p.solid) for p in parts]
+    gmin, gpair = np.inf, None
+    fails = []
+    for i, j in _pairs(boxes, 2 * c + 1e-3):
+        if parts[i].solid.is_empty() or parts[j].solid.is_empty():
+            continue
+        search = max(2 * c, 1e-3)
+        gap = float(parts[i].solid.min_gap(parts[j].solid, search))
+        if gap < gmin:
+            gmin, gpair = gap, (parts[i].name, parts[j].name)
+        if gap < c - GAP_EPS or gap <= GAP_EPS:     # touching parts print fused, whatever the profile says
+            fails.append(f"{parts[i].name} - {parts[j].name}: {gap:.4f} mm")
+    gval = None if not np.isfinite(gmin) else round(gmin, 5)
+    detail = (f"smallest gap {gmin:.3f} mm ({gpair[0]} - {gpair[1]}) >= clearance {c:g} mm" if gpair and not fails
+              else f"{len(fails)} pairs closer than the clearance {c:g} mm" if fails
+              else f"no two parts within {2 * c:g} mm")
+    checks.append(Check("min_gap", not fails, gval, c, detail, fails))
+
+    # -- logic states --------------------------------------------------------------------
+    if poses:
+        worst = 0.0
+        fails = []
+        for st, (pos, quat) in poses.items():
+            T = asm.part_transforms(pos, quat)
+            posed = [transform_solid(p.solid, T[p.name]) for p in parts]
+            bxs = [_bbox(s) for s in posed]
+            for i, j in _pairs(bxs, 0.0):
+                v = float((posed[i] ^ posed[j]).volume())
+                worst = max(worst, v)
+                if v > VOL_EPS:
+                    fails.append(f"state {st}: {parts[i].name} intersects {parts[j].name} ({v:.4g} mm^3)")
+        n_path = sum("@" in str(k) for k in poses)
+        what = f"{len(poses) - n_path} logic states"
+        if n_path:
+            what += f" and {n_path} pose{'s' if n_path > 1 else ''} on the way to them"
+        checks.append(Check("states", not fails, round(worst, 6), VOL_EPS,
+                            f"{what}, " + (f"{len(fails)} intersections" if fails else
+                                           "no intersection between parts"), fails))
+    else:
+        checks.append(Check("states", False, None, VOL_EPS,
+                            "no equilibrium poses: the logic states were not checked",
+                            ["static verification gave no poses (use --force to export unchecked)"]))
+
+    # -- retention ---------------------------------------------------------------------------
+    checks.append(_retention(asm))
+
+    # -- features ------------------------------------------------------------------------------
+    small = [f"{what}: {val:.3g} mm < {lim:g} mm" for what, val, lim in asm.features if val < lim - 1e-9]
+    checks.append(Check("features", not small, len(asm.features) - len(small), len(asm.features),
+                        f"{len(asm.features) - len(small)}/{len(asm.features)} features at or above the profile "
+                        f"minimums", small))
+
+    rep = Report(asm.scene.name, prof.to_dict(), info, checks, list(asm.notes))
+    rep.size_mm = print_size(asm)
+    rep.seconds = time.perf_counter() - t0
+    return rep
+
+
+def print_size(asm: Assembly) -> list | None:
+    """Extent (mm) of the whole assembly in the print frame."""
+    boxes = [_bbox(p.solid, asm.orient) for p in asm.parts if not p.solid.is_empty()]
+    if not boxes:
+        return None
+    lo = np.min([b[0] for b in boxes], axis=0)
+    hi = np.max([b[1] for b in boxes], axis=0)
+    return [round(float(x), 3) for x in hi - lo]
+
+
+def _closed(tri) -> bool:
+    """Every edge used exactly twice, once in each direction."""
+    if len(tri) == 0:
+        return False
+    tri = np.asarray(tri, np.int64)
+    n = int(tri.max()) + 1
+    e = np.concatenate([tri[:, [0, 1]], tri[:, [1, 2]], tri[:, [2, 0]]])
+    fwd = e[:, 0] * n + e[:, 1]
+    rev = e[:, 1] * n + e[:, 0]
+    fs = np.sort(fwd)
+    if np.any(fs[1:] == fs[:-1]):
+        return False
+    return bool(np.array_equal(fs, np.sort(rev)))
+
+
+def _retention(asm: Assembly) -> Check:
+    c = asm.profile.clearance
+    step = 1.5 * c
+    by = {p.name: p for p in asm.parts}
+    tests = []   # (part, partners, axis direction, joint, crop box: centre, frame, size)
+    for ax in asm.axes:
+        F = _perp_frame(ax.direction)
+        size = [2 * (ax.R + 3 * c)] * 2 + [ax.span + 6 * c]
+        for bn in ax.bodies:
+            tests.append((bn, [o for o in ax.bodies if o != bn], ax.direction, ax.name, ax.origin, F, size))
+    for uj in asm.ujoints:
+        C, O = uj.bodies
+        half = max(lay.extent for lay in uj.layouts) + uj.R + 3 * c
+        for who, partners, d in ((C, [uj.part], uj.axes[0]), (O, [uj.part], uj.axes[1]),
+                                 (uj.part, [C, O], uj.axes[0])):
+            tests.append((who, partners, d, uj.name, uj.center, np.eye(3), [2 * half] * 3))
+    fails = []
+    n = 0
+    if step <= 0:
+        return Check("retention", False, 0, 0, "clearance 0: retention not testable", ["clearance is zero"])
+    for name, partners, d, jn, centre, Fc, size in tests:
+        F = _perp_frame(d)
+        # only the joint's neighbourhood can stop a part: crop both sides there (much faster)
+        other = union([by[o].solid for o in partners]) ^ box(centre, Fc, size)
+        mine = by[name].solid ^ box(centre, Fc, [x + 4 * step for x in size])
+        for k, v in enumerate((F[:, 2], -F[:, 2], F[:, 0], -F[:, 0], F[:, 1], -F[:, 1])):
+            n += 1
+            moved = mine.translate((step * v).tolist())
+            if float((moved ^ other).volume()) <= VOL_EPS:
+                what = ["+axis", "-axis", "+radial", "-radial", "+radial2", "-radial2"][k]
+                fails.append(f"{name} at joint {jn} moves {step:.3g} mm {what} freely")
+    return Check("retention", not fails, n - len(fails), n,
+                 f"{n - len(fails)}/{n} displacements of {step:.3g} mm (1.5 x clearance) blocked by a joint partner",
+                 fails)

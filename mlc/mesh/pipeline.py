@@ -1,0 +1,318 @@
+"""Scene -> printable assembly + printability report, for one gate or many.
+
+A scene is split into *mechanisms* (bodies connected by bonds or muscles).  Mechanisms
+that are copies of each other up to a translation (a grid of gates, repeated cells) are
+built and checked once and the result is translated: the parts, the poses of every
+logic state and the report are the same.  Each mechanism is posed at the equilibrium of
+every input state of its own inputs (static verification), so a scene of many
+independent gates costs the sum, not the product, of their state counts.  Between
+different mechanisms, the parts must keep the clearance as printed and must not meet in
+any combination of their states (checked where their swept bounding boxes meet).
+"""
+from __future__ import annotations
+
+import copy
+import itertools
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from mlc.mesh.build import Assembly, Part, build_assembly, transform_solid, _orientation
+from mlc.mesh.checks import GAP_EPS, VOL_EPS, Check, Report, _bbox, _pairs, check_assembly, print_size
+from mlc.mesh.profiles import Profile
+from mlc.scene.model import Scene
+
+#: input states of one mechanism beyond which only a sample of states is posed
+MAX_STATES = 64
+#: poses checked on the way from rest to each state (besides the states themselves)
+PATH_STEPS = 1
+
+
+@dataclass
+class Mechanism:
+    scene: Scene              # the sub-scene (bodies of this mechanism, original names)
+    bodies: list              # indices into the full scene
+    shift: np.ndarray = field(default_factory=lambda: np.zeros(3))   # sigma, from its representative
+    rep: int = -1             # index of the representative mechanism (-1: itself)
+
+
+def split_mechanisms(scene: Scene) -> list[Mechanism]:
+    n = len(scene.bodies)
+    idx = {b.name: i for i, b in enumerate(scene.bodies)}
+    parent = list(range(n))
+
+    def find(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for it in list(scene.bonds) + list(scene.muscles):
+        a, b = idx[it.a.split(".")[0]], idx[it.b.split(".")[0]]
+        parent[find(a)] = find(b)
+    groups: dict[int, list[int]] = {}
+    for i in range(n):
+        groups.setdefault(find(i), []).append(i)
+    if len(groups) == 1:
+        return [Mechanism(scene, list(range(n)))]
+    out = []
+    for members in sorted(groups.values()):
+        names = {scene.bodies[i].name for i in members}
+        sub = Scene(
+            name=f"{scene.name}[{scene.bodies[members[0]].name}]",
+            bodies=[scene.bodies[i] for i in members],
+            bonds=[x for x in scene.bonds if x.a.split(".")[0] in names],
+            muscles=[x for x in scene.muscles if x.a.split(".")[0] in names],
+            probes=[x for x in scene.probes if x.a.split(".")[0] in names],
+            units=scene.units, source=scene.source)
+        sub.inputs = [s for s in scene.inputs if any(m.input == s for m in sub.muscles)]
+        sub.outputs = [s for s in scene.outputs if any(p.output == s for p in sub.probes)]
+        out.append(Mechanism(sub, members))
+    return out
+
+
+def _signature(scene: Scene):
+    """Geometry and topology of a mechanism, up to a translation and renaming."""
+    p0 = np.asarray(scene.bodies[0].position, float)
+    local = {b.name: i for i, b in enumerate(scene.bodies)}
+
+    def r(x):
+        return tuple(np.round(np.asarray(x, float).ravel(), 9).tolist())
+
+    def ref(s):
+        b, site = s.split(".", 1)
+        return (local[b], site)
+
+    sig = [tuple((r(np.asarray(b.position) - p0), r(b.orientation),
+                  tuple((r(x.size), r(x.center), r(x.orientation)) for x in b.boxes),
+                  tuple(sorted((k, r(v)) for k, v in b.sites.items())))) for b in scene.bodies]
+    inputs = {s: i for i, s in enumerate(scene.inputs)}
+    sig.append(tuple((ref(x.a), ref(x.b), x.kind, round(x.rest, 9), round(x.tolerance, 9), round(x.k, 9))
+                     for x in scene.bonds))
+    sig.append(tuple((ref(x.a), ref(x.b), inputs[x.input], round(x.rest, 9), round(x.actuated, 9))
+                     for x in scene.muscles))
+    sig.append(tuple((ref(x.a), ref(x.b)) for x in scene.probes))
+    return tuple(sig)
+
+
+def state_poses(scene: Scene, max_states: int = MAX_STATES, path_steps: int = PATH_STEPS) -> tuple[dict, str | None]:
+    """Body poses (sigma) at the equilibrium of the input states: ``{state: (pos, quat)}``,
+    plus ``path_steps`` points on the way from rest to each state (keys ``"01@0.50"``: the
+    equilibrium with the muscles that state actuates half-way there), and a note when only a
+    sample of the states was posed."""
+    try:
+        from mlc.verify.static import equilibrium
+    except ImportError:  # pragma: no cover - static verification ships with mlc
+        return {}, "static verification is not available: logic states not posed"
+    states = scene.states()
+    note = None
+    if len(states) > max_states:
+        n = len(scene.inputs)
+        pick = {"0" * n, "1" * n}
+        for i in range(n):
+            pick.add("".join("1" if j == i else "0" for j in range(n)))
+            pick.add("".join("0" if j == i else "1" for j in range(n)))
+        rng = np.random.default_rng(0)
+        while len(pick) < max_states:
+            pick.add("".join(rng.choice(["0", "1"], n)))
+        states = sorted(pick)[:max(max_states, 2 * n + 2)]
+        note = (f"{scene.name}: {len(scene.inputs)} inputs; posed {len(states)} of {2 ** n} input states "
+                f"(all zero, all one, each input alone on and off, then a fixed random sample)")
+    out = {}
+    for st in states:
+        eq = equilibrium(scene, st)
+        out[st] = (np.asarray(eq.pos, float), np.asarray(eq.quat, float))
+    rest = "0" * len(scene.inputs)
+    for k in range(1, path_steps + 1):
+        f = k / (path_steps + 1)
+        part = copy.copy(scene)
+        part.muscles = [copy.copy(m) for m in scene.muscles]
+        for m in part.muscles:
+            m.actuated = m.rest + f * (m.actuated - m.rest)
+        for st in states:
+            if st != rest:
+                eq = equilibrium(part, st)
+                out[f"{st}@{f:.2f}"] = (np.asarray(eq.pos, float), np.asarray(eq.quat, float))
+    return out, note
+
+
+def export_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
+                    solve: bool = True) -> tuple[Assembly, Report]:
+    """Build every part of ``scene`` for ``profile`` and run the printability checks.
+
+    ``poses`` (``{state: (pos, quat)}`` for the whole scene) skips static verification;
+    otherwise each mechanism is posed at the equilibrium of its own input states
+    (``solve=False``: no states are posed, and the states check fails)."""
+    t0 = time.perf_counter()
+    mechs = split_mechanisms(scene)
+    if poses is not None or len(mechs) == 1:
+        notes = []
+        if poses is None and solve:
+            poses, note = state_poses(scene)
+            if note:
+                notes.append(note)
+        asm = build_assembly(scene, profile, poses)
+        asm.notes[:0] = notes
+        rep = check_assembly(asm)
+        rep.seconds = time.perf_counter() - t0
+        return asm, rep
+
+    # many mechanisms: build each distinct one once
+    classes: dict = {}
+    for k, m in enumerate(mechs):
+        sig = _signature(m.scene)
+        if sig in classes:
+            r = classes[sig]
+            m.rep = r
+            m.shift = np.asarray(m.scene.bodies[0].position, float) - np.asarray(
+                mechs[r].scene.bodies[0].position, float)
+        else:
+            classes[sig] = k
+    s = profile.sigma_mm
+    built: dict[int, tuple] = {}
+    notes: list[str] = []
+    for k in classes.values():
+        sub = mechs[k].scene
+        p, note = state_poses(sub) if solve else ({}, None)
+        if note:
+            notes.append(note)
+        a = build_assembly(sub, profile, p or None)
+        r = check_assembly(a)
+        built[k] = (a, r)
+
+    # the full assembly: representative parts, translated for the copies
+    parts: list[Part] = []
+    owner: list[int] = []          # mechanism index of each part
+    axes, ujoints, features = [], [], []
+    for k, m in enumerate(mechs):
+        rk = k if m.rep < 0 else m.rep
+        a, _ = built[rk]
+        shift = m.shift * s
+        rename = {rb.name: b.name for rb, b in zip(mechs[rk].scene.bodies, m.scene.bodies)}
+        for p in a.parts:
+            name = rename.get(p.name, p.name if m.rep < 0 else f"{p.name}__{k}")
+            solid = p.solid if m.rep < 0 else p.solid.translate(shift.tolist())
+            parts.append(Part(name, p.kind, solid, [rename.get(x, x) for x in p.partners]))
+            owner.append(k)
+        if m.rep < 0:
+            axes += a.axes
+            ujoints += a.ujoints
+            features += a.features
+            notes += [x for x in a.notes if x not in notes]
+    n_joint = sum(len(built[k if m.rep < 0 else m.rep][0].ujoints) for k, m in enumerate(mechs))
+    full = Assembly(scene, profile, parts, axes, ujoints, notes, features, built[next(iter(built))][0].slab_thickness)
+    full.orient = _orientation(full)
+    full.n_joint_parts = n_joint
+
+    report = _merge_reports(scene, profile, mechs, built, full, owner)
+    report.seconds = time.perf_counter() - t0
+    return full, report
+
+
+def _swept_box(asm: Assembly, part: Part, mech_poses, shift):
+    lo, hi = _bbox(part.solid)
+    for pos, quat in mech_poses.values():
+        T = asm.part_transforms(pos, quat)[part.name]
+        l2, h2 = _bbox(part.solid, T)
+        lo, hi = np.minimum(lo, l2), np.maximum(hi, h2)
+    return lo + shift, hi + shift
+
+
+def _merge_reports(scene, profile, mechs, built, full, owner) -> Report:
+    c = profile.clearance
+    s = profile.sigma_mm
+    reps = {k: r for k, (_, r) in built.items()}
+    members = {k: [i for i, m in enumerate(mechs) if (i if m.rep < 0 else m.rep) == k] for k in built}
+    checks = []
+    for name in ("watertight", "part_count", "min_gap", "states", "retention", "features"):
+        subs = [(k, reps[k].check(name)) for k in reps]
+        ok = all(ch.ok for _, ch in subs)
+        fails = [f"{mechs[k].scene.name}: {f}" for k, ch in subs for f in ch.failures]
+        if name in ("watertight", "part_count", "retention", "features"):
+            val = sum((ch.value or 0) * len(members[k]) for k, ch in subs)
+            lim = sum((ch.limit or 0) * len(members[k]) for k, ch in subs)
+            detail = f"{val}/{lim} over {len(mechs)} mechanisms ({len(reps)} distinct)"
+            if name == "part_count":
+                detail = (f"{val} pieces printed, expected {len(scene.bodies)} bodies + "
+                          f"{full.n_joint_parts} joint parts = {lim}")
+        elif name == "min_gap":
+            vals = [ch.value for _, ch in subs if ch.value is not None]
+            val, lim = (min(vals) if vals else None), c
+            detail = f"within mechanisms: smallest gap {val} mm" if vals else "no close parts within mechanisms"
+        else:
+            val = max((ch.value or 0) for _, ch in subs)
+            lim = VOL_EPS
+            nst = sum(len(built[k][0].poses or {}) for k in reps)
+            detail = f"{nst} poses (logic states and points on the way) over {len(reps)} distinct mechanisms"
+            if any(not (built[k][0].poses) for k in reps):
+                detail += "; some mechanisms were not posed"
+        checks.append(Check(name, ok, val, lim, detail, fails))
+
+    # between mechanisms: clearance as printed, and no contact in any states
+    boxes = [_bbox(p.solid) for p in full.parts]
+    gap_fail, gmin = [], None
+    for i, j in _pairs(boxes, 2 * c + 1e-3):
+        if owner[i] == owner[j]:
+            continue
+        g = float(full.parts[i].solid.min_gap(full.parts[j].solid, max(2 * c, 1e-3)))
+        gmin = g if gmin is None else min(gmin, g)
+        if g < c - GAP_EPS or g <= GAP_EPS:
+            gap_fail.append(f"{full.parts[i].name} - {full.parts[j].name}: {g:.4f} mm")
+    mg = checks[2]
+    mg.failures += gap_fail
+    mg.ok = mg.ok and not gap_fail
+    if gmin is not None:
+        mg.value = min(mg.value, gmin) if mg.value is not None else gmin
+        mg.detail += f"; between mechanisms {gmin:.3f} mm"
+    else:
+        mg.detail += f"; mechanisms at least {2 * c:g} mm apart"
+
+    # swept boxes of each mechanism over its states
+    swept = []
+    for k, m in enumerate(mechs):
+        rk = k if m.rep < 0 else m.rep
+        a = built[rk][0]
+        poses = a.poses or {}
+        lo = np.full(3, np.inf)
+        hi = np.full(3, -np.inf)
+        for p in a.parts:
+            l2, h2 = _swept_box(a, p, poses, m.shift * s)
+            lo, hi = np.minimum(lo, l2), np.maximum(hi, h2)
+        swept.append((lo, hi))
+    st = checks[3]
+    close = _pairs(swept, 0.0)
+    for i, j in close:
+        fails = _cross_states(mechs, built, i, j, s)
+        st.failures += fails
+        st.ok = st.ok and not fails
+    st.detail += (f"; {len(close)} pairs of mechanisms sweep through shared space (checked in every state "
+                  f"combination)" if close else "; mechanisms never share space")
+    rep = Report(scene.name, profile.to_dict(),
+                 [{"name": p.name, "kind": p.kind, "volume_mm3": round(float(p.solid.volume()), 4), "pieces": 1}
+                  for p in full.parts], checks, list(full.notes))
+    rep.size_mm = print_size(full)
+    return rep
+
+
+def _cross_states(mechs, built, i, j, s) -> list[str]:
+    out = []
+    A = [(mechs[i], built[i if mechs[i].rep < 0 else mechs[i].rep][0]),
+         (mechs[j], built[j if mechs[j].rep < 0 else mechs[j].rep][0])]
+    posed = []
+    for m, a in A:
+        per = {}
+        for st, pq in (a.poses or {"rest": None}).items():
+            T = {p.name: np.eye(4) for p in a.parts} if pq is None else a.part_transforms(*pq)
+            per[st] = [transform_solid(p.solid, T[p.name]).translate((m.shift * s).tolist()) for p in a.parts]
+        posed.append(per)
+    for (s1, P1), (s2, P2) in itertools.product(posed[0].items(), posed[1].items()):
+        for x in P1:
+            for y in P2:
+                if (x ^ y).volume() > VOL_EPS:
+                    out.append(f"{mechs[i].scene.name} in state {s1} meets {mechs[j].scene.name} in state {s2}")
+                    break
+    return out
+
+
+__all__ = ["export_assembly", "split_mechanisms", "state_poses"]

@@ -1,0 +1,128 @@
+"""Every printability check passes on a good mechanism and can fail."""
+import manifold3d as mf
+import numpy as np
+import pytest
+
+from mlc.mesh import examples as ex
+from mlc.mesh.build import build_assembly
+from mlc.mesh.checks import check_assembly
+from mlc.mesh.profiles import load_profile
+
+POSES = {"0": 0.0, "1": -0.7, "2": 0.8}
+
+
+def _hinge(profile="mjp", overrides=None, poses=POSES):
+    sc = ex.hinge_pair()
+    return build_assembly(sc, load_profile(profile, overrides), ex.hinge_poses(sc, poses))
+
+
+def _failed(rep):
+    return {c.name for c in rep.checks if not c.ok}
+
+
+@pytest.mark.parametrize("profile", ["mjp", "sla", "fdm"])
+def test_hinge_pair_passes(profile):
+    rep = check_assembly(_hinge(profile))
+    assert rep.ok, rep.text()
+    assert rep.check("min_gap").value >= load_profile(profile).clearance - 1e-6
+    assert rep.check("retention").value == 12
+    assert any("slab thickness" in n and "0.1 mm" in n for n in rep.notes)   # the profile decides, and says so
+
+
+def test_three_bodies_on_one_axis():
+    sc = ex.three_on_axis()
+    asm = build_assembly(sc, load_profile("mjp"), {"": (np.array([b.position for b in sc.bodies]),
+                                                        np.array([b.orientation for b in sc.bodies]))})
+    (ax,) = asm.axes
+    assert len(ax.bodies) == 3 and len(ax.joints) == 2
+    assert sum(len(v) for v in ax.intervals.values()) == 4          # owner, body, body, owner
+    rep = check_assembly(asm)
+    assert rep.ok, rep.text()
+
+
+def test_universal_joint_is_a_separate_part():
+    sc = ex.ujoint_pair()
+    asm = build_assembly(sc, load_profile("mjp"), {"": (np.array([b.position for b in sc.bodies]),
+                                                        np.array([b.orientation for b in sc.bodies]))})
+    assert [p.kind for p in asm.parts] == ["body", "body", "joint"]
+    (uj,) = asm.ujoints
+    assert abs(np.dot(*uj.axes)) < 1e-9                              # two perpendicular hinges
+    rep = check_assembly(asm)
+    assert rep.check("part_count").value == 3
+    assert rep.ok, rep.text()
+
+
+def test_zero_clearance_fails():
+    rep = check_assembly(_hinge(overrides={"clearance": 0.0, "knuckle_gap": 0.0}))
+    assert {"min_gap", "retention"} <= _failed(rep)
+
+
+def test_small_clearance_fails_min_gap():
+    asm = _hinge(overrides={"clearance": 0.1, "knuckle_gap": 0.1})
+    asm.profile = load_profile("mjp")         # judge a 0.1 mm build against the 0.2 mm profile
+    rep = check_assembly(asm)
+    assert "min_gap" in _failed(rep)
+
+
+def test_part_posed_into_another_fails():
+    sc = ex.hinge_pair()
+    asm = _hinge()
+    rep = check_assembly(asm, ex.hinge_poses(sc, {"0": 0.0, "bad": -2.0}))   # B folded onto A
+    assert _failed(rep) == {"states"}
+    assert any("state bad" in f for f in rep.check("states").failures)
+
+
+def test_no_poses_fails_states():
+    sc = ex.hinge_pair()
+    rep = check_assembly(build_assembly(sc, load_profile("mjp"), None))
+    assert "states" in _failed(rep)
+
+
+def test_loose_knuckles_fail_retention():
+    rep = check_assembly(_hinge(overrides={"knuckle_gap": 0.5}))
+    assert "retention" in _failed(rep)
+    assert any("axis" in f for f in rep.check("retention").failures)
+
+
+def test_thin_slab_fails_features():
+    rep = check_assembly(_hinge(overrides={"slab_thickness": 0.3}))
+    assert "features" in _failed(rep)
+
+
+def test_broken_part_fails_watertight_and_count():
+    asm = _hinge()
+    asm.parts[1].solid = mf.Manifold()
+    rep = check_assembly(asm)
+    assert {"watertight", "part_count"} <= _failed(rep)
+
+
+def test_split_part_fails_count():
+    asm = _hinge()
+    a = asm.parts[0].solid
+    asm.parts[0].solid = a + mf.Manifold.cube([1, 1, 1]).translate([50, 50, 50])
+    rep = check_assembly(asm)
+    assert "part_count" in _failed(rep)
+    assert rep.check("part_count").value == 3
+
+
+def test_report_json_round_trip():
+    import json
+    rep = check_assembly(_hinge())
+    d = json.loads(json.dumps(rep.to_dict()))
+    assert d["ok"] is True and [c["name"] for c in d["checks"]] == [
+        "watertight", "part_count", "min_gap", "states", "retention", "features"]
+
+
+@pytest.mark.parametrize("profile", ["mjp", "fdm"])
+def test_cone_pins_pass(profile):
+    asm = _hinge(profile, {"pin": "cone"})
+    rep = check_assembly(asm)
+    assert rep.ok, rep.text()
+    assert any(f[0] == "cone pin diameter" for f in asm.features)
+
+
+def test_coarse_polygons_keep_the_clearance():
+    # inscribed-polygon cutters are scaled by 1/cos(pi/n): even 12-gons keep the full clearance
+    rep = check_assembly(_hinge(overrides={"circular_segments": 12}))
+    assert rep.ok, rep.text()
+    assert rep.check("min_gap").value >= 0.2 - 1e-6
