@@ -1,7 +1,6 @@
 """Every issue-2 CLI command, run through mlc.cli.main."""
 import json
 
-import pytest
 
 from mlc.cli import main
 

@@ -4,5 +4,8 @@ This is the one description of a mechanism that every back end uses: the static
 verifier, the Brownian-dynamics integrator and the mesh builder.  See
 docs/scene-format.md for the on-disk form.
 """
-from mlc.scene.model import Body, Bond, Box, Muscle, Probe, Scene, SceneArrays  # noqa: F401
-from mlc.scene.io import dump_scene, load_scene, parse_scene, scene_to_data, write_scene  # noqa: F401
+from mlc.scene.model import Body, Bond, Box, Muscle, Probe, Scene, SceneArrays
+from mlc.scene.io import dump_scene, load_scene, parse_scene, scene_to_data, write_scene
+
+__all__ = ["Body", "Bond", "Box", "Muscle", "Probe", "Scene", "SceneArrays",
+           "dump_scene", "load_scene", "parse_scene", "scene_to_data", "write_scene"]

@@ -492,6 +492,43 @@ def _spectral_py(site_body, arm, sp_i, sp_j, sp_k, end0, end_sp, end_sign, sp_tm
     return lam
 
 
+@njit(cache=True)
+def _record(n, t, rec_every, rec, nrec, probe_i, probe_j, ws, frame_every, fpos, fquat, nfr, pos, quat):
+    """Record the probe lengths (every ``rec_every`` steps) and a frame (every ``frame_every``)
+    at step ``n``; returns the new counts ``(nrec, nfr)``."""
+    if rec_every > 0 and n % rec_every == 0 and nrec < rec.shape[0]:
+        rec[nrec, 0] = t
+        for p in range(probe_i.shape[0]):
+            dx = ws[probe_j[p], 0] - ws[probe_i[p], 0]
+            dy = ws[probe_j[p], 1] - ws[probe_i[p], 1]
+            dz = ws[probe_j[p], 2] - ws[probe_i[p], 2]
+            rec[nrec, 1 + p] = math.sqrt(dx * dx + dy * dy + dz * dz)
+        nrec += 1
+    if frame_every > 0 and n % frame_every == 0 and nfr < fpos.shape[0]:
+        fpos[nfr] = pos
+        fquat[nfr] = quat
+        nfr += 1
+    return nrec, nfr
+
+
+@njit(cache=True)
+def _failed(mon, wca_min, status, step):
+    """Read the stability monitor: on a failure write (code, step, culprits) into ``status``
+    and return True."""
+    if not (mon[0] <= 1.0):
+        status[0] = STRETCH if mon[0] == mon[0] else NONFINITE
+        status[1] = step
+        status[2] = int(mon[1])
+        return True
+    if mon[2] < wca_min:
+        status[0] = WCA_CLOSE
+        status[1] = step
+        status[2] = int(mon[3])
+        status[3] = int(mon[4])
+        return True
+    return False
+
+
 def _euler_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_noise, seed,
               site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_rest0, sp_rest1, sp_tol, sp_inp, sp_bound,
               end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v, wca_eps, wca_s, wca_rc, wca_min,
@@ -514,28 +551,9 @@ def _euler_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_noi
               sp_inp, sp_bound, end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v,
               wca_eps, wca_s, wca_rc, ex0, ex_list, head, nxt, cell, nl0, nl, pos_nl, nlstate,
               uval, ws, arm, fsp, ratio, dmin, dpart, F, T, mon)
-        if rec_every > 0 and n % rec_every == 0 and nrec < rec.shape[0]:
-            rec[nrec, 0] = t
-            for p in range(probe_i.shape[0]):
-                dx = ws[probe_j[p], 0] - ws[probe_i[p], 0]
-                dy = ws[probe_j[p], 1] - ws[probe_i[p], 1]
-                dz = ws[probe_j[p], 2] - ws[probe_i[p], 2]
-                rec[nrec, 1 + p] = math.sqrt(dx * dx + dy * dy + dz * dz)
-            nrec += 1
-        if frame_every > 0 and n % frame_every == 0 and nfr < fpos.shape[0]:
-            fpos[nfr] = pos
-            fquat[nfr] = quat
-            nfr += 1
-        if not (mon[0] <= 1.0):
-            status[0] = STRETCH if mon[0] == mon[0] else NONFINITE
-            status[1] = step
-            status[2] = int(mon[1])
-            return n
-        if mon[2] < wca_min:
-            status[0] = WCA_CLOSE
-            status[1] = step
-            status[2] = int(mon[3])
-            status[3] = int(mon[4])
+        nrec, nfr = _record(n, t, rec_every, rec, nrec, probe_i, probe_j, ws, frame_every, fpos, fquat, nfr,
+                            pos, quat)
+        if _failed(mon, wca_min, status, step):
             return n
         for b in prange(N):
             xi0, xi1 = gauss2(seed, step, 2 * b)
@@ -703,28 +721,9 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
         t = t_start + n * dt
         step = step0 + n
         # F, T, ws, mon hold the state at (pos, quat, t)
-        if rec_every > 0 and n % rec_every == 0 and nrec < rec.shape[0]:
-            rec[nrec, 0] = t
-            for p in range(probe_i.shape[0]):
-                dx = ws[probe_j[p], 0] - ws[probe_i[p], 0]
-                dy = ws[probe_j[p], 1] - ws[probe_i[p], 1]
-                dz = ws[probe_j[p], 2] - ws[probe_i[p], 2]
-                rec[nrec, 1 + p] = math.sqrt(dx * dx + dy * dy + dz * dz)
-            nrec += 1
-        if frame_every > 0 and n % frame_every == 0 and nfr < fpos.shape[0]:
-            fpos[nfr] = pos
-            fquat[nfr] = quat
-            nfr += 1
-        if not (mon[0] <= 1.0):
-            status[0] = STRETCH if mon[0] == mon[0] else NONFINITE
-            status[1] = step
-            status[2] = int(mon[1])
-            return n
-        if mon[2] < wca_min:
-            status[0] = WCA_CLOSE
-            status[1] = step
-            status[2] = int(mon[3])
-            status[3] = int(mon[4])
+        nrec, nfr = _record(n, t, rec_every, rec, nrec, probe_i, probe_j, ws, frame_every, fpos, fquat, nfr,
+                            pos, quat)
+        if _failed(mon, wca_min, status, step):
             return n
         if fixed_s <= 0 and (n % rho_every == 0 or rho_b == 0.0):
             it = rho_iters if rho_b == 0.0 else max(3, rho_iters // 8)
