@@ -70,11 +70,10 @@ def run(args) -> int:
     try:
         report = export_scene(scene, prof, stl=args.output, threemf=args.threemf, parts_dir=args.parts,
                         force=args.force, solve=not args.no_states)
-        error = None
     except MlcError as e:
         if not hasattr(e, "report"):
             raise
-        report, error = e.report, e
+        report = e.report      # the checks failed: print the report, then fail below
     if args.report:
         from mlc.io.atomic import write_text
         write_text(args.report, json.dumps(report.to_dict(), indent=2) + "\n")

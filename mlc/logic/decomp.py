@@ -1,0 +1,211 @@
+"""Truth-table decomposition: a strong starting AIG for (incompletely specified) tables.
+
+For each output, recursively:
+
+1. drop the variables the interval ``[on, on | dc]`` need not depend on;
+2. at most four variables left: the exact minimum circuit from the NPN table, trying
+   the fillings of the don't cares (all of them when there are few);
+3. otherwise a *disjoint-support* step where one exists: ``f = x & g``, ``x | g``,
+   ``x ^ g`` (with any polarities), recursing on ``g``;
+4. otherwise the cheaper of a factored irredundant SOP (either phase) and a Shannon
+   expansion ``x ? f1 : f0`` on the most promising variables.
+
+Sub-results are memoised by (function, care set), so equal cofactors are shared.
+"""
+from __future__ import annotations
+
+from mlc.front.spec import TableSpec
+from mlc.logic import npn
+from mlc.logic import tt as T
+from mlc.logic.aig import AIG
+from mlc.logic.lower import factor_sop
+
+
+class _Dec:
+    def __init__(self, n: int, effort: int, rng=None):
+        self.rng = rng
+        self.n = n
+        self.full = T.mask(n)
+        self.effort = effort
+        self.memo: dict[tuple[int, int], tuple[int, object]] = {}
+        self.vars = [T.var(n, i) for i in range(n)]
+        self.shannon_limit = {1: 6, 2: 9, 3: 11}.get(effort, 6)
+
+    # -------------------------------------------------------------- analysis
+    def reduce_support(self, f: int, care: int) -> tuple[int, int, list[int]]:
+        n = self.n
+        sup = []
+        for i in range(n):
+            if not T.depends(f, n, i) and not T.depends(care, n, i):
+                continue
+            off = care & ~f
+            on0, on1 = T.cof0(f, n, i), T.cof1(f, n, i)
+            of0, of1 = T.cof0(off, n, i), T.cof1(off, n, i)
+            if on0 & of1 == 0 and on1 & of0 == 0:
+                # need not depend on i: merge the cofactors
+                f = on0 | on1
+                care = T.cof0(care, n, i) | T.cof1(care, n, i)
+            else:
+                sup.append(i)
+        return f & care, care, sup
+
+    # -------------------------------------------------------------- main recursion
+    def rec(self, f: int, care: int) -> tuple[int, object]:
+        """(estimated ANDs, plan) for the interval (f on care)."""
+        f &= care
+        key = (f, care)
+        r = self.memo.get(key)
+        if r is not None:
+            return r
+        r = self._rec(f, care)
+        self.memo[key] = r
+        return r
+
+    def _rec(self, f: int, care: int):
+        n, full = self.n, self.full
+        if f == 0:
+            return 0, ("const", 0)
+        if (f | ~care) & full == full:
+            return 0, ("const", 1)
+        f, care, sup = self.reduce_support(f, care)
+        for i in sup:
+            v = self.vars[i] & care
+            if v == f:
+                return 0, ("lit", 2 * (i + 1))
+            if (~self.vars[i]) & care == f:
+                return 0, ("lit", 2 * (i + 1) + 1)
+        if len(sup) <= 4:
+            return self.exact(f, care, sup)
+        off = care & ~f
+        # disjoint-support steps
+        for i in sup:
+            on0, on1 = T.cof0(f, n, i), T.cof1(f, n, i)
+            of0, of1 = T.cof0(off, n, i), T.cof1(off, n, i)
+            c0, c1 = T.cof0(care, n, i), T.cof1(care, n, i)
+            x = 2 * (i + 1)
+            if on0 == 0:                 # f = x & f1
+                c, p = self.rec(on1, c1)
+                return c + 1, ("and", x, p)
+            if on1 == 0:                 # f = !x & f0
+                c, p = self.rec(on0, c0)
+                return c + 1, ("and", x ^ 1, p)
+            if of1 == 0:                 # f = x | f0
+                c, p = self.rec(on0, c0)
+                return c + 1, ("or", x, p)
+            if of0 == 0:                 # f = !x | f1
+                c, p = self.rec(on1, c1)
+                return c + 1, ("or", x ^ 1, p)
+            if on0 & on1 == 0 and of0 & of1 == 0:   # f = x ^ g, g = f0 = !f1
+                g_on = on0 | of1
+                g_care = c0 | c1
+                c, p = self.rec(g_on, g_care)
+                return c + 3, ("xor", x, p)
+        # factored SOP, both phases
+        best = self.sop_plan(f, care)
+        if len(sup) <= self.shannon_limit:
+            # Shannon on the variables whose cofactors are simplest
+            scored = []
+            for i in sup:
+                on0, on1 = T.cof0(f, n, i), T.cof1(f, n, i)
+                c0, c1 = T.cof0(care, n, i), T.cof1(care, n, i)
+                s0 = len(self.reduce_support(on0, c0)[2])
+                s1 = len(self.reduce_support(on1, c1)[2])
+                noise = self.rng.random() * 3 if self.rng is not None else 0.0
+                scored.append((s0 + s1 + noise, i, on0, on1, c0, c1))
+            scored.sort()
+            width = (len(sup) if len(sup) <= 6 else 2) if self.effort >= 2 else 1
+            for _, i, on0, on1, c0, c1 in scored[:width]:
+                ca, pa = self.rec(on1, c1)
+                cb, pb = self.rec(on0, c0)
+                c = ca + cb + 3
+                if c < best[0]:
+                    best = (c, ("mux", 2 * (i + 1), pa, pb))
+        return best
+
+    def sop_plan(self, f: int, care: int):
+        n, full = self.n, self.full
+        cubes, _ = T.isop(f, f | (full & ~care), n)
+        off = care & ~f
+        cubes_n, _ = T.isop(off, off | (full & ~care), n)
+        best = None
+        for cs, c in ((cubes, 0), (cubes_n, 1)):
+            g = AIG([f"x{i}" for i in range(n)])
+            factor_sop(g, cs, [2 * (i + 1) for i in range(n)])
+            k = g.num_ands()
+            if best is None or k < best[0]:
+                best = (k, ("sop", cs, c))
+        return best
+
+    def exact(self, f: int, care: int, sup: list[int]):
+        n = self.n
+        k = len(sup)
+        lf = T.shrink(f, n, sup)
+        lc = T.shrink(care, n, sup)
+        width = 1 << k
+        # replicate to 16 bits so that unused variables are don't-care-free no-ops
+        def pad(t):
+            w = width
+            while w < 16:
+                t |= t << w
+                w *= 2
+            return t
+        lf, lc = pad(lf), pad(lc)
+        dcbits = [b for b in range(width) if not (lc >> b) & 1]
+        cands = []
+        if len(dcbits) <= 7:
+            for s in range(1 << len(dcbits)):
+                t = lf
+                for j, b in enumerate(dcbits):
+                    if (s >> j) & 1:
+                        t |= 1 << b
+                cands.append(pad(t & ((1 << width) - 1)))
+        else:
+            cubes, tab = T.isop(lf & ((1 << width) - 1), (lf | ~lc) & ((1 << width) - 1), k)
+            cands.append(pad(tab))
+            offt = (~lf & lc) & ((1 << width) - 1)
+            cubes, tab = T.isop(offt, (offt | ~lc) & ((1 << width) - 1), k)
+            cands.append(pad(~tab & ((1 << width) - 1)))
+            cands.append(pad(lf & ((1 << width) - 1)))
+        best = None
+        for t in cands:
+            c = npn.cost4(t)
+            if best is None or c < best[0]:
+                best = (c, t)
+        return best[0], ("exact", best[1], tuple(sup))
+
+    # -------------------------------------------------------------- building
+    def build(self, g: AIG, plan) -> int:
+        kind = plan[0]
+        if kind == "const":
+            return plan[1]
+        if kind == "lit":
+            return plan[1]
+        if kind == "and":
+            return g.and_(plan[1], self.build(g, plan[2]))
+        if kind == "or":
+            return g.or_(plan[1], self.build(g, plan[2]))
+        if kind == "xor":
+            return g.xor_(plan[1], self.build(g, plan[2]))
+        if kind == "mux":
+            return g.mux_(plan[1], self.build(g, plan[2]), self.build(g, plan[3]))
+        if kind == "sop":
+            _, cs, c = plan
+            return factor_sop(g, cs, [2 * (i + 1) for i in range(self.n)]) ^ c
+        if kind == "exact":
+            _, t, sup = plan
+            leaves = [2 * (i + 1) for i in sup] + [0] * (4 - len(sup))
+            return npn.build4(g, t, leaves)
+        raise AssertionError(kind)
+
+
+def from_table(spec: TableSpec, effort: int = 2, rng=None) -> AIG:
+    """A decomposed AIG for ``spec``; ``rng`` randomises the Shannon variable choice."""
+    n = spec.n
+    d = _Dec(n, effort, rng)
+    g = AIG(spec.inputs)
+    full = d.full
+    for name, on, dc in zip(spec.outputs, spec.on, spec.dc):
+        care = full & ~dc
+        _, plan = d.rec(on & care, care)
+        g.add_output(name, d.build(g, plan))
+    return g.cleanup()

@@ -1,0 +1,202 @@
+"""Generate ``npn4_exact.json``: a minimum-AND circuit for each 4-input NPN class.
+
+    python -m mlc.logic.gen_npn_table [CACHE_DIR [reverse]]   # generate (resumable)
+    python -m mlc.logic.gen_npn_table --prove SECONDS [reverse] # prove unproven entries
+
+Needs python-sat (generation only: the table is committed, nothing at run time
+needs a SAT solver).  Per class: increasing k with a short limit per SAT call
+(every k below the answer then is *proven* infeasible); if a call times out,
+descend from mlc's own heuristic circuit by SAT and try to prove the last step
+with a longer limit.  Entries whose minimality was not proven within the limits
+carry ``"proven": false`` and are listed under ``"unproven"``; ``--prove`` retries
+them with more time.  Every circuit is re-simulated before it is written.
+"""
+from __future__ import annotations
+
+import json
+import sys
+import time
+
+from mlc.logic import exactsat, npn
+from mlc.logic import tt as T
+
+
+PROOF_SECONDS = 15.0     # per SAT call; a timed-out call leaves the entry unproven
+QUICK_SECONDS = 4.0
+
+
+def solve_class(R: int) -> dict:
+    n = 4
+    full = 0xFFFF
+    if R in (0, full):
+        return {"ands": 0, "gates": [], "out": [-1, 1 if R else 0], "proven": True}
+    for i in range(4):
+        for c in (0, 1):
+            if R == T.var(4, i) ^ (full if c else 0):
+                return {"ands": 0, "gates": [], "out": [i, c], "proven": True}
+    sup = len(T.support(R, 4))
+    k = max(1, sup - 1)
+    # easy classes: increasing k with a short limit per call
+    while True:
+        r = exactsat.synthesize_exact(n, [(R, full)], k, time_limit=QUICK_SECONDS)
+        if r == "timeout":
+            break
+        if r is not None:
+            return _entry(R, k, r, True)
+        k += 1
+    # hard classes: every k' < k is proven infeasible; descend from a heuristic circuit
+    best = _heuristic(R)
+    kk = len(best[0]) - 1
+    proven = False
+    while kk >= k:
+        r = exactsat.synthesize_exact(n, [(R, full)], kk, time_limit=PROOF_SECONDS)
+        if r == "timeout":
+            break
+        if r is None:
+            proven = True
+            break
+        best = r
+        kk -= 1
+    if kk < k:
+        proven = True           # reached the proven lower bound
+    return _entry(R, len(best[0]), best, proven)
+
+
+def _entry(R, k, circ, proven):
+    gates, outs = circ
+    assert len(gates) == k
+    assert exactsat.circuit_tables(4, gates, outs) == [R]
+    return {"ands": k, "gates": [list(g) for g in gates], "out": list(outs[0]),
+            "proven": proven}
+
+
+def _heuristic(R):
+    """A (not necessarily minimum) circuit from mlc's own synthesis, as gate tuples."""
+    from mlc.front.spec import TableSpec
+    from mlc.logic.synth import synthesize
+    g = synthesize(TableSpec(["a", "b", "c", "d"], ["f"], [R], [0]), 2)
+    gates = [(a // 2 - 1, b // 2 - 1, a & 1, b & 1, 0) for a, b in g.ands]
+    lit = g.output_lits[0]
+    return gates, [(lit // 2 - 1, lit & 1)]
+
+
+def main(argv=None) -> int:
+    """``gen_npn_table [CACHE_DIR [reverse]]``: per-class results are cached as JSON
+    files in CACHE_DIR so that several processes (one in reverse order) can share the
+    work; the table is written once every class is solved."""
+    argv = sys.argv[1:] if argv is None else argv
+    import os
+    from pathlib import Path
+    cache = Path(argv[0]) if argv else None
+    if cache:
+        cache.mkdir(parents=True, exist_ok=True)
+    out_path = npn.TABLE_PATH
+    reps = npn.classes()
+    assert len(reps) == 222, len(reps)
+    order = list(enumerate(reps))
+    if len(argv) > 1 and argv[1] == "reverse":
+        order.reverse()
+    res = {}
+    t0 = time.time()
+    for idx, R in order:
+        key = f"{R:04x}"
+        if cache and (cache / key).exists():
+            res[key] = json.loads((cache / key).read_text())
+            continue
+        if cache and (cache / (key + ".busy")).exists():
+            continue
+        if cache:
+            (cache / (key + ".busy")).write_text(str(os.getpid()))
+        t = time.time()
+        res[key] = solve_class(R)
+        if cache:
+            (cache / key).write_text(json.dumps(res[key]))
+        print(f"{idx + 1:3d}/222 {key} ands={res[key]['ands']} {time.time() - t:.1f}s",
+              file=sys.stderr, flush=True)
+    if len(res) < 222:
+        if cache:
+            for R in reps:
+                key = f"{R:04x}"
+                while key not in res:
+                    if (cache / key).exists():
+                        res[key] = json.loads((cache / key).read_text())
+                    else:
+                        time.sleep(2)
+    data = {"format": "mlc-npn4-exact-v1",
+            "description": "minimum two-input AND gates (free inversions) per NPN class of "
+                           "4-input functions; gates [j, l, fj, fl, fo]: node 4+g = "
+                           "((node_j ^ fj) & (node_l ^ fl)) ^ fo; nodes 0..3 are the inputs; "
+                           "out [node, complement], node -1 = constant",
+            "seconds": round(time.time() - t0, 1),
+            "classes": res}
+    _write(data)
+    print(f"wrote {out_path} in {time.time() - t0:.0f}s; histogram {data['histogram']}",
+          file=sys.stderr)
+    return 0
+
+
+def prove(seconds: float, reverse: bool = False) -> int:
+    """``gen_npn_table --prove SECONDS [reverse]``: for every unproven entry of the
+    shipped table, try to show that one gate fewer is infeasible (or find such a
+    circuit), with SECONDS per SAT call; rewrites the table after every change."""
+    data = json.loads(npn.TABLE_PATH.read_text())
+    keys = [k for k, v in data["classes"].items() if not v.get("proven", True)]
+    keys.sort(key=lambda k: data["classes"][k]["ands"], reverse=reverse)
+    for key in keys:
+        R = int(key, 16)
+        while True:
+            # re-read: another prover may have updated the file
+            data = json.loads(npn.TABLE_PATH.read_text())
+            ent = data["classes"][key]
+            if ent.get("proven", True):
+                break
+            k = ent["ands"] - 1
+            t = time.time()
+            r = exactsat.synthesize_exact(4, [(R, 0xFFFF)], k, time_limit=seconds)
+            print(f"prove {key} k={k}: {'timeout' if r == 'timeout' else 'UNSAT' if r is None else 'SAT'}"
+                  f" {time.time() - t:.0f}s", file=sys.stderr, flush=True)
+            if r == "timeout":
+                break
+            data = json.loads(npn.TABLE_PATH.read_text())
+            if r is None:
+                data["classes"][key]["proven"] = True
+            else:
+                data["classes"][key] = _entry(R, k, r, False)
+            _write(data)
+    return 0
+
+
+def _write(data: dict) -> None:
+    hist: dict[int, int] = {}
+    for v in data["classes"].values():
+        hist[v["ands"]] = hist.get(v["ands"], 0) + 1
+    data["histogram"] = {str(k): hist[k] for k in sorted(hist)}
+    data["unproven"] = sorted(k for k, v in data["classes"].items() if not v.get("proven", True))
+    tmp = npn.TABLE_PATH.with_suffix(".tmp")
+    tmp.write_text(json.dumps(data, indent=0, sort_keys=True) + "\n")
+    tmp.replace(npn.TABLE_PATH)
+
+
+def improve_heuristically() -> int:
+    """``gen_npn_table --improve``: replace unproven entries by mlc's own synthesis
+    result (which rewrites with the other entries) where that is smaller."""
+    data = json.loads(npn.TABLE_PATH.read_text())
+    changed = 0
+    for key in list(data.get("unproven", [])):
+        R = int(key, 16)
+        npn.table.cache_clear()
+        gates, outs = _heuristic(R)
+        if len(gates) < data["classes"][key]["ands"]:
+            print(f"improve {key}: {data['classes'][key]['ands']} -> {len(gates)}", file=sys.stderr)
+            data["classes"][key] = _entry(R, len(gates), (gates, outs), False)
+            changed += 1
+            _write(data)
+    return 0
+
+
+if __name__ == "__main__":
+    if len(sys.argv) > 1 and sys.argv[1] == "--improve":
+        raise SystemExit(improve_heuristically())
+    if len(sys.argv) > 2 and sys.argv[1] == "--prove":
+        raise SystemExit(prove(float(sys.argv[2]), len(sys.argv) > 3 and sys.argv[3] == "reverse"))
+    raise SystemExit(main())

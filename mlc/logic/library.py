@@ -1,0 +1,167 @@
+"""Standard small functions as :class:`~mlc.front.spec.TableSpec`: the synthesis
+benchmark's suite (benchmarks/synthesis.py) and the tests' reference functions."""
+from __future__ import annotations
+
+import random
+from collections.abc import Callable
+
+from mlc.front.spec import TableSpec
+
+
+def table(name: str, inputs: list[str], outputs: list[str],
+          fn: Callable[[list[int]], list[int | None]]) -> TableSpec:
+    """Tabulate ``fn`` (input bits -> output bits, None = don't care)."""
+    n = len(inputs)
+    on = [0] * len(outputs)
+    dc = [0] * len(outputs)
+    for m in range(1 << n):
+        bits = [(m >> i) & 1 for i in range(n)]
+        vals = fn(bits)
+        for o, v in enumerate(vals):
+            if v is None:
+                dc[o] |= 1 << m
+            elif v:
+                on[o] |= 1 << m
+    return TableSpec(inputs, outputs, on, dc, source=name)
+
+
+def _num(bits):
+    return sum(b << i for i, b in enumerate(bits))
+
+
+def _bits(x, w):
+    return [(x >> i) & 1 for i in range(w)]
+
+
+def half_adder():
+    return table("half_adder", ["a", "b"], ["s", "c"], lambda x: [x[0] ^ x[1], x[0] & x[1]])
+
+
+def full_adder():
+    return table("full_adder", ["a", "b", "cin"], ["s", "cout"],
+                 lambda x: [x[0] ^ x[1] ^ x[2], int(x[0] + x[1] + x[2] >= 2)])
+
+
+def adder(w: int, carry_in: bool = False):
+    ins = [f"a{i}" for i in range(w)] + [f"b{i}" for i in range(w)] + (["cin"] if carry_in else [])
+    outs = [f"s{i}" for i in range(w + 1)]
+
+    def fn(x):
+        a, b = _num(x[:w]), _num(x[w:2 * w])
+        c = x[2 * w] if carry_in else 0
+        return _bits(a + b + c, w + 1)
+    return table(f"adder{w}" + ("c" if carry_in else ""), ins, outs, fn)
+
+
+def multiplier(w: int, v: int | None = None):
+    v = w if v is None else v
+    ins = [f"a{i}" for i in range(w)] + [f"b{i}" for i in range(v)]
+    outs = [f"p{i}" for i in range(w + v)]
+    return table(f"mult{w}x{v}", ins, outs, lambda x: _bits(_num(x[:w]) * _num(x[w:]), w + v))
+
+
+SEG = {0: "abcdef", 1: "bc", 2: "abdeg", 3: "abcdg", 4: "bcfg", 5: "acdfg", 6: "acdefg",
+       7: "abc", 8: "abcdefg", 9: "abcdfg"}
+
+
+def bcd7seg():
+    ins = ["d0", "d1", "d2", "d3"]
+    outs = list("abcdefg")
+
+    def fn(x):
+        v = _num(x)
+        if v > 9:
+            return [None] * 7
+        return [int(s in SEG[v]) for s in outs]
+    return table("bcd7seg", ins, outs, fn)
+
+
+def comparator(w: int):
+    ins = [f"a{i}" for i in range(w)] + [f"b{i}" for i in range(w)]
+
+    def fn(x):
+        a, b = _num(x[:w]), _num(x[w:])
+        return [int(a < b), int(a == b), int(a > b)]
+    return table(f"cmp{w}", ins, ["lt", "eq", "gt"], fn)
+
+
+def parity(n: int):
+    return table(f"parity{n}", [f"x{i}" for i in range(n)], ["p"], lambda x: [sum(x) & 1])
+
+
+def majority(n: int):
+    return table(f"maj{n}", [f"x{i}" for i in range(n)], ["m"], lambda x: [int(2 * sum(x) > n)])
+
+
+def mux(k: int):
+    """2**k-to-1 multiplexer: k select lines then 2**k data inputs."""
+    ins = [f"s{i}" for i in range(k)] + [f"d{i}" for i in range(1 << k)]
+    return table(f"mux{1 << k}", ins, ["y"], lambda x: [x[k + _num(x[:k])]])
+
+
+def decoder(k: int):
+    ins = [f"a{i}" for i in range(k)]
+    outs = [f"y{i}" for i in range(1 << k)]
+    return table(f"dec{k}to{1 << k}", ins, outs, lambda x: [int(_num(x) == j) for j in range(1 << k)])
+
+
+def priority_encoder(n: int = 4):
+    w = max(1, (n - 1).bit_length())
+    ins = [f"r{i}" for i in range(n)]
+
+    def fn(x):
+        hi = max((i for i in range(n) if x[i]), default=None)
+        if hi is None:
+            return [None] * w + [0]
+        return _bits(hi, w) + [1]
+    return table(f"prio{n}", ins, [f"y{i}" for i in range(w)] + ["valid"], fn)
+
+
+def gray(n: int = 4):
+    ins = [f"b{i}" for i in range(n)]
+
+    def fn(x):
+        v = _num(x)
+        return _bits(v ^ (v >> 1), n)
+    return table(f"bin2gray{n}", ins, [f"g{i}" for i in range(n)], fn)
+
+
+def gray_to_bin(n: int = 4):
+    ins = [f"g{i}" for i in range(n)]
+
+    def fn(x):
+        v = _num(x)
+        r = 0
+        while v:
+            r ^= v
+            v >>= 1
+        return _bits(r, n)
+    return table(f"gray2bin{n}", ins, [f"b{i}" for i in range(n)], fn)
+
+
+def random_function(n: int, m: int, seed: int, dc_fraction: float = 0.0):
+    rng = random.Random(seed)
+    ins = [f"x{i}" for i in range(n)]
+    outs = [f"y{i}" for i in range(m)]
+    tag = f"_dc{int(dc_fraction * 100)}" if dc_fraction else ""
+    return table(f"rand{n}x{m}_s{seed}{tag}", ins, outs,
+                 lambda x: [None if rng.random() < dc_fraction else rng.getrandbits(1)
+                            for _ in range(m)])
+
+
+def suite() -> list[TableSpec]:
+    """The benchmark suite (small functions)."""
+    return [
+        half_adder(), full_adder(), adder(2), adder(2, carry_in=True), multiplier(2),
+        bcd7seg(), comparator(1), comparator(2), parity(3), parity(4), parity(5),
+        majority(3), majority(5), mux(1), mux(2), decoder(2), decoder(3),
+        priority_encoder(4), gray(4), gray_to_bin(4),
+        random_function(4, 1, 1), random_function(4, 2, 2, 0.25),
+        random_function(5, 1, 3), random_function(5, 1, 4, 0.3),
+        random_function(6, 1, 5), random_function(6, 2, 6, 0.3),
+        random_function(7, 1, 7), random_function(7, 1, 8, 0.3),
+    ]
+
+
+# proven minima (AND gates, inversions free) quoted by issue 4
+KNOWN_MINIMA = {"full_adder": 7, "adder2": 10, "mult2x2": 8, "maj3": 4, "parity4": 9}

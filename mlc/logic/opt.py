@@ -1,0 +1,995 @@
+"""Optimisation passes on AIGs.  Cost = AND nodes (inversions are free), then depth.
+
+Every pass returns a new AIG (functional style); the driver :func:`optimize` keeps
+the best network seen and stops when a round brings nothing.
+
+Passes
+------
+* :func:`sweep`      -- merge nodes with equal (or complementary) global functions
+                        (exhaustive simulation; up to :data:`TT_LIMIT` inputs);
+* :func:`resub`      -- resubstitution: re-express a node with 0..3 new gates over
+                        existing nodes (divisors), freeing its maximum fanout-free
+                        cone; uses the external don't cares on output drivers;
+* :func:`rewrite`    -- DAG-aware rewriting of 4-input cuts with the exact NPN table
+                        (:mod:`mlc.logic.npn`), counting shared nodes;
+* :func:`balance`    -- AND-tree balancing for depth, never adding nodes.
+"""
+from __future__ import annotations
+
+import random
+import time
+
+from mlc.front.spec import NetworkSpec, TableSpec
+from mlc.logic import tt as T
+from mlc.logic.aig import AIG
+from mlc.logic.lower import from_spec
+
+TT_LIMIT = 16
+
+
+def cost(g: AIG) -> tuple[int, int]:
+    return (g.num_ands(), g.depth())
+
+
+# ----------------------------------------------------------------------------- helpers
+def refcounts(g: AIG) -> list[int]:
+    return g.fanout_counts()
+
+
+def mffc(g: AIG, node: int, refs: list[int], leaves: set[int] = frozenset()) -> list[int]:
+    """Nodes of the maximum fanout-free cone of ``node`` (including it), stopping at
+    inputs and ``leaves``.  ``refs`` is left unchanged."""
+    n = g.num_inputs
+    out = [node]
+    stack = [node]
+    touched = []
+    while stack:
+        x = stack.pop()
+        for f in g.ands[x - n - 1]:
+            y = f >> 1
+            if y <= n or y in leaves:
+                continue
+            refs[y] -= 1
+            touched.append(y)
+            if refs[y] == 0:
+                out.append(y)
+                stack.append(y)
+    for y in touched:
+        refs[y] += 1
+    return out
+
+
+def tfo_mark(g: AIG, node: int, upto: int | None = None) -> bytearray:
+    """Transitive fanout of ``node`` (including it), among nodes below ``upto``."""
+    n = g.num_inputs
+    mark = bytearray(g.num_nodes)
+    mark[node] = 1
+    end = len(g.ands) if upto is None else min(len(g.ands), upto - n - 1)
+    for k in range(node - n, end):
+        a, b = g.ands[k]
+        if mark[a >> 1] or mark[b >> 1]:
+            mark[n + 1 + k] = 1
+    return mark
+
+
+def _expr_nodes(e, acc: list[int]) -> list[int]:
+    if isinstance(e, int):
+        acc.append(e >> 1)
+    else:
+        _expr_nodes(e[1], acc)
+        _expr_nodes(e[2], acc)
+    return acc
+
+
+def rebuild(g: AIG, repl: dict[int, tuple]) -> AIG:
+    """Copy ``g`` replacing node ``x`` by the expression ``repl[x]``.
+
+    An expression is an old literal (int) or ``("and", e1, e2, compl)``.  The
+    replacements must keep the network acyclic (see :class:`_Virtual`); nodes are
+    rebuilt in a depth-first order of the resulting network.
+    """
+    h = AIG(g.inputs)
+    n = g.num_inputs
+    m: dict[int, int] = {i: 2 * i for i in range(n + 1)}
+
+    def deps(x: int) -> list[int]:
+        r = repl.get(x)
+        if r is not None:
+            return _expr_nodes(r, [])
+        a, b = g.ands[x - n - 1]
+        return [a >> 1, b >> 1]
+
+    def ev(e):
+        if isinstance(e, int):
+            return m[e >> 1] ^ (e & 1)
+        _, e1, e2, c = e
+        return h.and_(ev(e1), ev(e2)) ^ c
+
+    for lit in g.output_lits:
+        stack = [lit >> 1]
+        while stack:
+            x = stack[-1]
+            if x in m:
+                stack.pop()
+                continue
+            pend = [y for y in deps(x) if y not in m]
+            if pend:
+                stack.extend(pend)
+                continue
+            stack.pop()
+            r = repl.get(x)
+            if r is not None:
+                m[x] = ev(r)
+            else:
+                a, b = g.ands[x - n - 1]
+                m[x] = h.and_(m[a >> 1] ^ (a & 1), m[b >> 1] ^ (b & 1))
+    for name, lit in zip(g.outputs, g.output_lits):
+        h.add_output(name, m[lit >> 1] ^ (lit & 1))
+    return h.cleanup()
+
+
+class _Virtual:
+    """The network as it will be after the replacements accepted so far; used to
+    refuse a replacement that would create a cycle."""
+
+    def __init__(self, g: AIG):
+        self.g = g
+        self.repl_deps: dict[int, list[int]] = {}
+
+    def deps(self, x: int) -> list[int]:
+        r = self.repl_deps.get(x)
+        if r is not None:
+            return r
+        n = self.g.num_inputs
+        if x <= n:
+            return []
+        a, b = self.g.ands[x - n - 1]
+        return [a >> 1, b >> 1]
+
+    def reaches(self, sources: list[int], target: int) -> bool:
+        seen = set()
+        stack = [s for s in sources if s > self.g.num_inputs]
+        while stack:
+            x = stack.pop()
+            if x == target:
+                return True
+            if x in seen or x < target and x not in self.repl_deps and not self._any_repl_below:
+                continue
+            seen.add(x)
+            stack.extend(y for y in self.deps(x) if y > self.g.num_inputs)
+        return False
+
+    @property
+    def _any_repl_below(self) -> bool:
+        return bool(self.repl_deps)
+
+    def accept(self, x: int, e) -> bool:
+        ds = _expr_nodes(e, [])
+        if self.reaches(ds, x):
+            return False
+        self.repl_deps[x] = ds
+        return True
+
+
+def reorder(g: AIG, rng: random.Random | None = None) -> AIG:
+    """Re-number nodes in DFS order from the outputs (optionally shuffled order)."""
+    h = AIG(g.inputs)
+    n = g.num_inputs
+    m: dict[int, int] = {i: 2 * i for i in range(n + 1)}
+    order = list(range(len(g.outputs)))
+    if rng is not None:
+        rng.shuffle(order)
+    for o in order:
+        root = g.output_lits[o] >> 1
+        stack = [root]
+        while stack:
+            x = stack[-1]
+            if x in m:
+                stack.pop()
+                continue
+            a, b = g.ands[x - n - 1]
+            pend = [y for y in (a >> 1, b >> 1) if y not in m]
+            if rng is not None and len(pend) == 2 and rng.random() < 0.5:
+                pend.reverse()
+            if pend:
+                stack.extend(pend)
+                continue
+            stack.pop()
+            m[x] = h.and_(m[a >> 1] ^ (a & 1), m[b >> 1] ^ (b & 1))
+    for name, lit in zip(g.outputs, g.output_lits):
+        h.add_output(name, m[lit >> 1] ^ (lit & 1))
+    return h
+
+
+# ----------------------------------------------------------------------------- sweep
+def sweep(g: AIG) -> AIG:
+    """Merge functionally equivalent nodes (up to complement) using global tables."""
+    n = g.num_inputs
+    if n > TT_LIMIT:
+        return g
+    full = T.mask(n)
+    vals = g.node_tables()
+    seen: dict[int, int] = {}
+    repl: dict[int, tuple] = {}
+    for x in range(n + 1):
+        v = vals[x]
+        seen.setdefault(v, 2 * x)
+        seen.setdefault(v ^ full, 2 * x + 1)
+    for x in range(n + 1, g.num_nodes):
+        v = vals[x]
+        r = seen.get(v)
+        if r is not None:
+            repl[x] = r
+        else:
+            seen[v] = 2 * x
+            seen[v ^ full] = 2 * x + 1
+    if not repl:
+        return g
+    return rebuild(g, repl)
+
+
+# ----------------------------------------------------------------------------- resub
+def resub(g: AIG, care_out: list[int] | None = None, max_new: int = 2, max_div: int = 150,
+          deadline: float | None = None) -> AIG:
+    """One resubstitution pass with global truth tables (``n <= TT_LIMIT``)."""
+    n = g.num_inputs
+    if n > TT_LIMIT or not g.ands:
+        return g
+    full = T.mask(n)
+    vals = g.node_tables()
+    refs = refcounts(g)
+    # care set of each node: external don't cares apply to nodes feeding only outputs
+    node_care: dict[int, int] = {}
+    if care_out is not None:
+        drv: dict[int, int] = {}
+        cnt: dict[int, int] = {}
+        for lit, c in zip(g.output_lits, care_out):
+            x = lit >> 1
+            drv[x] = drv.get(x, 0) | (full & ~c)      # union of don't cares -> intersect cares
+            cnt[x] = cnt.get(x, 0) + 1
+        # a node driving several outputs: care = union of the outputs' cares
+        for lit, c in zip(g.output_lits, care_out):
+            x = lit >> 1
+            node_care[x] = node_care.get(x, 0) | c
+        for x in list(node_care):
+            if refs[x] != cnt[x]:        # also used inside the network: fully cared
+                node_care[x] = full
+    # output drivers whose function may change inside the don't cares are no divisors
+    relaxed = {x for x, c in node_care.items() if c != full}
+    touched = bytearray(g.num_nodes)
+    repl: dict[int, tuple] = {}
+    virt = _Virtual(g)
+    N = g.num_nodes
+    or_width = 16 if len(g.ands) < 300 else 2
+    for x in range(n + 1, N):
+        if deadline is not None and time.perf_counter() > deadline:
+            break
+        if touched[x] or refs[x] == 0:
+            continue
+        cone = mffc(g, x, refs)
+        save = len(cone)
+        if any(touched[y] for y in cone):
+            continue
+        care = node_care.get(x, full)
+        f = vals[x] & care
+        incone = set(cone)
+        lo, hi = max(n + 1, x - max_div), min(N, x + max_div // 3)
+        tfo = tfo_mark(g, x, hi)
+        divs = list(range(1, n + 1)) + [d for d in range(lo, hi) if d not in incone
+                                        and not touched[d] and not tfo[d] and refs[d] > 0
+                                        and d not in relaxed]
+        e = _find_resub(f, care, full, divs, vals, min(max_new, save - 1), or_width)
+        if e is None or not virt.accept(x, e):
+            continue
+        repl[x] = e
+        for y in cone:
+            touched[y] = 1
+    if not repl:
+        return g
+    return rebuild(g, repl)
+
+
+def resub_window(g: AIG, max_leaves: int = 10, max_new: int = 2, max_window: int = 150,
+                 deadline: float | None = None) -> AIG:
+    """Resubstitution for networks too wide for global tables: each node gets a
+    window (a reconvergence-driven cut and the nodes computable from it), and its
+    function and the divisors' are truth tables over the cut's leaves."""
+    n = g.num_inputs
+    if not g.ands:
+        return g
+    refs = refcounts(g)
+    fanouts: list[list[int]] = [[] for _ in range(g.num_nodes)]
+    for k, (a, b) in enumerate(g.ands):
+        x = n + 1 + k
+        fanouts[a >> 1].append(x)
+        if (b >> 1) != (a >> 1):
+            fanouts[b >> 1].append(x)
+    touched = bytearray(g.num_nodes)
+    repl: dict[int, tuple] = {}
+    virt = _Virtual(g)
+    for x in range(n + 1, g.num_nodes):
+        if deadline is not None and time.perf_counter() > deadline:
+            break
+        if touched[x] or refs[x] == 0:
+            continue
+        leaves = reconv_cut(g, x, max_leaves)
+        if any(touched[y] for y in leaves):
+            continue
+        cone = mffc(g, x, refs, set(leaves))
+        if len(cone) < 2 or any(touched[y] for y in cone):
+            continue
+        k = len(leaves)
+        full = T.mask(k)
+        vals: dict[int, int] = {leaf: T.var(k, i) for i, leaf in enumerate(leaves)}
+        # window: grow from the leaves through fanouts whose fanins are all inside
+        cand = sorted({y for leaf in leaves for y in fanouts[leaf]})
+        seen = set(cand)
+        i = 0
+        while i < len(cand) and len(vals) < max_window:
+            y = cand[i]
+            i += 1
+            if y in vals or y > x + max_window:
+                continue
+            a, b = g.ands[y - n - 1]
+            if (a >> 1) in vals and (b >> 1) in vals:
+                va = vals[a >> 1] ^ (full if a & 1 else 0)
+                vb = vals[b >> 1] ^ (full if b & 1 else 0)
+                vals[y] = va & vb
+                for z in fanouts[y]:
+                    if z not in seen:
+                        seen.add(z)
+                        cand.append(z)
+                cand_tail = cand[i:]
+                cand_tail.sort()
+                cand[i:] = cand_tail
+        if x not in vals:
+            continue
+        # exclude the node's fanout cone and its MFFC from the divisors
+        bad = set(cone)
+        tfo = {x}
+        for y in sorted(vals):
+            if y > x and y > n:
+                a, b = g.ands[y - n - 1]
+                if (a >> 1) in tfo or (b >> 1) in tfo:
+                    tfo.add(y)
+        bad |= tfo
+        divs = [d for d in sorted(vals) if d not in bad and not touched[d] and refs[d] > 0]
+        e = _find_resub(vals[x], full, full, divs, vals, min(max_new, len(cone) - 1), 8)
+        if e is None or not virt.accept(x, e):
+            continue
+        repl[x] = e
+        for y in cone:
+            touched[y] = 1
+    if not repl:
+        return g
+    return rebuild(g, repl)
+
+
+def _find_resub(f: int, care: int, full: int, divs: list[int], vals: list[int], max_new: int,
+                or_width: int = 16):
+    """An expression over divisors for ``f`` (on ``care``) with at most ``max_new`` ANDs."""
+    if max_new < 0:
+        return None
+    nf = ~f & care
+    # 0-resub
+    if f == 0:
+        return 0
+    if nf == 0:
+        return 1
+    for d in divs:
+        v = vals[d] & care
+        if v == f:
+            return 2 * d
+        if v == nf:
+            return 2 * d + 1
+    if max_new < 1:
+        return None
+    # divisor literals that contain f (for f = AND) or contain !f (for f = OR = !AND(!,!))
+    pos, neg = [], []
+    for d in divs:
+        v = vals[d]
+        for c in (0, 1):
+            w = (v ^ (full if c else 0)) & care
+            if f & ~w == 0:
+                pos.append((2 * d + c, w))
+            if nf & ~w == 0:
+                neg.append((2 * d + c, w))
+    # 1-resub
+    for target, cands, oc in ((f, pos, 0), (nf, neg, 1)):
+        L = len(cands)
+        for i in range(L):
+            li, wi = cands[i]
+            for j in range(i + 1, L):
+                lj, wj = cands[j]
+                if (li >> 1) != (lj >> 1) and wi & wj == target:
+                    return ("and", li, lj, oc)
+    if max_new < 2:
+        return None
+    # 2-resub: f = d1 & (d2 & d3)  (all three in pos), or f = d1 & (d2 | d3)
+    allv = []
+    for d in divs:
+        v = vals[d] & care
+        allv.append((2 * d, v))
+        allv.append((2 * d + 1, (~vals[d]) & care))
+    for target, cands, oc in ((f, pos, 0), (nf, neg, 1)):
+        L = len(cands)
+        if L <= 30:
+            for i in range(L):
+                li, wi = cands[i]
+                extra = wi & ~target          # minterms d1 lets through that must be removed
+                for j in range(i + 1, L):
+                    lj, wj = cands[j]
+                    e2 = extra & wj
+                    for k in range(j + 1, L):
+                        lk, wk = cands[k]
+                        if e2 & wk == 0:
+                            return ("and", li, ("and", lj, lk, 0), oc)
+        # d1 & (d2 | d3): d2, d3 avoid what d1 lets through, together cover the target
+        for i in range(min(L, or_width)):
+            li, wi = cands[-1 - i]
+            extra = wi & ~target
+            avoid = [(l, w) for l, w in allv if w & extra == 0 and w & target
+                     and (l >> 1) != (li >> 1)]
+            if len(avoid) > 60:
+                avoid = avoid[-60:]
+            A = len(avoid)
+            for j in range(A):
+                lj, wj = avoid[j]
+                rest = target & ~wj
+                for k in range(j + 1, A):
+                    lk, wk = avoid[k]
+                    if rest & ~wk == 0 and (lk >> 1) != (lj >> 1):
+                        return ("and", li, ("and", lj ^ 1, lk ^ 1, 1), oc)
+    return None
+
+
+# ----------------------------------------------------------------------------- rewrite
+def enumerate_cuts(g: AIG, k: int = 4, limit: int = 10) -> list[list[tuple[int, ...]]]:
+    n = g.num_inputs
+    cuts: list[list[tuple[int, ...]]] = [[()]] + [[(i,)] for i in range(1, n + 1)]
+    for idx, (a, b) in enumerate(g.ands):
+        x = n + 1 + idx
+        ca, cb = cuts[a >> 1], cuts[b >> 1]
+        res = set()
+        for c1 in ca:
+            for c2 in cb:
+                u = tuple(sorted(set(c1) | set(c2)))
+                if len(u) <= k:
+                    res.add(u)
+        lst = sorted(res, key=lambda c: (len(c), c))
+        # drop dominated cuts (supersets of another cut)
+        kept: list[tuple[int, ...]] = []
+        for c in lst:
+            sc = set(c)
+            if any(set(d) <= sc for d in kept):
+                continue
+            kept.append(c)
+            if len(kept) >= limit:
+                break
+        cuts.append(kept + [(x,)])
+    return cuts
+
+
+def cut_table(g: AIG, node: int, leaves: tuple[int, ...]) -> int:
+    """16-bit table of ``node`` over ``leaves`` (padded to 4 variables)."""
+    n = g.num_inputs
+    val = {leaf: T.var(4, i) for i, leaf in enumerate(leaves)}
+    full = 0xFFFF
+    stack = [node]
+    while stack:
+        x = stack[-1]
+        if x in val:
+            stack.pop()
+            continue
+        a, b = g.ands[x - n - 1]
+        pend = [y for y in (a >> 1, b >> 1) if y not in val]
+        if pend:
+            stack.extend(pend)
+            continue
+        stack.pop()
+        va = val[a >> 1] ^ (full if a & 1 else 0)
+        vb = val[b >> 1] ^ (full if b & 1 else 0)
+        val[x] = va & vb
+    return val[node]
+
+
+def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> AIG:
+    """One pass of DAG-aware exact 4-cut rewriting."""
+    from mlc.logic import npn
+    n = g.num_inputs
+    if not g.ands:
+        return g
+    tab = npn.table()
+    refs = refcounts(g)
+    cuts = enumerate_cuts(g)
+    lev = g.levels()
+    touched = bytearray(g.num_nodes)
+    repl: dict[int, tuple] = {}
+    virt = _Virtual(g)
+    for x in range(n + 1, g.num_nodes):
+        if deadline is not None and time.perf_counter() > deadline:
+            break
+        if touched[x] or refs[x] == 0:
+            continue
+        best = None
+        for c in cuts[x]:
+            if len(c) < 2 or c == (x,):
+                continue
+            if any(touched[y] for y in c):
+                continue
+            cone = mffc(g, x, refs, set(c))
+            if any(touched[y] for y in cone):
+                continue
+            f = cut_table(g, x, c)
+            R, perm, neg, out = npn.canon(f)
+            ent = tab[R]
+            if ent["ands"] > len(cone) or (ent["ands"] == len(cone) and not zero_gain):
+                continue
+            leaves = [2 * y for y in c] + [0] * (4 - len(c))
+            incone = set(cone)
+            lits: list = [leaves[perm[i]] ^ ((neg >> i) & 1) for i in range(4)]
+            exprs: list = list(lits)
+            new = 0
+            for j, l, fj, fl, fo in ent["gates"]:
+                a, b = lits[j], lits[l]
+                r = None
+                if a is not None and b is not None:
+                    r = g.lookup(a ^ fj, b ^ fl)
+                    if r is not None and ((r >> 1) in incone or touched[r >> 1]
+                                          or refs[r >> 1] == 0):
+                        r = None
+                if r is None:
+                    new += 1
+                    lits.append(None)
+                    exprs.append(("and", exprs[j] ^ fj if isinstance(exprs[j], int) else
+                                  _neg(exprs[j], fj), exprs[l] ^ fl if isinstance(exprs[l], int)
+                                  else _neg(exprs[l], fl), fo))
+                else:
+                    lits.append(r ^ fo)
+                    exprs.append(r ^ fo)
+            gain = len(cone) - new
+            if gain < 0 or (gain == 0 and not zero_gain):
+                continue
+            node, c_out = ent["out"]
+            if node < 0:
+                e = c_out ^ out
+            else:
+                e = exprs[node]
+                e = e ^ c_out ^ out if isinstance(e, int) else _neg(e, c_out ^ out)
+            # depth estimate as a tie-breaker
+            key = (gain, -_expr_depth(e, lev))
+            if best is None or key > best[0]:
+                best = (key, e, cone)
+        if best is None:
+            continue
+        if best[0][0] == 0 and best[0][1] <= -lev[x]:
+            continue                       # zero gain must at least not worsen depth
+        if not virt.accept(x, best[1]):
+            continue
+        repl[x] = best[1]
+        for y in best[2]:
+            touched[y] = 1
+    if not repl:
+        return g
+    return rebuild(g, repl)
+
+
+def _neg(e, c):
+    if not c:
+        return e
+    if isinstance(e, int):
+        return e ^ 1
+    return (e[0], e[1], e[2], e[3] ^ 1)
+
+
+def _expr_depth(e, lev) -> int:
+    if isinstance(e, int):
+        return lev[e >> 1]
+    return 1 + max(_expr_depth(e[1], lev), _expr_depth(e[2], lev))
+
+
+# ----------------------------------------------------------------------------- refactor
+def reconv_cut(g: AIG, x: int, max_leaves: int) -> list[int]:
+    """A reconvergence-driven cut of node ``x``: expand the leaf that adds fewest leaves."""
+    n = g.num_inputs
+    a, b = g.ands[x - n - 1]
+    leaves = {a >> 1, b >> 1}
+    leaves.discard(0)
+    inside = {x}
+    while True:
+        best, bcost = None, None
+        for y in leaves:
+            if y <= n:
+                continue
+            fa, fb = g.ands[y - n - 1]
+            c = sum(1 for z in (fa >> 1, fb >> 1) if z not in leaves and z not in inside and z) - 1
+            if bcost is None or c < bcost or (c == bcost and y > best):
+                best, bcost = y, c
+        if best is None or len(leaves) + bcost > max_leaves:
+            break
+        leaves.discard(best)
+        inside.add(best)
+        fa, fb = g.ands[best - n - 1]
+        for z in (fa >> 1, fb >> 1):
+            if z and z not in inside:
+                leaves.add(z)
+    return sorted(leaves)
+
+
+def cone_table(g: AIG, node: int, leaves: list[int]) -> int:
+    k = len(leaves)
+    n = g.num_inputs
+    full = T.mask(k)
+    val = {leaf: T.var(k, i) for i, leaf in enumerate(leaves)}
+    stack = [node]
+    while stack:
+        x = stack[-1]
+        if x in val:
+            stack.pop()
+            continue
+        a, b = g.ands[x - n - 1]
+        pend = [y for y in (a >> 1, b >> 1) if y not in val]
+        if pend:
+            stack.extend(pend)
+            continue
+        stack.pop()
+        va = val[a >> 1] ^ (full if a & 1 else 0)
+        vb = val[b >> 1] ^ (full if b & 1 else 0)
+        val[x] = va & vb
+    return val[node]
+
+
+def _aig_to_expr(s: AIG, leaf_lits: list[int]):
+    """Expression (see :func:`rebuild`) of the single output of scratch AIG ``s``."""
+    n = s.num_inputs
+    ex: dict[int, object] = {0: 0}
+    for i in range(n):
+        ex[i + 1] = leaf_lits[i]
+    for k, (a, b) in enumerate(s.ands):
+        ea = ex[a >> 1]
+        eb = ex[b >> 1]
+        ex[n + 1 + k] = ("and", _neg(ea, a & 1), _neg(eb, b & 1), 0)
+    lit = s.output_lits[0]
+    return _neg(ex[lit >> 1], lit & 1)
+
+
+def refactor(g: AIG, max_leaves: int = 8, zero_gain: bool = False,
+             deadline: float | None = None) -> AIG:
+    """Collapse the cone of each node over a reconvergence-driven cut of up to
+    ``max_leaves`` leaves and resynthesise it by decomposition (exact below 5
+    variables); replace when it frees more nodes than it adds."""
+    from mlc.logic.decomp import _Dec
+    n = g.num_inputs
+    if not g.ands:
+        return g
+    refs = refcounts(g)
+    touched = bytearray(g.num_nodes)
+    repl: dict[int, tuple] = {}
+    virt = _Virtual(g)
+    decs: dict[int, _Dec] = {}
+    for x in range(g.num_nodes - 1, n, -1):          # outputs first: large cones
+        if deadline is not None and time.perf_counter() > deadline:
+            break
+        if touched[x] or refs[x] == 0:
+            continue
+        leaves = reconv_cut(g, x, max_leaves)
+        if len(leaves) < 3 or any(touched[y] for y in leaves):
+            continue
+        cone = mffc(g, x, refs, set(leaves))
+        if len(cone) < 3 or any(touched[y] for y in cone):
+            continue
+        k = len(leaves)
+        f = cone_table(g, x, leaves)
+        d = decs.get(k)
+        if d is None:
+            d = decs[k] = _Dec(k, 2)
+        _, plan = d.rec(f, T.mask(k))
+        s = AIG([f"l{i}" for i in range(k)])
+        s.add_output("f", d.build(s, plan))
+        s = s.cleanup()
+        new = s.num_ands()
+        if new > len(cone) or (new == len(cone) and not zero_gain):
+            continue
+        e = _aig_to_expr(s, [2 * y for y in leaves])
+        if new == len(cone):
+            lev = g.levels()
+            if _expr_depth(e, lev) >= lev[x]:
+                continue
+        if not virt.accept(x, e):
+            continue
+        repl[x] = e
+        for y in cone:
+            touched[y] = 1
+    if not repl:
+        return g
+    return rebuild(g, repl)
+
+
+# ----------------------------------------------------------------------------- balance
+def balance(g: AIG) -> AIG:
+    """AND-tree balancing: collapse single-fanout, uncomplemented AND trees into
+    multi-input ANDs and rebuild them pairing the shallowest operands first."""
+    n = g.num_inputs
+    refs = refcounts(g)
+    h = AIG(g.inputs)
+    m = [0] * g.num_nodes
+    for i in range(1, n + 1):
+        m[i] = 2 * i
+    lev_new: dict[int, int] = {}
+
+    def nlev(lit: int) -> int:
+        return lev_new.get(lit >> 1, 0)
+
+    def hand(a: int, b: int) -> int:
+        r = h.and_(a, b)
+        if (r >> 1) not in lev_new and r >> 1 > n:
+            lev_new[r >> 1] = 1 + max(nlev(a), nlev(b))
+        return r
+
+    for k, (a, b) in enumerate(g.ands):
+        x = n + 1 + k
+        # collect the super-gate leaves
+        leaves = []
+        stack = [a, b]
+        while stack:
+            lit = stack.pop()
+            y = lit >> 1
+            if not (lit & 1) and y > n and refs[y] == 1 and len(leaves) + len(stack) < 16:
+                stack.extend(g.ands[y - n - 1])
+            else:
+                leaves.append(m[y] ^ (lit & 1))
+        leaves = list(dict.fromkeys(leaves))
+        if any((l ^ 1) in leaves for l in leaves):
+            m[x] = 0
+            continue
+        while len(leaves) > 1:
+            leaves.sort(key=nlev)
+            a1, a2 = leaves[0], leaves[1]
+            # prefer an existing pair among the shallowest ones
+            leaves = leaves[2:] + [hand(a1, a2)]
+        m[x] = leaves[0] if leaves else 1
+    for name, lit in zip(g.outputs, g.output_lits):
+        h.add_output(name, m[lit >> 1] ^ (lit & 1))
+    return h.cleanup()
+
+
+def _xor_gadget(g: AIG, x: int):
+    """``(u, v)`` if node ``x`` computes ``u XOR v`` as ``!(u & v) & !(!u & !v)``."""
+    n = g.num_inputs
+    if x <= n:
+        return None
+    a, b = g.ands[x - n - 1]
+    if not (a & 1 and b & 1):
+        return None
+    p, q = a >> 1, b >> 1
+    if p <= n or q <= n:
+        return None
+    pa, pb = g.ands[p - n - 1]
+    qa, qb = g.ands[q - n - 1]
+    if {pa ^ 1, pb ^ 1} == {qa, qb}:
+        return (pa, pb, p, q)
+    return None
+
+
+def balance_xor(g: AIG) -> AIG:
+    """Rebuild XOR trees (chains of 3-AND XOR gadgets with no other fanout) as
+    balanced trees: the same number of ANDs, less depth."""
+    n = g.num_inputs
+    refs = refcounts(g)
+    gad = {}
+    for x in range(n + 1, g.num_nodes):
+        r = _xor_gadget(g, x)
+        if r is not None:
+            gad[x] = r
+    if not gad:
+        return g
+
+    def absorbable(y: int) -> bool:
+        r = gad.get(y)
+        return r is not None and refs[y] == 2 and refs[r[2]] == 1 and refs[r[3]] == 1
+
+    h = AIG(g.inputs)
+    m = [0] * g.num_nodes
+    for i in range(1, n + 1):
+        m[i] = 2 * i
+    lev: dict[int, int] = {}
+
+    def L(lit: int) -> int:
+        return lev.get(lit >> 1, 0)
+
+    def hx(a: int, b: int) -> int:
+        r = h.xor_(a, b)
+        for lit in (r,):
+            if (lit >> 1) not in lev and (lit >> 1) > n:
+                lev[lit >> 1] = 2 + max(L(a), L(b))
+        return r
+
+    def hand(a: int, b: int) -> int:
+        r = h.and_(a, b)
+        if (r >> 1) not in lev and (r >> 1) > n:
+            lev[r >> 1] = 1 + max(L(a), L(b))
+        return r
+
+    for k, (a, b) in enumerate(g.ands):
+        x = n + 1 + k
+        r = gad.get(x)
+        if r is None:
+            m[x] = hand(m[a >> 1] ^ (a & 1), m[b >> 1] ^ (b & 1))
+            continue
+        leaves, par = [], 0
+        stack = [r[0], r[1]]
+        while stack:
+            lit = stack.pop()
+            y = lit >> 1
+            if absorbable(y) and len(leaves) + len(stack) < 32:
+                par ^= lit & 1
+                stack.extend(gad[y][:2])
+            else:
+                nl = m[y] ^ (lit & 1)
+                par ^= nl & 1
+                leaves.append(nl & ~1)
+        if len(leaves) <= 2:
+            m[x] = hand(m[a >> 1] ^ (a & 1), m[b >> 1] ^ (b & 1))
+            continue
+        while len(leaves) > 1:
+            leaves.sort(key=L)
+            leaves = leaves[2:] + [hx(leaves[0], leaves[1])]
+        # the gadget's node value is u ^ v (uncomplemented)
+        m[x] = leaves[0] ^ par
+    for name, lit in zip(g.outputs, g.output_lits):
+        h.add_output(name, m[lit >> 1] ^ (lit & 1))
+    return h.cleanup()
+
+
+# ----------------------------------------------------------------------------- initial
+def _filled(spec: TableSpec, mode: str) -> TableSpec:
+    """``spec`` with its don't cares assigned: by the ISOP cover, to 0 or to 1."""
+    full = T.mask(spec.n)
+    on = []
+    for f, d in zip(spec.on, spec.dc):
+        if mode == "isop":
+            _, cov = T.isop(f & full, (f | d) & full, spec.n)
+            on.append(cov)
+        elif mode == "one":
+            on.append((f | d) & full)
+        else:
+            on.append(f & full)
+    return TableSpec(list(spec.inputs), list(spec.outputs), on, [0] * len(on), spec.source)
+
+
+def initial_candidates(spec, effort: int) -> list[AIG]:
+    big_table = isinstance(spec, TableSpec) and spec.n >= 9 and effort >= 1
+    # (for wide tables the decomposition's SOP step subsumes the plain lowering)
+    cands = [] if big_table else [from_spec(spec)]
+    if effort >= 1 and isinstance(spec, TableSpec):
+        from mlc.logic import decomp
+        cands.append(decomp.from_table(spec, effort))
+        if effort >= 2 and any(spec.dc) and spec.n <= 10:
+            # other don't-care assignments: sharing between outputs may prefer them;
+            # the passes still see the don't cares (resubstitution at the outputs)
+            for mode in ("isop", "zero", "one"):
+                cands.append(decomp.from_table(_filled(spec, mode), effort))
+    if effort >= 1 and isinstance(spec, NetworkSpec) and len(spec.inputs) <= 12:
+        # collapse to tables and decompose: finds structure the network hides
+        from mlc.logic import decomp
+        from mlc.logic.equiv import spec_tables
+        on, dc = spec_tables(spec)
+        ts = TableSpec(list(spec.inputs), list(spec.outputs), on, dc, spec.source)
+        cands.append(decomp.from_table(ts, effort))
+    return cands
+
+
+def _care(spec) -> list[int] | None:
+    n = len(spec.inputs)
+    if n > TT_LIMIT:
+        return None
+    full = T.mask(n)
+    dc = spec.dc if spec.dc else None
+    if not dc or not any(dc):
+        return None
+    return [full & ~d for d in dc]
+
+
+def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
+    """Iterate the passes until a round brings no improvement."""
+    best = g
+    rounds = {0: 0, 1: 2, 2: 6, 3: 20}[effort]
+    for r in range(rounds):
+        if time.perf_counter() > deadline:
+            break
+        cur = best
+        cur = sweep(cur)
+        if cur.num_inputs > TT_LIMIT:
+            cur = resub_window(cur, max_new=1 if effort == 1 else 2, deadline=deadline)
+        cur = resub(cur, care, max_new=1 if effort == 1 else 2, deadline=deadline)
+        if effort >= 2:
+            cur = rewrite(cur, deadline=deadline)
+            cur = resub(cur, care, max_new=2, deadline=deadline)
+            rf = refactor(cur, deadline=deadline)
+            if cost(rf) < cost(cur):
+                cur = rf
+            if effort >= 3:
+                cur = rewrite(cur, zero_gain=True, deadline=deadline)
+                cur = resub(cur, care, max_new=2, deadline=deadline)
+        b = balance(cur)
+        if cost(b) <= cost(cur):
+            cur = b
+        b = balance(balance_xor(cur))
+        if cost(b) <= cost(cur):
+            cur = b
+        if cost(cur) < cost(best):
+            best = cur
+        else:
+            if effort >= 3 and r < rounds - 1:
+                # perturb: renumber in a random DFS order and try again
+                cur2 = reorder(best, random.Random(r))
+                cur2 = rewrite(resub(cur2, care, deadline=deadline), deadline=deadline)
+                if cost(cur2) < cost(best):
+                    best = cur2
+                    continue
+            break
+    if effort >= 2:
+        # depth polish: zero-gain rewrites that shorten paths, then balancing
+        for _ in range(3):
+            if time.perf_counter() > deadline:
+                break
+            d = balance(balance_xor(rewrite(best, zero_gain=True, deadline=deadline)))
+            d2 = balance(refactor(best, zero_gain=True, deadline=deadline))
+            d = min(d, d2, key=cost)
+            if cost(d) < cost(best):
+                best = d
+            else:
+                break
+    return best
+
+
+def optimize(spec, effort: int, time_budget: float | None = None) -> AIG:
+    t0 = time.perf_counter()
+    if time_budget is None:
+        n = len(spec.inputs)
+        # -O2 answers within a second up to 10 inputs, a few seconds at 16
+        time_budget = {0: 1.0, 1: 0.5, 2: (1.0 if n <= 8 else 0.6) + 0.8 * max(0, min(n, 20) - 10),
+                       3: 5.0 + 2.0 * max(0, min(n, 20) - 10)}[effort]
+    cands = initial_candidates(spec, effort)
+    if effort == 0:
+        return min(cands, key=cost)
+    care = _care(spec)
+    results = []
+    cands.sort(key=cost)
+    for i, c in enumerate(cands):
+        left = t0 + time_budget - time.perf_counter()
+        deadline = time.perf_counter() + max(0.0, left) / (len(cands) - i)
+        results.append(improve(c, effort, care, deadline))
+    best = min(results, key=cost)
+    n = len(spec.inputs)
+    if effort >= 3 and (n <= 4 or (n == 5 and best.num_ands() <= 9)):
+        from mlc.logic import exact_multi
+        e = exact_multi.try_exact(spec, best, t0 + time_budget)
+        if e is not None and cost(e) < cost(best):
+            best = e
+    elif effort >= 2 and 5 <= n <= TT_LIMIT:
+        # restarts: randomised decompositions, each improved, until the budget is spent
+        from mlc.logic import decomp
+        from mlc.logic.equiv import spec_tables
+        if isinstance(spec, TableSpec):
+            ts = spec
+        else:
+            on, dc = spec_tables(spec)
+            ts = TableSpec(list(spec.inputs), list(spec.outputs), on, dc, spec.source)
+        rng = random.Random(12345)
+        end = t0 + time_budget
+        stale = 0
+        restarts = 0
+        # -O2: a fixed number of restarts (deterministic unless the budget runs out)
+        max_restarts = 4 if effort == 2 and n <= 8 else (0 if effort == 2 else 10 ** 9)
+        while time.perf_counter() < end and stale < 25 and restarts < max_restarts:
+            restarts += 1
+            c = decomp.from_table(ts, effort, rng)
+            step_end = min(end, time.perf_counter() + max(0.5, 0.2 * time_budget))
+            c = improve(c, effort, care, step_end)
+            if cost(c) < cost(best):
+                best = c
+                stale = 0
+            else:
+                stale += 1
+    return best
