@@ -7,11 +7,11 @@ success.  When an UNSAT answer stops the descent, the result is a proven minimum
 """
 from __future__ import annotations
 
-import time
 
 from mlc.logic import exactsat
 from mlc.logic import tt as T
 from mlc.logic.aig import AIG
+from mlc.logic import work
 from mlc.logic.equiv import spec_tables
 
 MAX_INPUTS = 5
@@ -60,7 +60,7 @@ def try_exact(spec, best: AIG, deadline: float, info: dict | None = None) -> AIG
     found = None
     proven = False
     while k >= len(targets):
-        left = deadline - time.perf_counter()
+        left = deadline - work.now()
         if left < 0.05:
             break
         r = exactsat.synthesize_exact(n, targets, k, time_limit=left)

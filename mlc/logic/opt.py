@@ -17,10 +17,10 @@ Passes
 from __future__ import annotations
 
 import random
-import time
 
 from mlc.front.spec import NetworkSpec, TableSpec
 from mlc.logic import tt as T
+from mlc.logic import work
 from mlc.logic.aig import AIG
 from mlc.logic.lower import from_spec
 
@@ -262,7 +262,7 @@ def resub(g: AIG, care_out: list[int] | None = None, max_new: int = 2, max_div: 
     N = g.num_nodes
     or_width = 16 if len(g.ands) < 300 else 2
     for x in range(n + 1, N):
-        if deadline is not None and time.perf_counter() > deadline:
+        if deadline is not None and work.now(g.num_nodes) > deadline:
             break
         if touched[x] or refs[x] == 0:
             continue
@@ -308,7 +308,7 @@ def resub_window(g: AIG, max_leaves: int = 10, max_new: int = 2, max_window: int
     repl: dict[int, tuple] = {}
     virt = _Virtual(g)
     for x in range(n + 1, g.num_nodes):
-        if deadline is not None and time.perf_counter() > deadline:
+        if deadline is not None and work.now(g.num_nodes) > deadline:
             break
         if touched[x] or refs[x] == 0:
             continue
@@ -507,7 +507,7 @@ def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> A
     repl: dict[int, tuple] = {}
     virt = _Virtual(g)
     for x in range(n + 1, g.num_nodes):
-        if deadline is not None and time.perf_counter() > deadline:
+        if deadline is not None and work.now(g.num_nodes) > deadline:
             break
         if touched[x] or refs[x] == 0:
             continue
@@ -668,7 +668,7 @@ def refactor(g: AIG, max_leaves: int = 8, zero_gain: bool = False,
     virt = _Virtual(g)
     decs: dict[int, _Dec] = {}
     for x in range(g.num_nodes - 1, n, -1):          # outputs first: large cones
-        if deadline is not None and time.perf_counter() > deadline:
+        if deadline is not None and work.now(g.num_nodes) > deadline:
             break
         if touched[x] or refs[x] == 0:
             continue
@@ -895,7 +895,7 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
     best = g
     rounds = {0: 0, 1: 2, 2: 6, 3: 20}[effort]
     for r in range(rounds):
-        if time.perf_counter() > deadline:
+        if work.now(best.num_nodes) > deadline:
             break
         cur = best
         cur = sweep(cur)
@@ -931,7 +931,7 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
     if effort >= 2:
         # depth polish: zero-gain rewrites that shorten paths, then balancing
         for _ in range(3):
-            if time.perf_counter() > deadline:
+            if work.now(best.num_nodes) > deadline:
                 break
             d = balance(balance_xor(rewrite(best, zero_gain=True, deadline=deadline)))
             d2 = balance(refactor(best, zero_gain=True, deadline=deadline))
@@ -944,7 +944,11 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
 
 
 def optimize(spec, effort: int, time_budget: float | None = None) -> AIG:
-    t0 = time.perf_counter()
+    """Best AIG for ``spec`` at ``effort``.  ``time_budget`` is in seconds of the
+    deterministic work clock (:mod:`mlc.logic.work`), so the result never depends on
+    the machine's load."""
+    work.reset()
+    t0 = work.now()
     if time_budget is None:
         n = len(spec.inputs)
         # -O2 answers within a second up to 10 inputs, a few seconds at 16
@@ -957,8 +961,8 @@ def optimize(spec, effort: int, time_budget: float | None = None) -> AIG:
     results = []
     cands.sort(key=cost)
     for i, c in enumerate(cands):
-        left = t0 + time_budget - time.perf_counter()
-        deadline = time.perf_counter() + max(0.0, left) / (len(cands) - i)
+        left = t0 + time_budget - work.now()
+        deadline = work.now() + max(0.0, left) / (len(cands) - i)
         results.append(improve(c, effort, care, deadline))
     best = min(results, key=cost)
     n = len(spec.inputs)
@@ -982,10 +986,10 @@ def optimize(spec, effort: int, time_budget: float | None = None) -> AIG:
         restarts = 0
         # -O2: a fixed number of restarts (deterministic unless the budget runs out)
         max_restarts = 4 if effort == 2 and n <= 8 else (0 if effort == 2 else 10 ** 9)
-        while time.perf_counter() < end and stale < 25 and restarts < max_restarts:
+        while work.now(best.num_nodes) < end and stale < 25 and restarts < max_restarts:
             restarts += 1
             c = decomp.from_table(ts, effort, rng)
-            step_end = min(end, time.perf_counter() + max(0.5, 0.2 * time_budget))
+            step_end = min(end, work.now() + max(0.5, 0.2 * time_budget))
             c = improve(c, effort, care, step_end)
             if cost(c) < cost(best):
                 best = c
