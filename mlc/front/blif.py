@@ -218,32 +218,14 @@ def _label(nd: Node) -> str:
 
 
 def _check_loops(nodes: list[Node], filename: str) -> None:
-    state = [0] * len(nodes)
-    for root in range(len(nodes)):
-        if state[root]:
-            continue
-        stack = [(root, 0)]
-        state[root] = 1
-        path = [root]
-        while stack:
-            k, j = stack[-1]
-            args = nodes[k].args
-            if j < len(args):
-                stack[-1] = (k, j + 1)
-                a = args[j]
-                if state[a] == 1:
-                    cyc = path[path.index(a):]
-                    names = " -> ".join(_label(nodes[c]) for c in cyc + [a])
-                    raise MlcError(f"combinational loop: {names}", nodes[a].loc,
-                                   "mlc compiles combinational logic only; break the loop")
-                if state[a] == 0:
-                    state[a] = 1
-                    stack.append((a, 0))
-                    path.append(a)
-            else:
-                stack.pop()
-                path.pop()
-                state[k] = 2
+    from mlc.front.load import postorder
+
+    def loop(cyc):
+        names = " -> ".join(_label(nodes[c]) for c in cyc)
+        raise MlcError(f"combinational loop: {names}", nodes[cyc[-1]].loc,
+                       "mlc compiles combinational logic only; break the loop")
+
+    postorder(nodes, range(len(nodes)), loop)
 
 
 def print_blif(spec: NetworkSpec, model: str = "mlc") -> str:

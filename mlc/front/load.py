@@ -115,6 +115,45 @@ def minterm_str(spec_inputs: list[str], m: int) -> str:
 
 # --------------------------------------------------------------------------- networks
 
+def postorder(nodes: list[Node], roots, on_cycle=None, follow=None) -> list[int]:
+    """Iterative depth-first post-order of the nodes reachable from ``roots`` (each
+    node once, arguments before the node).  ``follow(a)`` limits which arguments are
+    entered (default: all).  A cycle calls ``on_cycle(path)`` with the nodes of the
+    cycle, ending where it started; the callback must raise."""
+    state = [0] * len(nodes)                 # 0 new, 1 on the current path, 2 done
+    out: list[int] = []
+    for root in roots:
+        if state[root]:
+            continue
+        stack = [(root, 0)]
+        path = [root]
+        state[root] = 1
+        while stack:
+            k, j = stack[-1]
+            args = nodes[k].args
+            if j < len(args):
+                stack[-1] = (k, j + 1)
+                a = args[j]
+                if follow is not None and not follow(a):
+                    continue
+                if state[a] == 1 and on_cycle is not None:
+                    on_cycle(path[path.index(a):] + [a])
+                if state[a] == 0:
+                    state[a] = 1
+                    stack.append((a, 0))
+                    path.append(a)
+            else:
+                stack.pop()
+                path.pop()
+                state[k] = 2
+                out.append(k)
+    return out
+
+
+def _internal_cycle(path):
+    raise InternalError(f"network has a cycle through node {path[0]}")
+
+
 def finish_network(inputs: list[str], outputs: list[str], nodes: list[Node], output_nodes: list[int],
                    source: str, output_locs, dc=None) -> NetworkSpec:
     """Renumber a parsed network into canonical order and check it.
@@ -133,30 +172,8 @@ def finish_network(inputs: list[str], outputs: list[str], nodes: list[Node], out
     for x in missing:
         by_name[x] = len(nodes)
         nodes.append(Node("input", (), x))
-    # live nodes: reachable from outputs (iterative DFS post-order)
-    order: list[int] = []
-    state = [0] * len(nodes)                 # 0 new, 1 on stack, 2 done
-    for root in output_nodes:
-        if state[root]:
-            continue
-        stack = [(root, 0)]
-        state[root] = 1
-        while stack:
-            k, j = stack[-1]
-            args = nodes[k].args
-            if j < len(args):
-                stack[-1] = (k, j + 1)
-                a = args[j]
-                if state[a] == 0:
-                    state[a] = 1
-                    stack.append((a, 0))
-                elif state[a] == 1:
-                    raise InternalError(f"network has a cycle through node {a}")
-            else:
-                stack.pop()
-                state[k] = 2
-                if nodes[k].op != "input":
-                    order.append(k)
+    # live nodes: reachable from outputs
+    order = [k for k in postorder(nodes, output_nodes, _internal_cycle) if nodes[k].op != "input"]
     order.sort()          # keep the parser's order where it is already topological
     order = _stable_topo(nodes, order)
     new_index = {}
@@ -181,26 +198,7 @@ def _stable_topo(nodes: list[Node], order: list[int]) -> list[int]:
     pos = {k: i for i, k in enumerate(order)}
     if all(all(nodes[a].op == "input" or pos[a] < pos[k] for a in nodes[k].args) for k in order):
         return order
-    done: set[int] = set()
-    out: list[int] = []
-    for root in order:
-        if root in done:
-            continue
-        stack = [(root, 0)]
-        while stack:
-            k, j = stack[-1]
-            args = nodes[k].args
-            if j < len(args):
-                stack[-1] = (k, j + 1)
-                a = args[j]
-                if a in pos and a not in done:
-                    stack.append((a, 0))
-            else:
-                stack.pop()
-                if k not in done:
-                    done.add(k)
-                    out.append(k)
-    return out
+    return postorder(nodes, order, follow=lambda a: a in pos)
 
 
 def check_spec(spec: Spec) -> None:

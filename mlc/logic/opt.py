@@ -472,25 +472,7 @@ def enumerate_cuts(g: AIG, k: int = 4, limit: int = 10) -> list[list[tuple[int, 
 
 def cut_table(g: AIG, node: int, leaves: tuple[int, ...]) -> int:
     """16-bit table of ``node`` over ``leaves`` (padded to 4 variables)."""
-    n = g.num_inputs
-    val = {leaf: T.var(4, i) for i, leaf in enumerate(leaves)}
-    full = 0xFFFF
-    stack = [node]
-    while stack:
-        x = stack[-1]
-        if x in val:
-            stack.pop()
-            continue
-        a, b = g.ands[x - n - 1]
-        pend = [y for y in (a >> 1, b >> 1) if y not in val]
-        if pend:
-            stack.extend(pend)
-            continue
-        stack.pop()
-        va = val[a >> 1] ^ (full if a & 1 else 0)
-        vb = val[b >> 1] ^ (full if b & 1 else 0)
-        val[x] = va & vb
-    return val[node]
+    return cone_table(g, node, list(leaves), 4)
 
 
 def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> AIG:
@@ -616,8 +598,9 @@ def reconv_cut(g: AIG, x: int, max_leaves: int) -> list[int]:
     return sorted(leaves)
 
 
-def cone_table(g: AIG, node: int, leaves: list[int]) -> int:
-    k = len(leaves)
+def cone_table(g: AIG, node: int, leaves: list[int], k: int | None = None) -> int:
+    """Truth table of ``node`` over ``leaves`` as ``k`` variables (default: one per leaf)."""
+    k = len(leaves) if k is None else k
     n = g.num_inputs
     full = T.mask(k)
     val = {leaf: T.var(k, i) for i, leaf in enumerate(leaves)}
