@@ -31,6 +31,18 @@ def lit_node(a: int) -> int:
     return a >> 1
 
 
+def balanced(f, xs):
+    """Combine ``xs`` (at least one) with the binary ``f`` as a balanced tree: pairs first,
+    so depth grows as log2(len(xs))."""
+    xs = list(xs)
+    while len(xs) > 1:
+        nxt = [f(xs[i], xs[i + 1]) for i in range(0, len(xs) - 1, 2)]
+        if len(xs) % 2:
+            nxt.append(xs[-1])
+        xs = nxt
+    return xs[0]
+
+
 class AIG:
     """A structurally hashed AIG.
 
@@ -152,29 +164,14 @@ class AIG:
 
     def and_many(self, lits: Sequence[int]) -> int:
         """Balanced AND of several literals."""
-        lits = list(lits)
-        if not lits:
-            return TRUE
-        while len(lits) > 1:
-            nxt = [self.and_(lits[i], lits[i + 1]) for i in range(0, len(lits) - 1, 2)]
-            if len(lits) % 2:
-                nxt.append(lits[-1])
-            lits = nxt
-        return lits[0]
+        return balanced(self.and_, lits) if lits else TRUE
 
     def or_many(self, lits: Sequence[int]) -> int:
         return self.and_many([x ^ 1 for x in lits]) ^ 1
 
     def xor_many(self, lits: Sequence[int]) -> int:
-        lits = list(lits)
-        if not lits:
-            return FALSE
-        while len(lits) > 1:
-            nxt = [self.xor_(lits[i], lits[i + 1]) for i in range(0, len(lits) - 1, 2)]
-            if len(lits) % 2:
-                nxt.append(lits[-1])
-            lits = nxt
-        return lits[0]
+        """Balanced XOR of several literals."""
+        return balanced(self.xor_, lits) if lits else FALSE
 
     # ---------------------------------------------------------------- invariants
     def check(self) -> None:

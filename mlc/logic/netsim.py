@@ -9,6 +9,7 @@ from __future__ import annotations
 
 from mlc.errors import InternalError, MlcError
 from mlc.front.spec import NetworkSpec
+from mlc.logic.aig import balanced
 
 
 def input_map(spec: NetworkSpec) -> dict[int, int]:
@@ -34,23 +35,6 @@ def input_map(spec: NetworkSpec) -> dict[int, int]:
     for k, i in zip(pending, free):
         res[k] = i
     return res
-
-
-def _fold(alg, f, xs):
-    acc = xs[0]
-    for x in xs[1:]:
-        acc = f(acc, x)
-    return acc
-
-
-def _balanced(f, xs):
-    xs = list(xs)
-    while len(xs) > 1:
-        nxt = [f(xs[i], xs[i + 1]) for i in range(0, len(xs) - 1, 2)]
-        if len(xs) % 2:
-            nxt.append(xs[-1])
-        xs = nxt
-    return xs[0]
 
 
 def majority(alg, xs):
@@ -88,15 +72,15 @@ def eval_network(spec: NetworkSpec, alg) -> list:
         elif op == "not":
             v = alg.not_(a[0])
         elif op in ("and", "nand"):
-            v = _balanced(alg.and_, a) if a else alg.const(True)
+            v = balanced(alg.and_, a) if a else alg.const(True)
             if op == "nand":
                 v = alg.not_(v)
         elif op in ("or", "nor"):
-            v = _balanced(alg.or_, a) if a else alg.const(False)
+            v = balanced(alg.or_, a) if a else alg.const(False)
             if op == "nor":
                 v = alg.not_(v)
         elif op in ("xor", "xnor"):
-            v = _balanced(alg.xor_, a) if a else alg.const(False)
+            v = balanced(alg.xor_, a) if a else alg.const(False)
             if op == "xnor":
                 v = alg.not_(v)
         elif op == "implies":
@@ -123,8 +107,8 @@ def eval_network(spec: NetworkSpec, alg) -> list:
                         lits.append(x)
                     elif c == "0":
                         lits.append(alg.not_(x))
-                terms.append(_balanced(alg.and_, lits) if lits else alg.const(True))
-            v = _balanced(alg.or_, terms) if terms else alg.const(False)
+                terms.append(balanced(alg.and_, lits) if lits else alg.const(True))
+            v = balanced(alg.or_, terms) if terms else alg.const(False)
             if cover and cover[0][1] == "0":
                 v = alg.not_(v)
         else:
