@@ -116,19 +116,13 @@ class AIG:
         self.output_lits.append(lit)
 
     def and_(self, a: int, b: int) -> int:
-        if a > b:
-            a, b = b, a
-        if a == 0:
-            return 0
-        if a == 1:
-            return b
-        if a == b:
-            return a
-        if a ^ b == 1:
-            return 0
-        r = self._hash.get((a, b))
+        """AND of two literals: folded or structurally hashed by :meth:`lookup` when
+        possible, otherwise a new node."""
+        r = self.lookup(a, b)
         if r is not None:
             return r
+        if a > b:
+            a, b = b, a
         r = 2 * self.num_nodes
         self.ands.append((a, b))
         self._hash[(a, b)] = r
