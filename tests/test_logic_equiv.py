@@ -1,4 +1,5 @@
-"""Equivalence checking: exhaustive, BDD, don't cares, and mismatches caught."""
+"""Equivalence checking: exhaustive, SAT (see also test_logic_cec.py), BDD, don't cares,
+and mismatches caught."""
 import pytest
 
 from mlc.errors import InternalError
@@ -94,12 +95,24 @@ def _wide_parity(n):
     return NetworkSpec(ins, ["p", "a"], nodes, [n, n + 1])
 
 
-def test_wide_uses_bdd_and_catches_mismatch():
+def test_wide_network_uses_sat_and_catches_mismatch():
     spec = _wide_parity(20)
     g = from_spec(spec)
     r = check_equivalent(g, spec)
-    assert r["method"] == "bdd"
+    assert r["method"] == "sat"
     bad = g.copy()
     bad.output_lits[1] = 0               # constant 0 instead of the 20-input AND:
     with pytest.raises(InternalError, match="output a"):   # differs on one minterm only
+        check_equivalent(bad, spec)
+
+
+def test_wide_table_uses_bdd():
+    n = 17
+    x0, x1, x16 = T.var(n, 0), T.var(n, 1), T.var(n, 16)
+    spec = TableSpec([f"x{i}" for i in range(n)], ["f"], [(x0 & x1) | x16], [0])
+    g = from_spec(spec)
+    assert check_equivalent(g, spec)["method"] == "bdd"
+    bad = g.copy()
+    bad.output_lits[0] ^= 1
+    with pytest.raises(InternalError, match="output f"):
         check_equivalent(bad, spec)

@@ -43,10 +43,8 @@ def test_canon_and_build_random():
 
 
 def test_sat_proves_small_minima():
-    """With python-sat installed (optional): the exact engine proves the full adder
-    (7) and majority-3 (4) minimal and its circuits simulate correctly."""
-    import pytest
-    pytest.importorskip("pysat")
+    """The exact engine proves the full adder (7) and majority-3 (4) minimal and its
+    circuits simulate correctly."""
     from mlc.logic import exactsat, library
     for spec, k in ((library.full_adder(), 7), (library.majority(3), 4)):
         full = T.mask(spec.n)

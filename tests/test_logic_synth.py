@@ -78,7 +78,7 @@ def test_network_spec_synthesis_shares_logic():
     assert g.num_ands() == 7
 
 
-def test_wide_network_synthesis_proven_by_bdd():
+def test_wide_network_synthesis_proven_by_sat():
     n = 18
     ins = [f"x{i}" for i in range(n)]
     nodes = [Node("input", name=x) for x in ins] + [Node("xor", tuple(range(n))),
@@ -86,7 +86,7 @@ def test_wide_network_synthesis_proven_by_bdd():
     spec = NetworkSpec(ins, ["p", "o"], nodes, [n, n + 1])
     st_: dict = {}
     g = synthesize(spec, stats=st_)
-    assert st_["equivalence"]["method"] == "bdd"
+    assert st_["equivalence"]["method"] == "sat"
     assert g.num_ands() == 3 * (n - 1) + n // 2 - 1
 
 
@@ -131,7 +131,7 @@ def test_wide_adder_network_windowed_resub():
     spec = NetworkSpec(ins, [f"s{i}" for i in range(w + 1)], nodes, outs)
     st_: dict = {}
     g = synthesize(spec, stats=st_)
-    assert st_["equivalence"]["method"] == "bdd"
+    assert st_["equivalence"]["method"] == "sat"
     assert g.num_ands() == 80
 
 

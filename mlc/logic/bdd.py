@@ -24,7 +24,7 @@ class BDD:
             r = len(self.nodes)
             if r >= self.max_nodes:
                 raise MlcError(f"BDD exceeds {self.max_nodes} nodes during the equivalence check",
-                               fix="the function is too large to prove equivalent by BDD")
+                               fix="the function is too large to prove equivalent (SAT sweeping and BDD both exceeded their limits)")
             self.nodes.append(key)
             self.unique[key] = r
         return r

@@ -1,7 +1,6 @@
-"""Exact multi-output resynthesis of small functions by SAT (effort 3 only, optional).
+"""Exact multi-output resynthesis of small functions by SAT (effort 3 only).
 
-Used only when ``python-sat`` is importable (it is not a runtime dependency of mlc):
-starting from the best heuristic network with ``k`` ANDs, ask the SAT solver for a
+Starting from the best heuristic network with ``k`` ANDs, ask the SAT solver for a
 ``k-1`` circuit, then ``k-2`` ..., each call under a time limit, and keep the last
 success.  When an UNSAT answer stops the descent, the result is a proven minimum.
 """

@@ -1,9 +1,8 @@
 """SAT-based exact synthesis of minimum-AND multi-output AIGs (inversions free).
 
-Used offline: to generate the shipped NPN table (``scripts`` in
-:mod:`mlc.logic.gen_npn_table`), by the benchmark (proven minima) and by the tests.
-It needs ``python-sat`` (``pip install python-sat``), imported lazily; nothing in the
-runtime compile path requires it (see :func:`available`).
+Used at -O3 (:mod:`mlc.logic.exact_multi`), to generate the shipped NPN table
+(:mod:`mlc.logic.gen_npn_table`), by the benchmark (proven minima) and by the tests.
+``python-sat`` is imported lazily (:func:`available`).
 
 Encoding (after Kojevnikov, Kulikov and Yaroslavtsev; Knuth TAOCP 7.1.2): ``k`` gates,
 each a *normal* AND-class two-input operator (value 0 on (0,0): a&b, a&!b, !a&b, a|b),

@@ -1,11 +1,12 @@
 """Standard small functions as :class:`~mlc.front.spec.TableSpec`: the synthesis
-benchmark's suite (benchmarks/synthesis.py) and the tests' reference functions."""
+benchmark's suite (benchmarks/synthesis.py) and the tests' reference functions;
+wide arithmetic as :class:`~mlc.front.spec.NetworkSpec` (:func:`array_multiplier`)."""
 from __future__ import annotations
 
 import random
 from collections.abc import Callable
 
-from mlc.front.spec import TableSpec
+from mlc.front.spec import NetworkSpec, Node, TableSpec
 
 
 def table(name: str, inputs: list[str], outputs: list[str],
@@ -58,6 +59,44 @@ def multiplier(w: int, v: int | None = None):
     ins = [f"a{i}" for i in range(w)] + [f"b{i}" for i in range(v)]
     outs = [f"p{i}" for i in range(w + v)]
     return table(f"mult{w}x{v}", ins, outs, lambda x: _bits(_num(x[:w]) * _num(x[w:]), w + v))
+
+
+def array_multiplier(w: int, swap: bool = False) -> NetworkSpec:
+    """A ``w`` x ``w``-bit unsigned array multiplier as a network (ripple-carry rows of
+    full adders over the partial products ``a_i & b_j``), inputs ``a0.. b0..``,
+    outputs ``p0 .. p(2w-1)``.  ``swap`` builds the same function with the operands'
+    roles exchanged (``b * a``): a structurally different network, hard to prove
+    equivalent to the unswapped one."""
+    if w < 2:
+        raise ValueError("array_multiplier needs w >= 2")
+    ins = [f"a{i}" for i in range(w)] + [f"b{i}" for i in range(w)]
+    nodes = [Node("input", name=x) for x in ins]
+    x, y = (range(w, 2 * w), range(w)) if swap else (range(w), range(w, 2 * w))
+    x, y = list(x), list(y)
+
+    def add(op: str, *args: int) -> int:
+        nodes.append(Node(op, args))
+        return len(nodes) - 1
+
+    rows = [[add("and", x[i], y[j]) for i in range(w)] for j in range(w)]
+    outs = [rows[0][0]]
+    acc = rows[0][1:]                      # running sum, bit 1 upwards
+    for j in range(1, w):
+        carry, new = None, []
+        for i in range(w):
+            s_in = acc[i] if i < len(acc) else None
+            terms = [t for t in (s_in, rows[j][i], carry) if t is not None]
+            if len(terms) == 1:
+                new.append(terms[0])
+                continue
+            new.append(add("xor", *terms))
+            carry = add("maj" if len(terms) == 3 else "and", *terms)
+        new.append(carry)
+        outs.append(new[0])
+        acc = new[1:]
+    outs += acc
+    return NetworkSpec(ins, [f"p{k}" for k in range(2 * w)], nodes, outs,
+                       source=f"array_multiplier({w})")
 
 
 SEG = {0: "abcdef", 1: "bc", 2: "abdeg", 3: "abcdg", 4: "bcfg", 5: "acdfg", 6: "acdefg",
