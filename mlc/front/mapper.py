@@ -9,7 +9,8 @@ of library gates.
   ``pout = 0`` and the consumers that want it inverted get it in their input levers.
   When ``v`` drives primary outputs, ``pout`` follows the majority of those outputs
   (ties: the rule above), because an output has no lever of its own: an output whose
-  edge complement differs from ``pout`` gets an inverting connector half unit.  The
+  edge complement differs from ``pout`` gets an inverting connector half unit (an
+  exact NOT, :mod:`mlc.gates.connector`).  The
   same holds for an output that is a complemented primary input (``f = !a``).  Gate
   inputs never need a half unit: their levers absorb any inversion.
 * Primary inputs are muscles of the chosen convention (``signal``: expand or contract);
