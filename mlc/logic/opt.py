@@ -689,26 +689,49 @@ def refactor(g: AIG, max_leaves: int = 8, zero_gain: bool = False,
 
 
 # ----------------------------------------------------------------------------- balance
+class _Rebuild:
+    """A new AIG over ``g``'s inputs, built node by node with the level of every new
+    node tracked (for the balancing passes): ``m[x]`` is the new literal of old node ``x``."""
+
+    def __init__(self, g: AIG):
+        self.g = g
+        self.n = g.num_inputs
+        self.h = AIG(g.inputs)
+        self.m = [0] * g.num_nodes
+        for i in range(1, self.n + 1):
+            self.m[i] = 2 * i
+        self.lev: dict[int, int] = {}
+
+    def level(self, lit: int) -> int:
+        return self.lev.get(lit >> 1, 0)
+
+    def lit(self, old: int) -> int:
+        """The new literal of an old literal."""
+        return self.m[old >> 1] ^ (old & 1)
+
+    def _new(self, r: int, depth: int) -> int:
+        if (r >> 1) not in self.lev and (r >> 1) > self.n:
+            self.lev[r >> 1] = depth
+        return r
+
+    def and_(self, a: int, b: int) -> int:
+        return self._new(self.h.and_(a, b), 1 + max(self.level(a), self.level(b)))
+
+    def xor_(self, a: int, b: int) -> int:
+        return self._new(self.h.xor_(a, b), 2 + max(self.level(a), self.level(b)))
+
+    def finish(self) -> AIG:
+        for name, lit in zip(self.g.outputs, self.g.output_lits):
+            self.h.add_output(name, self.lit(lit))
+        return self.h.cleanup()
+
+
 def balance(g: AIG) -> AIG:
     """AND-tree balancing: collapse single-fanout, uncomplemented AND trees into
     multi-input ANDs and rebuild them pairing the shallowest operands first."""
     n = g.num_inputs
     refs = refcounts(g)
-    h = AIG(g.inputs)
-    m = [0] * g.num_nodes
-    for i in range(1, n + 1):
-        m[i] = 2 * i
-    lev_new: dict[int, int] = {}
-
-    def nlev(lit: int) -> int:
-        return lev_new.get(lit >> 1, 0)
-
-    def hand(a: int, b: int) -> int:
-        r = h.and_(a, b)
-        if (r >> 1) not in lev_new and r >> 1 > n:
-            lev_new[r >> 1] = 1 + max(nlev(a), nlev(b))
-        return r
-
+    R = _Rebuild(g)
     for k, (a, b) in enumerate(g.ands):
         x = n + 1 + k
         # collect the super-gate leaves
@@ -720,20 +743,16 @@ def balance(g: AIG) -> AIG:
             if not (lit & 1) and y > n and refs[y] == 1 and len(leaves) + len(stack) < 16:
                 stack.extend(g.ands[y - n - 1])
             else:
-                leaves.append(m[y] ^ (lit & 1))
+                leaves.append(R.lit(lit))
         leaves = list(dict.fromkeys(leaves))
         if any((l ^ 1) in leaves for l in leaves):
-            m[x] = 0
+            R.m[x] = 0
             continue
         while len(leaves) > 1:
-            leaves.sort(key=nlev)
-            a1, a2 = leaves[0], leaves[1]
-            # prefer an existing pair among the shallowest ones
-            leaves = leaves[2:] + [hand(a1, a2)]
-        m[x] = leaves[0] if leaves else 1
-    for name, lit in zip(g.outputs, g.output_lits):
-        h.add_output(name, m[lit >> 1] ^ (lit & 1))
-    return h.cleanup()
+            leaves.sort(key=R.level)
+            leaves = leaves[2:] + [R.and_(leaves[0], leaves[1])]
+        R.m[x] = leaves[0] if leaves else 1
+    return R.finish()
 
 
 def _xor_gadget(g: AIG, x: int):
@@ -771,33 +790,12 @@ def balance_xor(g: AIG) -> AIG:
         r = gad.get(y)
         return r is not None and refs[y] == 2 and refs[r[2]] == 1 and refs[r[3]] == 1
 
-    h = AIG(g.inputs)
-    m = [0] * g.num_nodes
-    for i in range(1, n + 1):
-        m[i] = 2 * i
-    lev: dict[int, int] = {}
-
-    def L(lit: int) -> int:
-        return lev.get(lit >> 1, 0)
-
-    def hx(a: int, b: int) -> int:
-        r = h.xor_(a, b)
-        for lit in (r,):
-            if (lit >> 1) not in lev and (lit >> 1) > n:
-                lev[lit >> 1] = 2 + max(L(a), L(b))
-        return r
-
-    def hand(a: int, b: int) -> int:
-        r = h.and_(a, b)
-        if (r >> 1) not in lev and (r >> 1) > n:
-            lev[r >> 1] = 1 + max(L(a), L(b))
-        return r
-
+    R = _Rebuild(g)
     for k, (a, b) in enumerate(g.ands):
         x = n + 1 + k
         r = gad.get(x)
         if r is None:
-            m[x] = hand(m[a >> 1] ^ (a & 1), m[b >> 1] ^ (b & 1))
+            R.m[x] = R.and_(R.lit(a), R.lit(b))
             continue
         leaves, par = [], 0
         stack = [r[0], r[1]]
@@ -808,20 +806,18 @@ def balance_xor(g: AIG) -> AIG:
                 par ^= lit & 1
                 stack.extend(gad[y][:2])
             else:
-                nl = m[y] ^ (lit & 1)
+                nl = R.lit(lit)
                 par ^= nl & 1
                 leaves.append(nl & ~1)
         if len(leaves) <= 2:
-            m[x] = hand(m[a >> 1] ^ (a & 1), m[b >> 1] ^ (b & 1))
+            R.m[x] = R.and_(R.lit(a), R.lit(b))
             continue
         while len(leaves) > 1:
-            leaves.sort(key=L)
-            leaves = leaves[2:] + [hx(leaves[0], leaves[1])]
+            leaves.sort(key=R.level)
+            leaves = leaves[2:] + [R.xor_(leaves[0], leaves[1])]
         # the gadget's node value is u ^ v (uncomplemented)
-        m[x] = leaves[0] ^ par
-    for name, lit in zip(g.outputs, g.output_lits):
-        h.add_output(name, m[lit >> 1] ^ (lit & 1))
-    return h.cleanup()
+        R.m[x] = leaves[0] ^ par
+    return R.finish()
 
 
 # ----------------------------------------------------------------------------- initial
