@@ -113,22 +113,7 @@ def test_xor_chain_balanced_for_depth():
 def test_wide_adder_network_windowed_resub():
     # 24 inputs: beyond global truth tables; windowed resubstitution still shares the
     # XOR internals with the carries: 3 (half adder) + 11 * 7 (full adders) = 80 ANDs
-    w = 12
-    ins = [f"a{i}" for i in range(w)] + [f"b{i}" for i in range(w)]
-    nodes = [Node("input", name=x) for x in ins]
-    carry, outs = None, []
-    for i in range(w):
-        if carry is None:
-            nodes.append(Node("xor", (i, w + i)))
-            outs.append(len(nodes) - 1)
-            nodes.append(Node("and", (i, w + i)))
-        else:
-            nodes.append(Node("xor", (i, w + i, carry)))
-            outs.append(len(nodes) - 1)
-            nodes.append(Node("maj", (i, w + i, carry)))
-        carry = len(nodes) - 1
-    outs.append(carry)
-    spec = NetworkSpec(ins, [f"s{i}" for i in range(w + 1)], nodes, outs)
+    spec = library.ripple_adder(12)
     st_: dict = {}
     g = synthesize(spec, stats=st_)
     assert st_["equivalence"]["method"] == "sat"

@@ -1,6 +1,7 @@
 """Standard small functions as :class:`~mlc.front.spec.TableSpec`: the synthesis
 benchmark's suite (benchmarks/synthesis.py) and the tests' reference functions;
-wide arithmetic as :class:`~mlc.front.spec.NetworkSpec` (:func:`array_multiplier`)."""
+wide arithmetic as :class:`~mlc.front.spec.NetworkSpec` (:func:`ripple_adder`,
+:func:`array_multiplier`)."""
 from __future__ import annotations
 
 import random
@@ -59,6 +60,28 @@ def multiplier(w: int, v: int | None = None):
     ins = [f"a{i}" for i in range(w)] + [f"b{i}" for i in range(v)]
     outs = [f"p{i}" for i in range(w + v)]
     return table(f"mult{w}x{v}", ins, outs, lambda x: _bits(_num(x[:w]) * _num(x[w:]), w + v))
+
+
+def ripple_adder(w: int) -> NetworkSpec:
+    """A ``w``-bit ripple-carry adder as a network (XOR/MAJ per bit), inputs
+    ``a0.. b0..``, outputs ``s0 .. sw`` (``sw`` the carry out)."""
+    ins = [f"a{i}" for i in range(w)] + [f"b{i}" for i in range(w)]
+    nodes = [Node("input", name=x) for x in ins]
+    carry = None
+    outs = []
+    for i in range(w):
+        a, b = i, w + i
+        if carry is None:
+            nodes.append(Node("xor", (a, b)))
+            outs.append(len(nodes) - 1)
+            nodes.append(Node("and", (a, b)))
+        else:
+            nodes.append(Node("xor", (a, b, carry)))
+            outs.append(len(nodes) - 1)
+            nodes.append(Node("maj", (a, b, carry)))
+        carry = len(nodes) - 1
+    outs.append(carry)
+    return NetworkSpec(ins, [f"s{i}" for i in range(w + 1)], nodes, outs, source=f"ripple_adder({w})")
 
 
 def array_multiplier(w: int, swap: bool = False) -> NetworkSpec:
