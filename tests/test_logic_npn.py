@@ -64,3 +64,52 @@ def test_table_metadata():
     assert sorted(k for k, v in cls.items() if not v["proven"]) == data["unproven"]
     assert sum(v["proven"] for v in cls.values()) >= 171
     assert cls["6996"]["ands"] == 9 and cls["6996"]["proven"]       # parity-4
+
+
+def test_cadical_time_limit_runs_in_a_child():
+    """CaDiCaL cannot be interrupted through python-sat: a time-limited call runs in a
+    child process that is killed at the limit; an easy call still returns its answer."""
+    from mlc.logic import exactsat, library
+    spec = library.full_adder()
+    targets = [(f, T.mask(3)) for f in spec.on]
+    r = exactsat.synthesize_exact(3, targets, 7, time_limit=60, solver="cadical195")
+    assert r not in (None, "timeout")
+    assert exactsat.circuit_tables(3, *r) == list(spec.on)
+    # proving that NPN class 0x0197 needs more than 8 ANDs takes minutes
+    assert exactsat.synthesize_exact(4, [(0x0197, 0xFFFF)], 8, time_limit=0.5,
+                                     solver="cadical195") == "timeout"
+
+
+def test_minimality_of_small_entries_re_proven():
+    """Re-prove, independently of the generator, that every entry of 2 to 6 ANDs
+    cannot be built with one gate fewer (the larger ones take minutes each)."""
+    from mlc.logic import exactsat
+    tab = npn.table()
+    for R in sorted(R for R, e in tab.items() if 2 <= e["ands"] <= 6):
+        k = tab[R]["ands"]
+        assert exactsat.synthesize_exact(4, [(R, 0xFFFF)], k - 1, solver="cadical195") is None, hex(R)
+
+
+def test_fences_and_symmetry_breaking_keep_the_minimum():
+    """Fences partition the search and symmetry breaking keeps one circuit per orbit:
+    on a seeded sample of classes both must still find the stored size and prove one
+    gate fewer infeasible (a wrong constraint would lose solutions or keep none)."""
+    from mlc.logic import exactsat
+    assert exactsat.fences(4) == [(1, 1, 1, 1), (1, 2, 1), (2, 1, 1)]
+    tab = npn.table()
+    pool = sorted(R for R, e in tab.items() if 3 <= e["ands"] <= 5)
+    for R in random.Random(2).sample(pool, 10):
+        k = tab[R]["ands"]
+        hits = []
+        for f in exactsat.fences(k):
+            r = exactsat.synthesize_exact(4, [(R, 0xFFFF)], k, solver="cadical195", fence=f,
+                                          symmetry=True)
+            if r is not None:
+                assert exactsat.circuit_tables(4, *r) == [R]
+                hits.append(f)
+        assert hits, hex(R)
+        assert all(exactsat.synthesize_exact(4, [(R, 0xFFFF)], k - 1, solver="cadical195", fence=f,
+                                             symmetry=True) is None for f in exactsat.fences(k - 1))
+    assert exactsat.symmetric_inputs(4, 0x6996) == [[0, 1, 2, 3]]      # parity-4
+    a, b, c = (T.var(4, i) for i in range(3))
+    assert exactsat.symmetric_inputs(4, (a & b) | c) == [[0, 1]]        # d unused: no link

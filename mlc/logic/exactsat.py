@@ -32,20 +32,42 @@ class _Vars:
         return self.n
 
 
-def _encode(n: int, targets: list[tuple[int, int]], k: int):
-    """CNF for: ``k`` gates over ``n`` inputs realise every (on, care) target."""
+def _encode(n: int, targets: list[tuple[int, int]], k: int, fence: tuple[int, ...] | None = None,
+            symmetric: list[list[int]] | None = None):
+    """CNF for: ``k`` gates over ``n`` inputs realise every (on, care) target.
+
+    ``fence`` (optional, Haaswijk et al.'s topology families) fixes how many gates sit
+    on each logic level 1, 2, ...: a gate on level L takes one fanin from level L-1
+    and the other from any lower level (inputs are level 0).  Every circuit has
+    exactly one fence (its gates' longest-path levels, gates sorted by level), so
+    the fences of ``k`` gates partition the search: a circuit exists iff one
+    fence's instance is satisfiable.
+
+    ``symmetric`` (optional): groups of inputs that the targets' symmetries permute
+    arbitrarily (:func:`symmetric_inputs`).  Relabelling a circuit's inputs by such a
+    symmetry gives another solution with the same gates in the same order, so
+    within a group the inputs may be required to have non-increasing fanout counts
+    (a property of the circuit's graph, independent of the gate order, hence
+    compatible with the ordering constraints below)."""
     V = _Vars()
     clauses: list[list[int]] = []
     T = range(1, 1 << n)
     N = n + k
     # x[i][t] for gates i in n..N-1; inputs are constants
     x = {i: {t: V.new() for t in T} for i in range(n, N)}
+    level = [0] * n
+    if fence is not None:
+        if sum(fence) != k:
+            raise ValueError(f"fence {fence} does not have {k} gates")
+        for lv, cnt in enumerate(fence, 1):
+            level += [lv] * cnt
     sel = {}
     for i in range(n, N):
         sel[i] = {}
         for j in range(i):
             for l in range(j + 1, i):
-                sel[i][(j, l)] = V.new()
+                if fence is None or level[l] == level[i] - 1:
+                    sel[i][(j, l)] = V.new()
     op = {i: (V.new(), V.new(), V.new()) for i in range(n, N)}   # values at (0,1),(1,0),(1,1)
 
     def val(node, t):
@@ -108,9 +130,25 @@ def _encode(n: int, targets: list[tuple[int, int]], k: int):
         users = [s for i2 in range(i + 1, N) for (j, l), s in sel[i2].items() if i in (j, l)]
         users += [os_[i] for _, os_ in outsel]
         clauses.append(users)
-    # consecutive gates not using each other are ordered by their fanin pair
+    # inputs of one symmetric group: fanout counts non-increasing in input order
+    for group in symmetric or []:
+        cnt = {}
+        for p in group:
+            uses = [V.new() for _ in range(n, N)]
+            for u, i in zip(uses, range(n, N)):
+                lits = [v for (j, l), v in sel[i].items() if p in (j, l)]
+                clauses.append([-u] + lits)
+                clauses += [[u, -v] for v in lits]
+            cnt[p] = _unary_count(V, clauses, uses)
+        for p, q in zip(group, group[1:]):
+            for t in range(len(cnt[p])):
+                clauses.append([-cnt[q][t], cnt[p][t]])      # count(q) >= t+1 -> count(p) >= t+1
+    # consecutive gates not using each other are ordered by their fanin pair (with a
+    # fence: only within a level, since swapping across levels leaves the fence)
     for i in range(n, N - 1):
         i2 = i + 1
+        if level[i] != level[i2] if fence is not None else False:
+            continue
         for (j, l), s in sel[i].items():
             for (j2, l2), s2 in sel[i2].items():
                 if i in (j2, l2):
@@ -120,16 +158,85 @@ def _encode(n: int, targets: list[tuple[int, int]], k: int):
     return V, clauses, x, sel, op, outsel
 
 
+def _unary_count(V: _Vars, clauses: list, lits: list[int]) -> list[int]:
+    """Variables ``c[t]`` <-> "at least t+1 of ``lits`` are true" (sequential counter,
+    both directions), t = 0 .. len(lits)-1."""
+    prev: list[int] = []
+    for x in lits:
+        cur = []
+        for t in range(len(prev) + 1):
+            c = V.new()
+            a = prev[t] if t < len(prev) else None        # at least t+1 before x
+            b = prev[t - 1] if t >= 1 else True           # at least t before x
+            # c <-> a | (b & x)
+            if a is not None:
+                clauses.append([c, -a])
+            if b is True:
+                clauses.append([c, -x])
+                clauses.append([-c, x] + ([a] if a is not None else []))
+            else:
+                clauses.append([c, -b, -x])
+                clauses.append([-c, b] + ([a] if a is not None else []))
+                clauses.append([-c, x] + ([a] if a is not None else []))
+            cur.append(c)
+        prev = cur
+    return prev
+
+
+def symmetric_inputs(n: int, f: int) -> list[list[int]]:
+    """Groups of inputs of the completely specified ``f`` that its symmetries permute
+    arbitrarily: inputs p, q are linked when swapping them (with any input negations,
+    and possibly complementing the output) maps ``f`` to itself; the connected
+    components of those transpositions generate every permutation of a component."""
+    from mlc.logic import tt as T
+    full = T.mask(n)
+    parent = list(range(n))
+
+    def find(a):
+        while parent[a] != a:
+            a = parent[a]
+        return a
+
+    for p in range(n):
+        for q in range(p + 1, n):
+            perm = list(range(n))
+            perm[p], perm[q] = q, p
+            for neg in range(1 << n):
+                g = 0
+                for m in range(1 << n):
+                    y = 0
+                    for i in range(n):
+                        y |= (((m >> perm[i]) & 1) ^ ((neg >> i) & 1)) << i
+                    g |= ((f >> y) & 1) << m
+                if g in (f, f ^ full):
+                    parent[find(q)] = find(p)
+                    break
+    groups: dict[int, list[int]] = {}
+    for i in range(n):
+        groups.setdefault(find(i), []).append(i)
+    return [g for g in groups.values() if len(g) > 1]
+
+
 def synthesize_exact(n: int, targets: list[tuple[int, int]], k: int, time_limit: float | None = None,
-                     solver: str = "minisat22"):
+                     solver: str = "minisat22", fence: tuple[int, ...] | None = None,
+                     symmetry: bool = False):
     """A k-gate circuit for ``targets`` or None (UNSAT) or "timeout".
+
+    ``symmetry``: for one completely specified target, break its input symmetries
+    (:func:`symmetric_inputs`).
 
     Returns ``(gates, outs)``: ``gates[g] = (j, l, fj, fl, fo)`` meaning node ``n+g`` is
     ``((node_j ^ fj) & (node_l ^ fl)) ^ fo``; ``outs[h] = (node, complement)``.
     """
     from pysat.solvers import Solver
 
-    V, clauses, x, sel, op, outsel = _encode(n, targets, k)
+    if time_limit is not None and not solver.startswith(("minisat", "glucose", "maple")):
+        # CaDiCaL and Kissat cannot be interrupted through python-sat: run in a child
+        return _in_child(n, targets, k, time_limit, solver, fence, symmetry)
+    sym = None
+    if symmetry and len(targets) == 1 and targets[0][1] == (1 << (1 << n)) - 1:
+        sym = symmetric_inputs(n, targets[0][0])
+    V, clauses, x, sel, op, outsel = _encode(n, targets, k, fence, sym)
     with Solver(name=solver, bootstrap_with=clauses) as s:
         if time_limit is None:
             ok = s.solve()
@@ -166,6 +273,62 @@ def synthesize_exact(n: int, targets: list[tuple[int, int]], k: int, time_limit:
         i = next(i for i, v in os_.items() if v in model)
         outs.append((i, int(cv in model)))
     return gates, outs
+
+
+def _child(conn, n, targets, k, solver, fence, symmetry):
+    conn.send(synthesize_exact(n, targets, k, None, solver, fence, symmetry))
+    conn.close()
+
+
+def _in_child(n, targets, k, time_limit, solver, fence=None, symmetry=False):
+    """:func:`synthesize_exact` in a forked process, killed after ``time_limit`` s."""
+    import multiprocessing as mp
+    ctx = mp.get_context("fork")
+    recv, send = ctx.Pipe(duplex=False)
+    p = ctx.Process(target=_child, args=(send, n, targets, k, solver, fence, symmetry), daemon=True)
+    p.start()
+    send.close()
+    try:
+        if recv.poll(time_limit):
+            return recv.recv()
+        return "timeout"
+    finally:
+        if p.is_alive():
+            p.kill()
+        p.join()
+        recv.close()
+
+
+def fences(k: int, outputs: int = 1):
+    """Every fence of ``k`` gates that a circuit with ``outputs`` outputs, all gates
+    used, can have: the top level holds at most ``outputs`` gates (all outputs), and
+    every other level at most twice as many gates as all higher levels together plus
+    the outputs not on the top level (each gate has a user above it or is an output,
+    and a user takes two fanins)."""
+    res = []
+
+    def rec(rest: int, acc: list[int]):
+        if rest == 0:
+            if acc and acc[-1] <= outputs:
+                res.append(tuple(acc))
+            return
+        for c in range(1, rest + 1):
+            rec(rest - c, acc + [c])
+
+    rec(k, [])
+    ok = []
+    for f in res:
+        spare = outputs - f[-1]          # outputs that may sit below the top level
+        above = f[-1]
+        good = True
+        for lv in range(len(f) - 2, -1, -1):
+            if f[lv] > 2 * above + spare:
+                good = False
+                break
+            above += f[lv]
+        if good:
+            ok.append(f)
+    return ok
 
 
 def minimum_circuit(n: int, targets: list[tuple[int, int]], upper: int | None = None,
