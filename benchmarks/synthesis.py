@@ -30,6 +30,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from mlc.front.spec import TableSpec  # noqa: E402
+from mlc.logic.aigio import write_blif  # noqa: E402
+from mlc.logic.lower import from_spec  # noqa: E402
 from mlc.logic import exactsat, library  # noqa: E402
 from mlc.logic import tt as T  # noqa: E402
 from mlc.logic.synth import synthesize  # noqa: E402
@@ -148,13 +150,16 @@ def scaling(args) -> list[dict]:
                    "meets_goal": None if goal is None else dt < goal,
                    "equivalence": st["equivalence"]["method"],
                    "equivalence_seconds": round(st["equivalence_s"], 3)}
-            if isinstance(spec, TableSpec) and not args.no_abc:
-                r = run_abc(spec_to_blif(spec), f"{COMPRESS2RS}; {COMPRESS2RS}", timeout=600)
+            if not args.no_abc:
+                # tables: the don't-care-minimised SOP; networks: their structural AIG
+                blif = (spec_to_blif(spec) if isinstance(spec, TableSpec)
+                        else write_blif(from_spec(spec)))
+                r = run_abc(blif, f"{COMPRESS2RS}; {COMPRESS2RS}", timeout=600)
                 row["abc_compress2rs"] = r.get("ands")
                 row["abc_seconds"] = r.get("seconds")
             rows.append(row)
             print(f"  scaling {label} -O{effort}: {g.num_ands()} ANDs, depth {g.depth()}, "
-                  f"{dt:.2f}s (goal < {goal}s), equivalence {row['equivalence']} "
+                  f"{dt:.2f}s ({'no goal' if goal is None else f'goal < {goal}s'}), equivalence {row['equivalence']} "
                   f"{row['equivalence_seconds']}s; ABC {row.get('abc_compress2rs')}", flush=True)
     return rows
 
