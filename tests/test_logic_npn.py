@@ -113,3 +113,16 @@ def test_fences_and_symmetry_breaking_keep_the_minimum():
     assert exactsat.symmetric_inputs(4, 0x6996) == [[0, 1, 2, 3]]      # parity-4
     a, b, c = (T.var(4, i) for i in range(3))
     assert exactsat.symmetric_inputs(4, (a & b) | c) == [[0, 1]]        # d unused: no link
+
+
+def test_first_use_symmetry_breaking_on_fully_symmetric_classes():
+    """Fully symmetric classes get the stronger first-use constraint (fences only): it
+    must keep a circuit of the stored size and still refute one gate fewer."""
+    from mlc.logic import exactsat
+    tab = npn.table()
+    for R in (0x0001, 0x0117, 0x0180):
+        assert exactsat.symmetric_inputs(4, R) == [[0, 1, 2, 3]]
+        k = tab[R]["ands"]
+        r = exactsat.synthesize_exact_fenced(4, [(R, 0xFFFF)], k)
+        assert r not in (None, "timeout") and exactsat.circuit_tables(4, *r) == [R]
+        assert exactsat.synthesize_exact_fenced(4, [(R, 0xFFFF)], k - 1) is None

@@ -130,8 +130,21 @@ def _encode(n: int, targets: list[tuple[int, int]], k: int, fence: tuple[int, ..
         users = [s for i2 in range(i + 1, N) for (j, l), s in sel[i2].items() if i in (j, l)]
         users += [os_[i] for _, os_ in outsel]
         clauses.append(users)
-    # inputs of one symmetric group: fanout counts non-increasing in input order
+    # inputs of one symmetric group
+    full_group = fence is not None and symmetric == [list(range(n))]
     for group in symmetric or []:
+        if full_group:
+            # all inputs interchangeable, level-1 gates sorted by fanin pair: the inputs
+            # can be labelled in the order level-1 gates first use them (docs/synthesis.md)
+            lvl1 = [i for i in range(n, N) if level[i] == 1]
+            use = {p: [[v for (j, l), v in sel[i].items() if p in (j, l)] for i in lvl1]
+                   for p in group}
+            for p, q in zip(group, group[1:]):
+                for a in range(len(lvl1)):
+                    for v in use[q][a]:
+                        clauses.append([-v] + [w for b in range(a + 1) for w in use[p][b]])
+            continue
+        # otherwise: fanout counts non-increasing in input order
         cnt = {}
         for p in group:
             uses = [V.new() for _ in range(n, N)]
@@ -329,6 +342,25 @@ def fences(k: int, outputs: int = 1):
         if good:
             ok.append(f)
     return ok
+
+
+def synthesize_exact_fenced(n: int, targets: list[tuple[int, int]], k: int,
+                            time_limit: float | None = None, solver: str = "cadical195",
+                            symmetry: bool = True):
+    """:func:`synthesize_exact` one fence at a time (the fences partition the search):
+    a circuit, None (every fence unsatisfiable) or "timeout" (``time_limit`` seconds
+    in all).  With a single fully symmetric target, fences allow the stronger
+    first-use symmetry breaking (see :func:`_encode`)."""
+    import time
+    deadline = None if time_limit is None else time.monotonic() + time_limit
+    for f in fences(k, len(targets)):
+        left = None if deadline is None else deadline - time.monotonic()
+        if left is not None and left <= 0:
+            return "timeout"
+        r = synthesize_exact(n, targets, k, left, solver, f, symmetry)
+        if r is not None:
+            return r
+    return None
 
 
 def minimum_circuit(n: int, targets: list[tuple[int, int]], upper: int | None = None,

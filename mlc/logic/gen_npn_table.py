@@ -174,8 +174,12 @@ def _prove_one(key: str, seconds: float, solver: str) -> None:
             return
         k = ent["ands"] - 1
         t = time.time()
-        r = exactsat.synthesize_exact(4, [(R, 0xFFFF)], k, time_limit=seconds, solver=solver,
-                                     symmetry=True)
+        if exactsat.symmetric_inputs(4, R) == [[0, 1, 2, 3]]:
+            # fully symmetric: fences admit the stronger first-use symmetry breaking
+            r = exactsat.synthesize_exact_fenced(4, [(R, 0xFFFF)], k, seconds, solver)
+        else:
+            r = exactsat.synthesize_exact(4, [(R, 0xFFFF)], k, time_limit=seconds, solver=solver,
+                                         symmetry=True)
         print(f"prove {key} k={k}: {'timeout' if r == 'timeout' else 'UNSAT' if r is None else 'SAT'}"
               f" {time.time() - t:.0f}s", file=sys.stderr, flush=True)
         if r == "timeout":
