@@ -126,3 +126,20 @@ def test_first_use_symmetry_breaking_on_fully_symmetric_classes():
         r = exactsat.synthesize_exact_fenced(4, [(R, 0xFFFF)], k)
         assert r not in (None, "timeout") and exactsat.circuit_tables(4, *r) == [R]
         assert exactsat.synthesize_exact_fenced(4, [(R, 0xFFFF)], k - 1) is None
+
+
+def test_prover_moves_a_symmetric_group_last_and_maps_back():
+    from mlc.logic import exactsat
+    from mlc.logic.gen_npn_table import _permuted, _suffix_perm, _unpermute
+    tab = npn.table()
+    a, b, c = (T.var(4, i) for i in range(3))
+    for f in ((a & b) | c, 0x0018):
+        R = npn.canon(f)[0]
+        perm = _suffix_perm(R)
+        assert perm is not None
+        Rp = _permuted(R, perm)
+        assert exactsat.suffix_symmetric(4, Rp)
+        k = tab[R]["ands"]
+        r = exactsat.synthesize_exact_fenced(4, [(Rp, 0xFFFF)], k)
+        assert exactsat.circuit_tables(4, *_unpermute(r, perm)) == [R]
+        assert exactsat.synthesize_exact_fenced(4, [(Rp, 0xFFFF)], k - 1) is None

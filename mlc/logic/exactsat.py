@@ -131,11 +131,13 @@ def _encode(n: int, targets: list[tuple[int, int]], k: int, fence: tuple[int, ..
         users += [os_[i] for _, os_ in outsel]
         clauses.append(users)
     # inputs of one symmetric group
-    full_group = fence is not None and symmetric == [list(range(n))]
+    suffix_group = (fence is not None and symmetric is not None and len(symmetric) == 1
+                    and symmetric[0] == list(range(n - len(symmetric[0]), n)))
     for group in symmetric or []:
-        if full_group:
-            # all inputs interchangeable, level-1 gates sorted by fanin pair: the inputs
-            # can be labelled in the order level-1 gates first use them (docs/synthesis.md)
+        if suffix_group:
+            # the last inputs are interchangeable and level-1 gates are sorted by fanin
+            # pair: they can be labelled in the order level-1 gates first use them
+            # (docs/synthesis.md)
             lvl1 = [i for i in range(n, N) if level[i] == 1]
             use = {p: [[v for (j, l), v in sel[i].items() if p in (j, l)] for i in lvl1]
                    for p in group}
@@ -344,13 +346,20 @@ def fences(k: int, outputs: int = 1):
     return ok
 
 
+def suffix_symmetric(n: int, f: int) -> bool:
+    """Does ``f`` have a single group of interchangeable inputs, the last ones?"""
+    g = symmetric_inputs(n, f)
+    return len(g) == 1 and g[0] == list(range(n - len(g[0]), n))
+
+
 def synthesize_exact_fenced(n: int, targets: list[tuple[int, int]], k: int,
                             time_limit: float | None = None, solver: str = "cadical195",
                             symmetry: bool = True):
     """:func:`synthesize_exact` one fence at a time (the fences partition the search):
     a circuit, None (every fence unsatisfiable) or "timeout" (``time_limit`` seconds
-    in all).  With a single fully symmetric target, fences allow the stronger
-    first-use symmetry breaking (see :func:`_encode`)."""
+    in all).  When the target's interchangeable inputs are the last ones
+    (:func:`suffix_symmetric`), fences allow the stronger first-use symmetry breaking
+    (see :func:`_encode`)."""
     import time
     deadline = None if time_limit is None else time.monotonic() + time_limit
     for f in fences(k, len(targets)):

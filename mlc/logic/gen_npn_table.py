@@ -174,9 +174,14 @@ def _prove_one(key: str, seconds: float, solver: str) -> None:
             return
         k = ent["ands"] - 1
         t = time.time()
-        if exactsat.symmetric_inputs(4, R) == [[0, 1, 2, 3]]:
-            # fully symmetric: fences admit the stronger first-use symmetry breaking
-            r = exactsat.synthesize_exact_fenced(4, [(R, 0xFFFF)], k, seconds, solver)
+        perm = _suffix_perm(R)
+        if perm is not None:
+            # interchangeable inputs moved to the end: fences admit the stronger
+            # first-use symmetry breaking; the circuit is mapped back
+            Rp = _permuted(R, perm)
+            r = exactsat.synthesize_exact_fenced(4, [(Rp, 0xFFFF)], k, seconds, solver)
+            if r not in (None, "timeout"):
+                r = _unpermute(r, perm)
         else:
             r = exactsat.synthesize_exact(4, [(R, 0xFFFF)], k, time_limit=seconds, solver=solver,
                                          symmetry=True)
@@ -190,6 +195,36 @@ def _prove_one(key: str, seconds: float, solver: str) -> None:
         else:
             data["classes"][key] = _entry(R, k, r, False)
         _write(data)
+
+
+def _permuted(R: int, perm: list[int]) -> int:
+    """The function g with g(x) = R(y), y[i] = x[perm[i]] (4 inputs)."""
+    g = 0
+    for m in range(16):
+        y = sum(((m >> perm[i]) & 1) << i for i in range(4))
+        g |= ((R >> y) & 1) << m
+    return g
+
+
+def _suffix_perm(R: int) -> list[int] | None:
+    """An input permutation after which R's single group of interchangeable inputs
+    comes last, or None (no group, or several)."""
+    groups = exactsat.symmetric_inputs(4, R)
+    if len(groups) != 1:
+        return None
+    rest = [i for i in range(4) if i not in groups[0]]
+    perm = rest + groups[0]          # new input position p reads old input perm[p]...
+    inv = [perm.index(i) for i in range(4)]
+    return inv if exactsat.suffix_symmetric(4, _permuted(R, inv)) else None
+
+
+def _unpermute(circ, perm):
+    """A circuit for _permuted(R, perm), rewired into one for R."""
+    gates, outs = circ
+    m = {q: perm.index(q) for q in range(4)}   # input q of the permuted function is fed by R's input perm^-1[q]
+    gates = [((m.get(j, j)), m.get(l, l), fj, fl, fo) for j, l, fj, fl, fo in gates]
+    gates = [(j, l, fj, fl, fo) if j < l or l >= 4 else (l, j, fl, fj, fo) for j, l, fj, fl, fo in gates]
+    return gates, outs
 
 
 def _write(data: dict) -> None:
