@@ -93,7 +93,8 @@ class _Sat:
 
     def satisfiable(self, lits: list[int], budget: int | None):
         """Is the conjunction of AIG literals ``lits`` satisfiable?  True / False / None
-        (budget exceeded).  A fresh activation variable keeps the query retractable."""
+        (budget exceeded).  The literals are assumptions, so the query leaves the
+        solver's clauses unchanged."""
         if budget is None:
             return self.s.solve(assumptions=[self.lit(x) for x in lits])
         self.s.conf_budget(budget)
@@ -136,6 +137,7 @@ def check(impl: AIG, spec, seed: int = 1, max_conflicts: int = MAX_CONFLICTS,
         if any(r is not None for r in res):
             return res
         merged: set[int] = set()
+        skipped: set[int] = set()       # over budget once: not retried
         for rnd in range(MAX_ROUNDS):
             st["rounds"] = rnd + 1
             full = (1 << width) - 1
@@ -143,7 +145,7 @@ def check(impl: AIG, spec, seed: int = 1, max_conflicts: int = MAX_CONFLICTS,
             reps: dict[int, int] = {0: 0}
             cexs: list[int] = []
             for v in range(n + 1, m.num_nodes):
-                if not live[v] or v in merged:
+                if not live[v] or v in merged or v in skipped:
                     continue
                 s = sig[v]
                 phase = s & 1
@@ -171,10 +173,11 @@ def check(impl: AIG, spec, seed: int = 1, max_conflicts: int = MAX_CONFLICTS,
                 elif verdict is False:
                     st["disproved"] += 1
                 else:
+                    skipped.add(v)
                     st["skipped"] += 1
             if not cexs:
                 break
-            # refine: the counterexamples become new patterns (plus fresh random ones)
+            # refine: the counterexamples become new patterns
             extra = len(cexs)
             for i in range(n):
                 bits = sum(((c >> i) & 1) << j for j, c in enumerate(cexs))
