@@ -234,11 +234,12 @@ def symmetric_inputs(n: int, f: int) -> list[list[int]]:
 
 def synthesize_exact(n: int, targets: list[tuple[int, int]], k: int, time_limit: float | None = None,
                      solver: str = "minisat22", fence: tuple[int, ...] | None = None,
-                     symmetry: bool = False):
+                     symmetry: bool | list[list[int]] = False):
     """A k-gate circuit for ``targets`` or None (UNSAT) or "timeout".
 
-    ``symmetry``: for one completely specified target, break its input symmetries
-    (:func:`symmetric_inputs`).
+    ``symmetry``: True breaks the input symmetries of one completely specified
+    target (:func:`symmetric_inputs`); a list gives the groups of interchangeable
+    inputs to break (any subset of the true ones is sound).
 
     Returns ``(gates, outs)``: ``gates[g] = (j, l, fj, fl, fo)`` meaning node ``n+g`` is
     ``((node_j ^ fj) & (node_l ^ fl)) ^ fo``; ``outs[h] = (node, complement)``.
@@ -249,7 +250,9 @@ def synthesize_exact(n: int, targets: list[tuple[int, int]], k: int, time_limit:
         # CaDiCaL and Kissat cannot be interrupted through python-sat: run in a child
         return _in_child(n, targets, k, time_limit, solver, fence, symmetry)
     sym = None
-    if symmetry and len(targets) == 1 and targets[0][1] == (1 << (1 << n)) - 1:
+    if isinstance(symmetry, list):
+        sym = symmetry
+    elif symmetry and len(targets) == 1 and targets[0][1] == (1 << (1 << n)) - 1:
         sym = symmetric_inputs(n, targets[0][0])
     V, clauses, x, sel, op, outsel = _encode(n, targets, k, fence, sym)
     with Solver(name=solver, bootstrap_with=clauses) as s:
@@ -354,7 +357,7 @@ def suffix_symmetric(n: int, f: int) -> bool:
 
 def synthesize_exact_fenced(n: int, targets: list[tuple[int, int]], k: int,
                             time_limit: float | None = None, solver: str = "cadical195",
-                            symmetry: bool = True):
+                            symmetry: bool | list[list[int]] = True):
     """:func:`synthesize_exact` one fence at a time (the fences partition the search):
     a circuit, None (every fence unsatisfiable) or "timeout" (``time_limit`` seconds
     in all).  When the target's interchangeable inputs are the last ones

@@ -176,10 +176,12 @@ def _prove_one(key: str, seconds: float, solver: str) -> None:
         t = time.time()
         perm = _suffix_perm(R)
         if perm is not None:
-            # interchangeable inputs moved to the end: fences admit the stronger
-            # first-use symmetry breaking; the circuit is mapped back
+            # the largest group of interchangeable inputs moved to the end: fences admit
+            # the stronger first-use symmetry breaking; the circuit is mapped back
             Rp = _permuted(R, perm)
-            r = exactsat.synthesize_exact_fenced(4, [(Rp, 0xFFFF)], k, seconds, solver)
+            size = max(len(g) for g in exactsat.symmetric_inputs(4, R))
+            r = exactsat.synthesize_exact_fenced(4, [(Rp, 0xFFFF)], k, seconds, solver,
+                                                 [list(range(4 - size, 4))])
             if r not in (None, "timeout"):
                 r = _unpermute(r, perm)
         else:
@@ -207,15 +209,18 @@ def _permuted(R: int, perm: list[int]) -> int:
 
 
 def _suffix_perm(R: int) -> list[int] | None:
-    """An input permutation after which R's single group of interchangeable inputs
-    comes last, or None (no group, or several)."""
+    """An input permutation after which R's largest group of interchangeable inputs
+    comes last, or None (no group)."""
     groups = exactsat.symmetric_inputs(4, R)
-    if len(groups) != 1:
+    if not groups:
         return None
-    rest = [i for i in range(4) if i not in groups[0]]
-    perm = rest + groups[0]          # new input position p reads old input perm[p]...
+    big = max(groups, key=len)
+    perm = [i for i in range(4) if i not in big] + big   # new input p reads old input perm[p]
     inv = [perm.index(i) for i in range(4)]
-    return inv if exactsat.suffix_symmetric(4, _permuted(R, inv)) else None
+    Rp = _permuted(R, inv)
+    if list(range(4 - len(big), 4)) not in exactsat.symmetric_inputs(4, Rp):
+        raise AssertionError(f"moving {big} last failed for {R:04x}")
+    return inv
 
 
 def _unpermute(circ, perm):
