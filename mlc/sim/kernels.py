@@ -260,9 +260,11 @@ def _eval_py(pos, quat, t, site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_r
             rest = rest + uval[sp_inp[m]] * (sp_rest1[m] - rest)
         tol = sp_tol[m]
         k = sp_k[m]
+        bd = sp_bound[m]
         if rest == 0.0 and tol == 0.0:
             c = k
-            e = math.sqrt(dx * dx + dy * dy + dz * dz)
+            # stretch ratio squared (no sqrt on the hot path); mon[0] takes the root
+            ratio[m] = (dx * dx + dy * dy + dz * dz) / (bd * bd)
         else:
             dist = math.sqrt(dx * dx + dy * dy + dz * dz)
             dev = dist - rest
@@ -273,10 +275,10 @@ def _eval_py(pos, quat, t, site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_r
                     c = -c
             else:
                 c = 0.0
+            ratio[m] = e * abs(e) / (bd * bd)        # signed square of e / bound
         fsp[m, 0] = c * dx
         fsp[m, 1] = c * dy
         fsp[m, 2] = c * dz
-        ratio[m] = e / sp_bound[m]
     # gather per body, then WCA through the Verlet list (or the cell list if it overflowed)
     nlok = True
     if wca_eps > 0.0:
@@ -395,7 +397,7 @@ def _eval_py(pos, quat, t, site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_r
         if dmin[b] < md:
             md = dmin[b]
             ma = b
-    mon[0] = mr
+    mon[0] = math.sqrt(mr) if mr >= 0.0 else (-math.sqrt(-mr) if mr > -np.inf else mr)
     mon[1] = mi
     mon[2] = md
     mon[3] = ma
@@ -577,9 +579,9 @@ def _euler_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_noi
             quat[b, 1] = q1
             quat[b, 2] = q2
             quat[b, 3] = q3
-            dd = math.sqrt(dx * dx + dy * dy + dz * dz)
-            dw = math.sqrt(wx * wx + wy * wy + wz * wz)
-            disp[b] = max(dd / max_disp, dw / max_rot)
+            # squared displacement ratios: <= 1 exactly when the ratios are
+            disp[b] = max((dx * dx + dy * dy + dz * dz) / (max_disp * max_disp),
+                          (wx * wx + wy * wy + wz * wz) / (max_rot * max_rot))
         worst = 0.0
         wb = -1
         for b in range(N):
