@@ -134,7 +134,7 @@ def format_summary(d: dict) -> str:
         lines.append("constant outputs: " + ", ".join(f"{k} = {v}" for k, v in d["const_outputs"].items()))
     if d["input_outputs"]:
         lines.append("outputs wired to an input: " + ", ".join(f"{k} = {v}" for k, v in d["input_outputs"].items()))
-    lines.append(f"equivalence proven ({d['equivalence_method']}) in {d['seconds']} s")
+    lines.append(f"equivalence proven ({d['equivalence_method']}); compiled in {d['seconds']} s")
     lines.append("wrote " + ", ".join(d["files"]))
     return "\n".join(lines)
 
