@@ -214,13 +214,13 @@ def _suffix_perm(R: int) -> list[int] | None:
     groups = exactsat.symmetric_inputs(4, R)
     if not groups:
         return None
+    from mlc.errors import InternalError
     big = max(groups, key=len)
-    perm = [i for i in range(4) if i not in big] + big   # new input p reads old input perm[p]
-    inv = [perm.index(i) for i in range(4)]
-    Rp = _permuted(R, inv)
-    if list(range(4 - len(big), 4)) not in exactsat.symmetric_inputs(4, Rp):
-        raise AssertionError(f"moving {big} last failed for {R:04x}")
-    return inv
+    order = [i for i in range(4) if i not in big] + big   # R's inputs, the group last
+    perm = [order.index(i) for i in range(4)]
+    if list(range(4 - len(big), 4)) not in exactsat.symmetric_inputs(4, _permuted(R, perm)):
+        raise InternalError(f"gen_npn_table: moving inputs {big} last failed for {R:04x}")
+    return perm
 
 
 def _unpermute(circ, perm):
