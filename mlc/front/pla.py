@@ -39,12 +39,10 @@ from __future__ import annotations
 import re
 
 from mlc.errors import Loc, MlcError
+from mlc.front.lines import DIRECTIVE_RE, content_lines, tokens
 from mlc.front.load import MAX_TABLE_INPUTS, cube_mask, full_mask, lowest_minterm, minterm_str
 from mlc.front.spec import TableSpec
 
-COMMENT_RE = re.compile(r"#.*$")
-KEYWORD_RE = re.compile(r"\.([A-Za-z_]+)")
-TOKEN_RE = re.compile(r"\S+")
 INT_RE = re.compile(r"[0-9]+")
 NAME_RE = re.compile(r"[^\s|#]+")
 IN_CHARS = frozenset("01-")
@@ -55,12 +53,8 @@ UNSUPPORTED = {"mv", "phase", "pair", "symbolic", "symbolic-output", "kiss", "la
 ENUMERATE_LIMIT = 8      # cubes with at most this many '-' are enumerated minterm by minterm
 
 
-def _tokens(line: str, start: int):
-    return [(m.start() + 1, m.group()) for m in TOKEN_RE.finditer(line, start)]
-
-
 def _int_arg(filename, lineno, line, start, word):
-    toks = _tokens(line, start)
+    toks = tokens(line, start)
     if len(toks) != 1 or not INT_RE.fullmatch(toks[0][1]):
         col = toks[0][0] if toks else len(line) + 1
         raise MlcError(f".{word} takes one non-negative integer", Loc(filename, lineno, col))
@@ -76,14 +70,9 @@ def parse(text: str, filename: str = "<input>") -> TableSpec:
     p_count = None
     ptype = "fd"
     cubes: list[tuple[int, str, str, list[int]]] = []     # (line, inputs, outputs, output columns)
-    for lineno, raw in enumerate(text.splitlines(), 1):
-        line = COMMENT_RE.sub("", raw).rstrip()
-        if not line.strip():
-            continue
-        stripped = line.lstrip()
-        indent = len(line) - len(stripped)
+    for lineno, line, stripped, indent in content_lines(text):
         where = Loc(filename, lineno, indent + 1)
-        k = KEYWORD_RE.match(stripped)
+        k = DIRECTIVE_RE.match(stripped)
         if k:
             word = k.group(1)
             rest = indent + k.end()
@@ -106,7 +95,7 @@ def parse(text: str, filename: str = "<input>") -> TableSpec:
                 if m == 0:
                     raise MlcError(".o must be at least 1", where)
             elif word in ("ilb", "ob"):
-                toks = _tokens(line, rest)
+                toks = tokens(line, rest)
                 count = n if word == "ilb" else m
                 if count is None:
                     raise MlcError(f".{word} before .{'i' if word == 'ilb' else 'o'}", where)
@@ -127,7 +116,7 @@ def parse(text: str, filename: str = "<input>") -> TableSpec:
             elif word == "p":
                 p_count = _int_arg(filename, lineno, line, rest, word)
             elif word == "type":
-                toks = _tokens(line, rest)
+                toks = tokens(line, rest)
                 if len(toks) != 1 or toks[0][1] not in TYPES:
                     col = toks[0][0] if toks else len(line) + 1
                     raise MlcError(".type must be f, fd, fr or fdr", Loc(filename, lineno, col))

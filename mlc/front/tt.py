@@ -31,24 +31,17 @@ from __future__ import annotations
 import re
 
 from mlc.errors import Loc, MlcError
+from mlc.front.lines import DIRECTIVE_RE, content_lines, tokens
 from mlc.front.load import MAX_TABLE_INPUTS, cube_mask, full_mask, lowest_minterm, minterm_str
 from mlc.front.spec import TableSpec
 
 NAME_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_.]*(?:\[[0-9]+\])?")
-COMMENT_RE = re.compile(r"#.*$")
-DIRECTIVE_RE = re.compile(r"\.([A-Za-z_]+)")
-TOKEN_RE = re.compile(r"\S+")
 BIT_CHARS = frozenset("01-")
-
-
-def _tokens(line: str, start: int):
-    """(column, token) pairs of the blank-separated tokens of ``line`` from index ``start``."""
-    return [(m.start() + 1, m.group()) for m in TOKEN_RE.finditer(line, start)]
 
 
 def _names(filename, lineno, line, start, what, seen, allow_empty):
     names, cols = [], []
-    for col, tok in _tokens(line, start):
+    for col, tok in tokens(line, start):
         if not NAME_RE.fullmatch(tok):
             raise MlcError(f"invalid {what} name {tok!r}", Loc(filename, lineno, col),
                            "names are letters, digits, _ and . starting with a letter or _, optionally with an index like a[3]")
@@ -102,12 +95,7 @@ def parse(text: str, filename: str = "<input>", strict: bool = False) -> TableSp
     full_rows: dict[int, tuple[int, str, list[int]]] = {}   # minterm -> (line, outputs, cols)
     dup_rows: list[tuple[int, int, str, list[int]]] = []    # further rows of an already listed minterm
     cube_rows: list[tuple[int, str, str, list[int]]] = []   # (line, input cube, outputs, cols)
-    for lineno, raw in enumerate(text.splitlines(), 1):
-        line = COMMENT_RE.sub("", raw).rstrip()
-        if not line.strip():
-            continue
-        stripped = line.lstrip()
-        indent = len(line) - len(stripped)
+    for lineno, line, stripped, indent in content_lines(text):
         d = DIRECTIVE_RE.match(stripped)
         if d:
             word = d.group(1)
@@ -127,7 +115,7 @@ def parse(text: str, filename: str = "<input>", strict: bool = False) -> TableSp
                     raise MlcError(f"second .outputs line (the first is line {out_line})", where)
                 (outputs, out_cols), out_line = _names(filename, lineno, line, rest, "output", seen, False), lineno
             elif word == "unlisted":
-                toks = _tokens(line, rest)
+                toks = tokens(line, rest)
                 if len(toks) != 1 or toks[0][1] not in ("dc", "0", "1"):
                     col = toks[0][0] if toks else len(line) + 1
                     raise MlcError(".unlisted takes one value: dc, 0 or 1", Loc(filename, lineno, col))
