@@ -81,6 +81,33 @@ def _expr_nodes(e, acc: list[int]) -> list[int]:
     return acc
 
 
+def _fanin_nodes(g: AIG, x: int) -> tuple[int, int]:
+    a, b = g.ands[x - g.num_inputs - 1]
+    return a >> 1, b >> 1
+
+
+def _postorder(roots, deps, done, rng: random.Random | None = None):
+    """Yield the nodes reachable from ``roots`` that are not in ``done``, each after
+    its dependencies (``deps(x)``); the caller adds every yielded node to ``done``
+    before asking for the next.  With ``rng``, two pending dependencies are visited
+    in random order."""
+    for root in roots:
+        stack = [root]
+        while stack:
+            x = stack[-1]
+            if x in done:
+                stack.pop()
+                continue
+            pend = [y for y in deps(x) if y not in done]
+            if rng is not None and len(pend) == 2 and rng.random() < 0.5:
+                pend.reverse()
+            if pend:
+                stack.extend(pend)
+                continue
+            stack.pop()
+            yield x
+
+
 def rebuild(g: AIG, repl: dict[int, tuple]) -> AIG:
     """Copy ``g`` replacing node ``x`` by the expression ``repl[x]``.
 
@@ -105,24 +132,13 @@ def rebuild(g: AIG, repl: dict[int, tuple]) -> AIG:
         _, e1, e2, c = e
         return h.and_(ev(e1), ev(e2)) ^ c
 
-    for lit in g.output_lits:
-        stack = [lit >> 1]
-        while stack:
-            x = stack[-1]
-            if x in m:
-                stack.pop()
-                continue
-            pend = [y for y in deps(x) if y not in m]
-            if pend:
-                stack.extend(pend)
-                continue
-            stack.pop()
-            r = repl.get(x)
-            if r is not None:
-                m[x] = ev(r)
-            else:
-                a, b = g.ands[x - n - 1]
-                m[x] = h.and_(m[a >> 1] ^ (a & 1), m[b >> 1] ^ (b & 1))
+    for x in _postorder([lit >> 1 for lit in g.output_lits], deps, m):
+        r = repl.get(x)
+        if r is not None:
+            m[x] = ev(r)
+        else:
+            a, b = g.ands[x - n - 1]
+            m[x] = h.and_(m[a >> 1] ^ (a & 1), m[b >> 1] ^ (b & 1))
     for name, lit in zip(g.outputs, g.output_lits):
         h.add_output(name, m[lit >> 1] ^ (lit & 1))
     return h.cleanup()
@@ -179,23 +195,9 @@ def reorder(g: AIG, rng: random.Random | None = None) -> AIG:
     order = list(range(len(g.outputs)))
     if rng is not None:
         rng.shuffle(order)
-    for o in order:
-        root = g.output_lits[o] >> 1
-        stack = [root]
-        while stack:
-            x = stack[-1]
-            if x in m:
-                stack.pop()
-                continue
-            a, b = g.ands[x - n - 1]
-            pend = [y for y in (a >> 1, b >> 1) if y not in m]
-            if rng is not None and len(pend) == 2 and rng.random() < 0.5:
-                pend.reverse()
-            if pend:
-                stack.extend(pend)
-                continue
-            stack.pop()
-            m[x] = h.and_(m[a >> 1] ^ (a & 1), m[b >> 1] ^ (b & 1))
+    for x in _postorder([g.output_lits[o] >> 1 for o in order], lambda x: _fanin_nodes(g, x), m, rng):
+        a, b = g.ands[x - n - 1]
+        m[x] = h.and_(m[a >> 1] ^ (a & 1), m[b >> 1] ^ (b & 1))
     for name, lit in zip(g.outputs, g.output_lits):
         h.add_output(name, m[lit >> 1] ^ (lit & 1))
     return h
@@ -604,18 +606,8 @@ def cone_table(g: AIG, node: int, leaves: list[int], k: int | None = None) -> in
     n = g.num_inputs
     full = T.mask(k)
     val = {leaf: T.var(k, i) for i, leaf in enumerate(leaves)}
-    stack = [node]
-    while stack:
-        x = stack[-1]
-        if x in val:
-            stack.pop()
-            continue
+    for x in _postorder([node], lambda x: _fanin_nodes(g, x), val):
         a, b = g.ands[x - n - 1]
-        pend = [y for y in (a >> 1, b >> 1) if y not in val]
-        if pend:
-            stack.extend(pend)
-            continue
-        stack.pop()
         va = val[a >> 1] ^ (full if a & 1 else 0)
         vb = val[b >> 1] ^ (full if b & 1 else 0)
         val[x] = va & vb
