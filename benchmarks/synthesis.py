@@ -29,7 +29,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from mlc.front.spec import TableSpec  # noqa: E402
+from mlc.spec import TableSpec  # noqa: E402
 from mlc.logic.aigio import write_blif  # noqa: E402
 from mlc.logic.lower import from_spec  # noqa: E402
 from mlc.logic import exactsat, library  # noqa: E402

@@ -9,7 +9,7 @@ from mlc.cli import main
 from mlc.front.aiger import parse as parse_aag
 from mlc.front.blif import parse as parse_blif
 from mlc.front.load import load, truth_tables
-from mlc.front.netlist import Netlist
+from mlc.netlist.ir import Netlist
 
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLES = sorted(p.name for p in (ROOT / "examples").iterdir()
@@ -115,7 +115,7 @@ from hypothesis import strategies as st  # noqa: E402
 
 @st.composite
 def tables(draw):
-    from mlc.front.spec import TableSpec
+    from mlc.spec import TableSpec
     n = draw(st.integers(0, 5))
     m = draw(st.integers(1, 3))
     full = (1 << (1 << n)) - 1

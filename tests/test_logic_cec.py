@@ -6,7 +6,7 @@ import random
 import pytest
 
 from mlc.errors import InternalError
-from mlc.front.spec import NetworkSpec, Node
+from mlc.spec import NetworkSpec, Node
 from mlc.logic import cec, equiv, library
 from mlc.logic.lower import from_spec
 from mlc.logic.netsim import simulate_network

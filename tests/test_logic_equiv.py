@@ -3,7 +3,7 @@ and mismatches caught."""
 import pytest
 
 from mlc.errors import InternalError
-from mlc.front.spec import NetworkSpec, Node, TableSpec
+from mlc.spec import NetworkSpec, Node, TableSpec
 from mlc.logic import tt as T
 from mlc.logic.aig import AIG
 from mlc.logic.equiv import check_equivalent

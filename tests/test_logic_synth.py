@@ -5,7 +5,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from mlc.errors import MlcError
-from mlc.front.spec import NetworkSpec, Node, TableSpec
+from mlc.spec import NetworkSpec, Node, TableSpec
 from mlc.logic import library
 from mlc.logic import tt as T
 from mlc.logic.equiv import check_equivalent

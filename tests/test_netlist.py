@@ -10,8 +10,8 @@ from mlc.errors import InternalError, MlcError
 from mlc.front.aiger import parse as parse_aag
 from mlc.front.blif import parse as parse_blif
 from mlc.front.load import load, truth_tables
-from mlc.front.mapper import map_aig
-from mlc.front.netlist import Netlist
+from mlc.netlist.mapper import map_aig
+from mlc.netlist.ir import Netlist
 from mlc.gates.library import load_library
 from mlc.io.schema import load_schema, validate
 from mlc.logic.aig import AIG

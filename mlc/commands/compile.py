@@ -4,7 +4,7 @@ Pipeline (each step one call; the back end adds scene and mesh steps after ``map
 
     spec    = load(INPUT or -e EXPR)                  mlc.front.load
     aig     = synthesize(spec, -O)                    mlc.logic.synth (proves aig == spec)
-    netlist = map_aig(aig, --signal)                  mlc.front.mapper
+    netlist = map_aig(aig, --signal)                  mlc.netlist.mapper
     proof   = check_equivalent(netlist.to_aig(), spec)   the mapped gates, proven again
     files   = render(netlist, ...)                    everything in memory first
     write(OUTDIR, files)                              atomically, only after all of the above
@@ -48,7 +48,7 @@ class Compiled:
 
 def compile_spec(spec, level: int = 2, signal: str = "expand") -> Compiled:
     """Synthesize, map and prove; raises InternalError if anything is not equivalent."""
-    from mlc.front.mapper import map_aig
+    from mlc.netlist.mapper import map_aig
     from mlc.logic.equiv import check_equivalent
     from mlc.logic.synth import synthesize
 

@@ -1,1 +1,1 @@
-"""Front end: parsers (one module per input format) producing the plain data of :mod:`mlc.front.spec`."""
+"""Front end: parsers (one module per input format) producing the plain data of :mod:`mlc.spec`."""

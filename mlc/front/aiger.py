@@ -24,7 +24,7 @@ import re
 from mlc.errors import Loc, MlcError
 from mlc.front.blif import _check_loops
 from mlc.front.load import finish_network
-from mlc.front.spec import Node, NetworkSpec
+from mlc.spec import Node, NetworkSpec
 
 TOKEN_RE = re.compile(r"\S+")
 INT_RE = re.compile(r"[0-9]+")

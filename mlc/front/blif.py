@@ -28,7 +28,7 @@ import re
 
 from mlc.errors import Loc, MlcError
 from mlc.front.load import finish_network
-from mlc.front.spec import Node, NetworkSpec
+from mlc.spec import Node, NetworkSpec
 
 TOKEN_RE = re.compile(r"\S+")
 CUBE_RE = re.compile(r"[01-]*")

@@ -26,7 +26,7 @@ breaks never end a statement: every statement ends with ";".  ``mux(s, a, b)`` a
 number of arguments.  A name must be defined before it is used; a name never defined
 is an input.  Function names are reserved only when followed by "(".
 
-:func:`print_network` writes any :class:`~mlc.front.spec.NetworkSpec` in this syntax such
+:func:`print_network` writes any :class:`~mlc.spec.NetworkSpec` in this syntax such
 that ``print(parse(print(x))) == print(x)`` and parsing preserves the function.
 """
 from __future__ import annotations
@@ -35,7 +35,7 @@ import re
 
 from mlc.errors import Loc, MlcError
 from mlc.front.load import finish_network
-from mlc.front.spec import Node, NetworkSpec
+from mlc.spec import Node, NetworkSpec
 
 NAME_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_.]*(?:\[[0-9]+\])?")
 TOKEN_RE = re.compile(r"""

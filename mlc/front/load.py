@@ -1,8 +1,8 @@
 """Reading a specification: dispatch by file extension (or ``-e EXPR``), plus the
 helpers every parser shares.
 
-* :func:`load` -- ``path`` or ``expr`` -> :class:`~mlc.front.spec.TableSpec` or
-  :class:`~mlc.front.spec.NetworkSpec`.
+* :func:`load` -- ``path`` or ``expr`` -> :class:`~mlc.spec.TableSpec` or
+  :class:`~mlc.spec.NetworkSpec`.
 * :func:`finish_network` -- put a parsed network into the canonical shape every
   consumer may rely on (input nodes first, in ``inputs`` order; then the other
   nodes in topological order) and check it.
@@ -19,7 +19,7 @@ from functools import lru_cache
 from pathlib import Path
 
 from mlc.errors import InternalError, MlcError
-from mlc.front.spec import OPS, Node, NetworkSpec, Spec, TableSpec
+from mlc.spec import OPS, Node, NetworkSpec, Spec, TableSpec
 
 # Largest number of inputs a truth table (or exhaustive simulation) may have:
 # bit sets of 2**24 bits are 2 MiB each.

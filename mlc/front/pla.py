@@ -16,7 +16,7 @@ Grammar (``#`` starts a comment that runs to the end of the line)::
     OUT      := "0" | "1" | "-" | "~"
 
 The first input of ``.ilb`` is the leftmost column and the least significant bit of
-the minterm numbering of :class:`~mlc.front.spec.TableSpec`.
+the minterm numbering of :class:`~mlc.spec.TableSpec`.
 
 Meaning of an output column, by ``.type`` (as in espresso(5)):
 
@@ -41,7 +41,7 @@ import re
 from mlc.errors import Loc, MlcError
 from mlc.front.lines import DIRECTIVE_RE, content_lines, tokens
 from mlc.front.load import MAX_TABLE_INPUTS, cube_mask, full_mask, lowest_minterm, minterm_str
-from mlc.front.spec import TableSpec
+from mlc.spec import TableSpec
 
 INT_RE = re.compile(r"[0-9]+")
 NAME_RE = re.compile(r"[^\s|#]+")

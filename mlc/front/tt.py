@@ -23,7 +23,7 @@ default, or an error when ``strict=True`` (``mlc compile --strict``) and the fil
 no ``.unlisted`` line.  Two rows that give the same output opposite values on a common
 input combination are an error that names both lines.
 
-Minterm numbering is that of :class:`mlc.front.spec.TableSpec`: the first input is the
+Minterm numbering is that of :class:`mlc.spec.TableSpec`: the first input is the
 least significant bit.
 """
 from __future__ import annotations
@@ -33,7 +33,7 @@ import re
 from mlc.errors import Loc, MlcError
 from mlc.front.lines import DIRECTIVE_RE, content_lines, tokens
 from mlc.front.load import MAX_TABLE_INPUTS, cube_mask, full_mask, lowest_minterm, minterm_str
-from mlc.front.spec import TableSpec
+from mlc.spec import TableSpec
 
 NAME_RE = re.compile(r"[A-Za-z_][A-Za-z0-9_.]*(?:\[[0-9]+\])?")
 BIT_CHARS = frozenset("01-")

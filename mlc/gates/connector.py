@@ -18,7 +18,7 @@ Expanding wires (L0 = 1, L1 = 1.5 sigma) give s = 0.901 sigma; contracting ones
 (L0 = 1, L1 = 0.5 sigma) give s = 0.559 sigma.  Two half units in a row (the paper's
 full connector unit) map every state to itself.  This is what makes the mapper's
 "inversion on a wire goes into a connector half unit" physical
-(:mod:`mlc.front.mapper`); see docs/gates.md, "Connector half unit".
+(:mod:`mlc.netlist.mapper`); see docs/gates.md, "Connector half unit".
 
 Units: sigma (length), k0 (stiffness).
 """
@@ -28,7 +28,8 @@ import math
 
 import numpy as np
 
-from mlc.gates.library import SIGNALS, Design, _axis_sites, _body, _check_signal, _hinge, load_design
+from mlc.gates.library import SIGNALS, Design, _body, _check_signal, load_design
+from mlc.gates.parts import axis_sites, hinge
 from mlc.scene.model import Muscle, Probe, Scene
 
 _EZ = np.array([0.0, 0.0, 1.0])
@@ -68,11 +69,11 @@ def half_unit_scene(signal: str = "expand", design: Design | None = None) -> Sce
          "B": np.array([0.0, 0.5 * L1, 0.0]), "D": np.array([0.0, -0.5 * L1, 0.0])}
     bodies, bonds = [], []
     for u, v in (("A", "B"), ("B", "C"), ("C", "D"), ("D", "A")):
-        sites = {**_axis_sites(u, P[u], _EZ, w), **_axis_sites(v, P[v], _EZ, w), u: P[u], v: P[v]}
+        sites = {**axis_sites(u, P[u], _EZ, w), **axis_sites(v, P[v], _EZ, w), u: P[u], v: P[v]}
         bodies.append(_body(f"slab_{u}{v}", [(P[u], P[v])], sites, _EZ, d))
     for c, (b1, b2) in {"A": ("DA", "AB"), "B": ("AB", "BC"), "C": ("BC", "CD"),
                         "D": ("CD", "DA")}.items():
-        bonds += _hinge(f"hinge_{c}", f"slab_{b1}", f"slab_{b2}", c, c, d.k)
+        bonds += hinge(f"hinge_{c}", f"slab_{b1}", f"slab_{b2}", c, c, d.k)
     muscles = [Muscle("muscle_in", "a", "slab_AB.A", "slab_BC.C", L0, L1, d.k)]
     probes = [Probe("out", "out", "slab_AB.B", "slab_CD.D", L0, L1)]
     scene = Scene(name=f"half_unit_{signal}", bodies=bodies, bonds=bonds, muscles=muscles,

@@ -36,7 +36,8 @@ from mlc.geometry.core import CoreSolution, solve_core
 from mlc.geometry.lever import LeverSolution, lever_type_for, solve_lever
 from mlc.io import yamlsrc
 from mlc.io.schema import load_schema, validate
-from mlc.scene.model import Body, Bond, Box, Muscle, Probe, Scene
+from mlc.gates.parts import axis_sites, hinge, slab_body, universal_joint
+from mlc.scene.model import Body, Muscle, Probe, Scene
 
 SIGNALS = ("expand", "contract")
 GATE_NAMES = ("AND", "NAND", "OR", "NOR", "NIMPLY", "CNIMPLY", "IMPLY", "CIMPLY")
@@ -233,32 +234,8 @@ def _place_lever(lev: LeverSolution, actuated: bool, side: str, lo, hi, toward_o
     return world, ("A_up", b_of_up), ("A_dn", b_of_dn)
 
 
-def _segment_box(p, q, axis, width, thickness) -> Box:
-    """A slab from p to q (world == body frame at build time), ``width`` along the hinge
-    ``axis`` and ``thickness`` across."""
-    from mlc.geometry.rotation import frame_matrix, matrix_to_quat
-    L = float(np.linalg.norm(q - p))
-    return Box(np.array([L, width, thickness]), 0.5 * (p + q), matrix_to_quat(frame_matrix(q - p, axis)))
-
-
 def _body(name, segments, sites, axis, d: Design) -> Body:
-    """A body made of straight slab segments (list of (p, q) world points at build time).
-    The body frame is parallel to the world frame, its origin at the slab material's centroid."""
-    lengths = np.array([np.linalg.norm(q - p) for p, q in segments])
-    mids = np.array([0.5 * (p + q) for p, q in segments])
-    centre = (lengths[:, None] * mids).sum(0) / lengths.sum()
-    boxes = [_segment_box(p - centre, q - centre, axis, d.slab_width, d.slab_thickness) for p, q in segments]
-    return Body(name, centre, np.array([1.0, 0, 0, 0]), boxes,
-                {k: np.asarray(v, float) - centre for k, v in sites.items()})
-
-
-def _axis_sites(prefix, point, axis, width) -> dict:
-    return {f"{prefix}_0": point - 0.5 * width * axis, f"{prefix}_1": point + 0.5 * width * axis}
-
-
-def _hinge(name, body_a, body_b, site_a, site_b, k) -> list[Bond]:
-    return [Bond(f"{name}_{i}", f"{body_a}.{site_a}_{i}", f"{body_b}.{site_b}_{i}", k, 0.0, 0.0, "hinge", name)
-            for i in (0, 1)]
+    return slab_body(name, segments, sites, axis, d.slab_width, d.slab_thickness)
 
 
 def gate_scene(name: str, signal: str = "expand", design: Design | None = None) -> Scene:
@@ -278,10 +255,10 @@ def gate_scene(name: str, signal: str = "expand", design: Design | None = None) 
 
     bodies, bonds = [], []
     bodies.append(_body("core_ab", [(P["a"], P["b"])],
-                        {**_axis_sites("a", P["a"], _EZ, w), **_axis_sites("b", P["b"], _EZ, w),
-                         **_axis_sites("m", m, _EX, w)}, _EZ, d))
+                        {**axis_sites("a", P["a"], _EZ, w), **axis_sites("b", P["b"], _EZ, w),
+                         **axis_sites("m", m, _EX, w)}, _EZ, d))
     bodies.append(_body("core_cd", [(P["c"], P["d"])],
-                        {**_axis_sites("c", P["c"], _EZ, w), "d": P["d"]}, _EZ, d))
+                        {**axis_sites("c", P["c"], _EZ, w), "d": P["d"]}, _EZ, d))
 
     muscles = []
     for inp, lev, corner in (("a", geo.lever_a, "a"), ("b", geo.lever_b, "b")):
@@ -295,12 +272,12 @@ def gate_scene(name: str, signal: str = "expand", design: Design | None = None) 
         lo_keys = up_keys if up_keys[1] == "B_dn" else dn_keys
         hi_keys = dn_keys if lo_keys is up_keys else up_keys
         for bname, (akey, bkey) in ((f"{inp}_lo", lo_keys), (f"{inp}_hi", hi_keys)):
-            sites = {"in": world[akey], **_axis_sites("piv", world["P"], _EZ, w),
-                     **_axis_sites("core", world[bkey], _EZ, w)}
+            sites = {"in": world[akey], **axis_sites("piv", world["P"], _EZ, w),
+                     **axis_sites("core", world[bkey], _EZ, w)}
             bodies.append(_body(bname, [(world[akey], world["P"]), (world["P"], world[bkey])], sites, _EZ, d))
-        bonds += _hinge(f"pivot_{inp}", f"{inp}_lo", f"{inp}_hi", "piv", "piv", d.k)
-        bonds += _hinge(f"hinge_{corner}", "core_ab", f"{inp}_lo", corner, "core", d.k)
-        bonds += _hinge(f"hinge_c_{inp}", "core_cd", f"{inp}_hi", "c", "core", d.k)
+        bonds += hinge(f"pivot_{inp}", f"{inp}_lo", f"{inp}_hi", "piv", "piv", d.k)
+        bonds += hinge(f"hinge_{corner}", "core_ab", f"{inp}_lo", corner, "core", d.k)
+        bonds += hinge(f"hinge_c_{inp}", "core_cd", f"{inp}_hi", "c", "core", d.k)
         act = d.rest + (d.signal if signal == "expand" else -d.signal)
         # muscle ends: A_up / A_dn, on whichever bodies carry them
         a_up_body = f"{inp}_lo" if lo_keys[0] == "A_up" else f"{inp}_hi"
@@ -311,14 +288,14 @@ def gate_scene(name: str, signal: str = "expand", design: Design | None = None) 
     core_on = bool(p["a"] and p["b"])            # core state at the all-zero input state
     world, up_keys, dn_keys = _place_lever(geo.lever_out, core_on, "A", m, P["d"], _EZ)
     bodies.append(_body("out_lo", [(world["A_dn"], world["P"]), (world["P"], world[dn_keys[1]])],
-                        {**_axis_sites("core", world["A_dn"], _EX, w), **_axis_sites("piv", world["P"], _EX, w),
+                        {**axis_sites("core", world["A_dn"], _EX, w), **axis_sites("piv", world["P"], _EX, w),
                          "out": world[dn_keys[1]]}, _EX, d))
     bodies.append(_body("out_hi", [(world["A_up"], world["P"]), (world["P"], world[up_keys[1]])],
-                        {"core": world["A_up"], **_axis_sites("piv", world["P"], _EX, w),
+                        {"core": world["A_up"], **axis_sites("piv", world["P"], _EX, w),
                          "out": world[up_keys[1]]}, _EX, d))
-    bonds += _hinge("pivot_out", "out_lo", "out_hi", "piv", "piv", d.k)
-    bonds += _hinge("hinge_m", "core_ab", "out_lo", "m", "core", d.k)
-    bonds.append(Bond("ujoint_d", "core_cd.d", "out_hi.core", d.k, 0.0, 0.0, "universal", "ujoint_d"))
+    bonds += hinge("pivot_out", "out_lo", "out_hi", "piv", "piv", d.k)
+    bonds += hinge("hinge_m", "core_ab", "out_lo", "m", "core", d.k)
+    bonds.append(universal_joint("ujoint_d", "core_cd.d", "out_hi.core", d.k))
     act = d.rest + (d.signal if signal == "expand" else -d.signal)
     probes = [Probe("out", "out", "out_lo.out", "out_hi.out", d.rest, act)]
 

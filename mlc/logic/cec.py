@@ -30,7 +30,7 @@ from __future__ import annotations
 import random
 
 from mlc.errors import MlcError
-from mlc.front.spec import NetworkSpec, TableSpec
+from mlc.spec import NetworkSpec, TableSpec
 from mlc.logic.aig import AIG
 from mlc.logic.netsim import AIGAlgebra, eval_network
 

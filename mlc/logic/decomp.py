@@ -14,7 +14,7 @@ Sub-results are memoised by (function, care set), so equal cofactors are shared.
 """
 from __future__ import annotations
 
-from mlc.front.spec import TableSpec
+from mlc.spec import TableSpec
 from mlc.logic import npn
 from mlc.logic import tt as T
 from mlc.logic.aig import AIG

@@ -22,7 +22,7 @@ from __future__ import annotations
 import random
 
 from mlc.errors import InternalError
-from mlc.front.spec import NetworkSpec, TableSpec
+from mlc.spec import NetworkSpec, TableSpec
 from mlc.logic import tt as T
 from mlc.logic.aig import AIG
 from mlc.logic.bdd import BDD

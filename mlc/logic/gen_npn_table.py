@@ -79,7 +79,7 @@ def _entry(R, k, circ, proven):
 
 def _heuristic(R):
     """A (not necessarily minimum) circuit from mlc's own synthesis, as gate tuples."""
-    from mlc.front.spec import TableSpec
+    from mlc.spec import TableSpec
     from mlc.logic.synth import synthesize
     g = synthesize(TableSpec(["a", "b", "c", "d"], ["f"], [R], [0]), 2)
     gates = [(a // 2 - 1, b // 2 - 1, a & 1, b & 1, 0) for a, b in g.ands]

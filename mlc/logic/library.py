@@ -1,13 +1,13 @@
-"""Standard small functions as :class:`~mlc.front.spec.TableSpec`: the synthesis
+"""Standard small functions as :class:`~mlc.spec.TableSpec`: the synthesis
 benchmark's suite (benchmarks/synthesis.py) and the tests' reference functions;
-wide arithmetic as :class:`~mlc.front.spec.NetworkSpec` (:func:`ripple_adder`,
+wide arithmetic as :class:`~mlc.spec.NetworkSpec` (:func:`ripple_adder`,
 :func:`array_multiplier`)."""
 from __future__ import annotations
 
 import random
 from collections.abc import Callable
 
-from mlc.front.spec import NetworkSpec, Node, TableSpec
+from mlc.spec import NetworkSpec, Node, TableSpec
 
 
 def table(name: str, inputs: list[str], outputs: list[str],

@@ -1,8 +1,8 @@
 """Lower a specification to a first, unoptimised-but-reasonable AIG.
 
-* :class:`~mlc.front.spec.NetworkSpec`: structural translation, node by node, with
+* :class:`~mlc.spec.NetworkSpec`: structural translation, node by node, with
   structural hashing and constant folding (don't cares are kept for later passes).
-* :class:`~mlc.front.spec.TableSpec`: per output an irredundant SOP of the interval
+* :class:`~mlc.spec.TableSpec`: per output an irredundant SOP of the interval
   ``[on, on | dc]`` (Minato-Morreale), algebraically factored.
 """
 from __future__ import annotations
@@ -10,7 +10,7 @@ from __future__ import annotations
 from collections.abc import Sequence
 
 from mlc.errors import InternalError
-from mlc.front.spec import NetworkSpec, TableSpec
+from mlc.spec import NetworkSpec, TableSpec
 from mlc.logic import tt as T
 from mlc.logic.aig import AIG
 from mlc.logic.netsim import AIGAlgebra, eval_network

@@ -1,4 +1,4 @@
-"""Evaluate a :class:`~mlc.front.spec.NetworkSpec` over any Boolean algebra.
+"""Evaluate a :class:`~mlc.spec.NetworkSpec` over any Boolean algebra.
 
 One evaluator serves three purposes: bit-parallel simulation (ints as words),
 lowering to an AIG (literals) and BDD construction (node ids).  An algebra provides
@@ -8,7 +8,7 @@ and optionally ``mux_(s, t, e)`` and ``maj3(a, b, c)``.
 from __future__ import annotations
 
 from mlc.errors import InternalError, MlcError
-from mlc.front.spec import NetworkSpec
+from mlc.spec import NetworkSpec
 from mlc.logic.aig import balanced
 
 

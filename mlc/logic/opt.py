@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import random
 
-from mlc.front.spec import NetworkSpec, TableSpec
+from mlc.spec import NetworkSpec, TableSpec
 from mlc.logic import tt as T
 from mlc.logic import work
 from mlc.logic.aig import AIG

@@ -2,7 +2,7 @@
 
 A truth table over ``n`` variables is an int of ``2**n`` bits; bit ``m`` is the value
 on minterm ``m``, where variable ``i`` has the value ``(m >> i) & 1`` (the numbering
-of :class:`mlc.front.spec.TableSpec`).  Python's big ints make every Boolean
+of :class:`mlc.spec.TableSpec`).  Python's big ints make every Boolean
 operation bit-parallel over all minterms at once.
 """
 from __future__ import annotations

@@ -1,4 +1,4 @@
-"""Technology mapping: an AIG with free inversions -> a :class:`~mlc.front.netlist.Netlist`
+"""Technology mapping: an AIG with free inversions -> a :class:`~mlc.netlist.ir.Netlist`
 of library gates.
 
 * Every AND node that an output depends on becomes one library gate.  The gate's type
@@ -23,7 +23,7 @@ of library gates.
 from __future__ import annotations
 
 from mlc.errors import InternalError, MlcError
-from mlc.front.netlist import Gate, Input, Netlist, Output, Pin
+from mlc.netlist.ir import Gate, Input, Netlist, Output, Pin
 
 
 def map_aig(aig, signal: str = "expand", source: str = "<input>") -> Netlist:

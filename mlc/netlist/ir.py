@@ -1,6 +1,6 @@
 """The gate netlist IR: library gates, lever types, connector branches and half units.
 
-A :class:`Netlist` is what technology mapping (:mod:`mlc.front.mapper`) produces and
+A :class:`Netlist` is what technology mapping (:mod:`mlc.netlist.mapper`) produces and
 what the back end turns into mechanisms.  It is stored as JSON (schema
 ``mlc/schemas/netlist.schema.json``, documented in docs/netlist-format.md) and has a
 stable text form for golden tests, DOT and PNG drawings, and BLIF / AIGER exports.
