@@ -1,8 +1,9 @@
 """Writing and reading the printable meshes: STL (whole assembly or one part) and 3MF.
 
 Meshes go out through trimesh (STL).  3MF is written here with the standard library
-(zip + XML, unit millimetre, one named ``object`` per part, one build ``item`` each) so it
-needs no XML package beyond Python's; :func:`read_3mf` reads it back.  Every file is
+(zip + XML, unit millimetre): one object, the assembly, whose named parts are volumes
+(PrusaSlicer's ``Slic3r_PE_model.config``), so slicers keep the parts in place; it needs no
+XML package beyond Python's; :func:`read_3mf` reads it back.  Every file is
 written atomically (``mlc.io.atomic``): a failed export leaves no partial file.
 """
 from __future__ import annotations
@@ -46,25 +47,44 @@ def stl_bytes(meshes) -> bytes:
 
 
 def threemf_bytes(meshes, title: str = "mlc") -> bytes:
-    """A 3MF package (unit millimetre) with one named object per part."""
+    """A 3MF package (unit millimetre): the whole assembly as **one object** whose named
+    parts are *volumes*, so that a slicer keeps them where they are.
+
+    The core 3MF model has one mesh object holding every part's triangles (each part a closed
+    shell of its own; any 3MF reader sees the assembly in place).  The parts' names and their
+    triangle ranges are in ``Metadata/Slic3r_PE_model.config``, the convention PrusaSlicer (and
+    its forks, Orca and Bambu Studio) read to split an object into named volumes.  A 3MF with
+    one object per part instead makes PrusaSlicer drop each part onto the bed on its own."""
+    if not meshes:
+        raise MlcError("nothing to export: the assembly has no parts")
     out = io.BytesIO()
-    parts = []
-    for i, (name, m) in enumerate(meshes, start=1):
+    verts, tris, vols = [], [], []
+    voff = toff = 0
+    for name, m in meshes:
         v = np.asarray(m.vertices, float)
         f = np.asarray(m.faces, np.int64)
-        verts = "".join(f'<vertex x="{x:.6g}" y="{y:.6g}" z="{z:.6g}"/>' for x, y, z in v.tolist())
-        tris = "".join(f'<triangle v1="{a}" v2="{b}" v3="{c}"/>' for a, b, c in f.tolist())
-        parts.append(f'<object id="{i}" type="model" name="{_xml(name)}"><mesh><vertices>{verts}</vertices>'
-                     f'<triangles>{tris}</triangles></mesh></object>')
-    items = "".join(f'<item objectid="{i}"/>' for i in range(1, len(meshes) + 1))
+        verts.append("".join(f'<vertex x="{x:.6g}" y="{y:.6g}" z="{z:.6g}"/>' for x, y, z in v.tolist()))
+        tris.append("".join(f'<triangle v1="{a}" v2="{b}" v3="{c}"/>' for a, b, c in (f + voff).tolist()))
+        vols.append((name, toff, toff + len(f) - 1))
+        voff += len(v)
+        toff += len(f)
     model = (f'<?xml version="1.0" encoding="UTF-8"?>\n<model unit="millimeter" xml:lang="en-US" '
              f'xmlns="{_NS_3MF}"><metadata name="Title">{_xml(title)}</metadata>'
              f'<metadata name="Application">mlc</metadata>'
-             f'<resources>{"".join(parts)}</resources><build>{items}</build></model>\n')
+             f'<resources><object id="1" type="model" name="{_xml(title)}"><mesh><vertices>{"".join(verts)}'
+             f'</vertices><triangles>{"".join(tris)}</triangles></mesh></object></resources>'
+             f'<build><item objectid="1"/></build></model>\n')
+    cfg = ['<?xml version="1.0" encoding="UTF-8"?>\n<config>\n <object id="1" instances_count="1">\n'
+           f'  <metadata type="object" key="name" value="{_xml(title)}"/>\n']
+    for name, a, b in vols:
+        cfg.append(f'  <volume firstid="{a}" lastid="{b}">\n'
+                   f'   <metadata type="volume" key="name" value="{_xml(name)}"/>\n'
+                   f'   <metadata type="volume" key="volume_type" value="ModelPart"/>\n  </volume>\n')
+    cfg.append(" </object>\n</config>\n")
     types = ('<?xml version="1.0" encoding="UTF-8"?>\n<Types xmlns="http://schemas.openxmlformats.org/package/'
              '2006/content-types"><Default Extension="rels" ContentType="application/vnd.openxmlformats-'
              'package.relationships+xml"/><Default Extension="model" ContentType="application/vnd.ms-package.'
-             '3dmanufacturing-3dmodel+xml"/></Types>\n')
+             '3dmanufacturing-3dmodel+xml"/><Default Extension="config" ContentType="text/xml"/></Types>\n')
     rels = ('<?xml version="1.0" encoding="UTF-8"?>\n<Relationships xmlns="http://schemas.openxmlformats.org/'
             'package/2006/relationships"><Relationship Target="/3D/3dmodel.model" Id="rel0" Type="http://'
             'schemas.microsoft.com/3dmanufacturing/2013/01/3dmodel"/></Relationships>\n')
@@ -72,7 +92,11 @@ def threemf_bytes(meshes, title: str = "mlc") -> bytes:
         z.writestr("[Content_Types].xml", types)
         z.writestr("_rels/.rels", rels)
         z.writestr("3D/3dmodel.model", model)
+        z.writestr(SLIC3R_CONFIG, "".join(cfg))
     return out.getvalue()
+
+
+SLIC3R_CONFIG = "Metadata/Slic3r_PE_model.config"
 
 
 def _xml(s: str) -> str:
@@ -80,18 +104,28 @@ def _xml(s: str) -> str:
 
 
 def read_3mf(path) -> list[tuple[str, trimesh.Trimesh]]:
-    """The named objects of a 3MF file as meshes (in millimetres)."""
+    """The named parts of a 3MF file as meshes (in millimetres): the volumes of each object
+    when the file lists them (``Metadata/Slic3r_PE_model.config``), else one mesh per object."""
     try:
         with zipfile.ZipFile(path) as z:
             names = [n for n in z.namelist() if n.lower().endswith(".model")]
             if not names:
                 raise MlcError("not a 3MF file: no 3D model inside", str(path))
             root = ET.fromstring(z.read(names[0]))
+            cfg = ET.fromstring(z.read(SLIC3R_CONFIG)) if SLIC3R_CONFIG in z.namelist() else None
     except (zipfile.BadZipFile, ET.ParseError, OSError) as e:
         raise MlcError(f"cannot read 3MF: {e}", str(path)) from None
     ns = {"m": root.tag[1:].split("}")[0]} if root.tag.startswith("{") else {"m": ""}
     scale = {"millimeter": 1.0, "micron": 1e-3, "centimeter": 10.0, "meter": 1000.0, "inch": 25.4,
              "foot": 304.8}.get(root.get("unit", "millimeter"), 1.0)
+    volumes = {}
+    if cfg is not None:
+        for obj in cfg.iter("object"):
+            vl = []
+            for vol in obj.iter("volume"):
+                nm = next((m.get("value") for m in vol.iter("metadata") if m.get("key") == "name"), None)
+                vl.append((nm, int(vol.get("firstid")), int(vol.get("lastid"))))
+            volumes[obj.get("id")] = vl
     out = []
     q = (lambda t: f"m:{t}") if ns["m"] else (lambda t: t)
     for obj in root.iter(f"{{{ns['m']}}}object" if ns["m"] else "object"):
@@ -102,7 +136,15 @@ def read_3mf(path) -> list[tuple[str, trimesh.Trimesh]]:
                       for e in mesh.find(q("vertices"), ns)], float) * scale
         f = np.array([[int(e.get("v1")), int(e.get("v2")), int(e.get("v3"))]
                       for e in mesh.find(q("triangles"), ns)], np.int64).reshape(-1, 3)
-        out.append((obj.get("name") or f"object_{obj.get('id')}", trimesh.Trimesh(v, f, process=False)))
+        name = obj.get("name") or f"object_{obj.get('id')}"
+        vl = volumes.get(obj.get("id"))
+        if not vl:
+            out.append((name, trimesh.Trimesh(v, f, process=False)))
+            continue
+        for k, (nm, a, b) in enumerate(vl):
+            sub = trimesh.Trimesh(v, f[a:b + 1], process=False)
+            sub.remove_unreferenced_vertices()
+            out.append((nm or f"{name}_{k}", sub))
     return out
 
 
