@@ -1,4 +1,4 @@
-"""The ASCII AIGER parser: golden output, semantics, error rules, round trip with the netlist writer."""
+"""The ASCII AIGER parser: golden output, semantics, error rules (binary AIGER: test_front_aig_binary.py)."""
 from pathlib import Path
 
 import pytest
@@ -37,7 +37,7 @@ def test_aiger_1_9_header_with_zero_properties():
 
 BAD = [
     ("", "1", "empty AIGER"),
-    ("aig 1 1 0 1 0\n", "1:1", "binary AIGER"),
+    ("aig 1 1 0 1 0\n", "1", "file ends before the output 0 line"),   # binary, by its header
     ("foo\n", "1:1", "first line must start with 'aag'"),
     ("aag 1 1\n", "1:1", "5 to 9 numbers"),
     ("aag 1 1 x 1 0\n2\n", "1:9", "non-negative integer"),

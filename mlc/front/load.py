@@ -11,7 +11,10 @@ helpers every parser shares.
 * :func:`var_mask` -- the bit set of the minterms in which input ``i`` is 1.
 
 Extensions: ``.tt`` (mlc truth table), ``.pla`` (Berkeley PLA), ``.expr`` / ``.eqn``
-(Boolean expressions), ``.blif`` (BLIF, combinational), ``.aag`` (ASCII AIGER).
+(Boolean expressions), ``.blif`` (BLIF, combinational), ``.aag`` and ``.aig`` (AIGER,
+ASCII or binary: the parser tells them apart by the header, so a misnamed one still
+reads; a file with another extension whose first bytes are ``aag `` or ``aig `` is
+read as AIGER too).
 """
 from __future__ import annotations
 
@@ -27,8 +30,9 @@ MAX_TABLE_INPUTS = 24
 
 EXTENSIONS = {
     ".tt": "tt", ".pla": "pla", ".expr": "expr", ".eqn": "expr",
-    ".blif": "blif", ".aag": "aiger",
+    ".blif": "blif", ".aag": "aiger", ".aig": "aiger",
 }
+AIGER_MAGIC = (b"aag ", b"aig ")
 
 
 def parser_for(name: str):
@@ -36,8 +40,9 @@ def parser_for(name: str):
     return importlib.import_module(f"mlc.front.{name}")
 
 
-def parse_text(text: str, filename: str, fmt: str, strict: bool = False) -> Spec:
-    """Parse ``text`` in format ``fmt`` (a value of :data:`EXTENSIONS`)."""
+def parse_text(text: str | bytes, filename: str, fmt: str, strict: bool = False) -> Spec:
+    """Parse ``text`` in format ``fmt`` (a value of :data:`EXTENSIONS`); ``aiger`` also
+    takes ``bytes`` (binary AIGER)."""
     mod = parser_for(fmt)
     if fmt == "tt":
         return mod.parse(text, filename, strict=strict)
@@ -56,15 +61,16 @@ def load(path: str | None = None, expr: str | None = None, strict: bool = False)
         return parse_text(expr, "<-e>", "expr", strict)
     p = Path(path)
     fmt = EXTENSIONS.get(p.suffix.lower())
-    if fmt is None:
-        if p.suffix.lower() == ".aig":
-            raise MlcError("binary AIGER is not supported", str(p),
-                           "convert it to ASCII AIGER first: aigtoaig in.aig out.aag")
+    if fmt is None and not (p.is_file() and _starts_with(p, AIGER_MAGIC)):
         known = ", ".join(sorted(EXTENSIONS))
         raise MlcError(f"unknown input format {p.suffix or '(no extension)'!r}", str(p),
                        f"use one of {known}, or -e EXPR")
     try:
-        text = p.read_text(encoding="utf-8")
+        if fmt in (None, "aiger"):
+            text = p.read_bytes()           # AIGER may be binary; the parser reads the header
+            fmt = "aiger"
+        else:
+            text = p.read_text(encoding="utf-8")
     except FileNotFoundError:
         raise MlcError("no such file", str(p)) from None
     except IsADirectoryError:
@@ -74,6 +80,15 @@ def load(path: str | None = None, expr: str | None = None, strict: bool = False)
     except OSError as e:
         raise MlcError(f"cannot read: {e.strerror}", str(p)) from None
     return parse_text(text, str(path), fmt, strict)
+
+
+def _starts_with(p: Path, prefixes: tuple[bytes, ...]) -> bool:
+    try:
+        with p.open("rb") as f:
+            head = f.read(max(len(x) for x in prefixes))
+    except OSError:
+        return False
+    return head.startswith(prefixes)
 
 
 # --------------------------------------------------------------------------- bit sets
