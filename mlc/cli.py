@@ -2,12 +2,16 @@
 
 Subcommands live in :mod:`mlc.commands` (one module each, discovered at start-up).
 User errors (:class:`~mlc.errors.MlcError`) print one line ``mlc: error: ...`` and exit 2;
-internal errors print one line and exit 3; neither prints a traceback.
+internal errors (and any unexpected exception) print one line and exit 3; neither prints a
+traceback (set ``MLC_TRACEBACK=1`` to get one for a bug report).  Ctrl-C exits 130.
+Standard output that is closed, full (``>/dev/full``) or a broken pipe is handled too:
+closed or full is an error (exit 2), a reader that went away (``| head``) is not.
 """
 from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import pkgutil
 import sys
 
@@ -33,14 +37,80 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
+class _Stdout:
+    """Standard output whose write errors (other than a broken pipe) are MlcErrors."""
+
+    def __init__(self, inner):
+        self._inner = inner
+
+    def _fail(self, e: OSError):
+        return MlcError(f"cannot write to standard output: {e.strerror or e}", None,
+                        "redirect it to a file or device that accepts data")
+
+    def write(self, s):
+        try:
+            return self._inner.write(s)
+        except BrokenPipeError:
+            raise
+        except OSError as e:
+            raise self._fail(e) from None
+
+    def flush(self):
+        try:
+            return self._inner.flush()
+        except BrokenPipeError:
+            raise
+        except OSError as e:
+            raise self._fail(e) from None
+
+    def __getattr__(self, name):
+        return getattr(self._inner, name)
+
+
+def _quiet_stdout(stream) -> None:
+    """After a broken pipe: point fd 1 at /dev/null so the interpreter's final flush is silent."""
+    try:
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, stream.fileno())
+        os.close(devnull)
+    except (OSError, ValueError, AttributeError):
+        pass
+
+
 def main(argv=None) -> int:
+    if sys.stdout is None:       # started as `mlc ... >&-`
+        if sys.stderr is not None:
+            sys.stderr.write("mlc: error: standard output is closed (redirect it, e.g. >/dev/null)\n")
+        return 2
+    real = sys.stdout
+    sys.stdout = _Stdout(real)
+    try:
+        return _main(argv)
+    except MlcError as e:        # from writing standard output while handling another error
+        sys.stderr.write(f"mlc: error: {e.format()}\n")
+        return 2
+    except BrokenPipeError:
+        _quiet_stdout(real)
+        return 0
+    finally:
+        if sys.stdout.__class__ is _Stdout:
+            sys.stdout = real
+
+
+def _main(argv) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    try:
+        args = parser.parse_args(argv)
+    except SystemExit as e:      # --help, --version, usage errors
+        sys.stdout.flush()
+        return e.code if isinstance(e.code, int) else (0 if e.code is None else 2)
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
     try:
-        return int(args.func(args) or 0)
+        code = int(args.func(args) or 0)
+        sys.stdout.flush()
+        return code
     except MlcError as e:
         sys.stderr.write(f"mlc: error: {e.format()}\n")
         return 2
@@ -51,7 +121,22 @@ def main(argv=None) -> int:
         sys.stderr.write("mlc: interrupted\n")
         return 130
     except BrokenPipeError:
-        return 0
+        raise
+    except MemoryError:
+        sys.stderr.write("mlc: error: out of memory (try a smaller input or fewer outputs)\n")
+        return 2
+    except Exception as e:
+        if os.environ.get("MLC_TRACEBACK"):
+            raise
+        where = ""
+        tb = e.__traceback__
+        while tb is not None and tb.tb_next is not None:
+            tb = tb.tb_next
+        if tb is not None:
+            where = f" at {os.path.basename(tb.tb_frame.f_code.co_filename)}:{tb.tb_lineno}"
+        sys.stderr.write(f"mlc: internal error: {type(e).__name__}: {e}{where} (this is a bug in mlc; please "
+                         f"report it; MLC_TRACEBACK=1 shows the traceback)\n")
+        return 3
 
 
 if __name__ == "__main__":  # pragma: no cover

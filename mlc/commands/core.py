@@ -19,19 +19,27 @@ def register(sub):
 def run(args) -> int:
     from mlc.geometry.core import design_space, solve_core
     if args.plot or args.data:
-        from mlc.io.atomic import write_text
-        space = design_space()
-        if args.data:
-            write_text(args.data, json.dumps({
-                "units": "sigma", "curves": {str(h): pts for h, pts in space["curves"].items()},
-                "boundary": [{"h": h, "din_max": d, "dout": o} for h, d, o in space["boundary"]]}, indent=1))
-        if args.plot:
-            from mlc.draw import plot_design_space
-            plot_design_space(space, args.plot, marker=(args.din, args.h))
+        from mlc.io.outputs import Outputs
+        from mlc.io.progress import Progress
+        outs = Outputs()
+        plot = outs.file(args.plot, "--plot", suffixes=(".png",))
+        data = outs.file(args.data, "--data", suffixes=(".json",))
+        with outs:                       # every output checked before the ~30 s of work
+            if plot:
+                solve_core(args.din, args.h)          # the marker must exist: fail before the work
+            # about 30 s on the reference machine (29 accessible-range scans of 150 core solves)
+            with Progress("mlc core: computing the Fig. 1B design space", expect=30.0):
+                space = design_space()
+            if data:
+                data.write_text(json.dumps({
+                    "units": "sigma", "curves": {str(h): pts for h, pts in space["curves"].items()},
+                    "boundary": [{"h": h, "din_max": d, "dout": o} for h, d, o in space["boundary"]]}, indent=1))
+            if plot:
+                from mlc.draw import plot_design_space
+                plot_design_space(space, plot.tmp, marker=(args.din, args.h))
         if not args.json:
-            for f in (args.plot, args.data):
-                if f:
-                    print(f"wrote {f}")
+            for f in outs.written:
+                print(f"wrote {f}")
             return 0
     sol = solve_core(args.din, args.h)
     d = sol.to_dict()

@@ -5,35 +5,48 @@ from pathlib import Path
 
 
 def register(sub):
-    p = sub.add_parser("draw", help="render a gate or scene in every input state (PNG), or a mesh with --mesh")
-    p.add_argument("target", nargs="?", help="library gate name or scene YAML file")
+    p = sub.add_parser("draw", help="render a gate or scene in every input state (PNG), or a mesh with --mesh",
+                       description="Draw a library gate (by name) or a scene file in each of its input states, "
+                                   "one panel per state, or with --mesh an STL/3MF file.  Lengths in sigma.")
+    p.add_argument("target", nargs="?", help="library gate name or scene YAML file (not with --mesh)")
     p.add_argument("--signal", choices=("expand", "contract"), default="expand")
-    p.add_argument("--mesh", metavar="STL", help="render this mesh file instead")
-    p.add_argument("-o", "--output", required=True, metavar="PNG")
+    p.add_argument("--mesh", metavar="STL", help="render this mesh file (.stl or .3mf) instead of a gate or scene")
+    p.add_argument("-o", "--output", required=True, metavar="PNG", help="picture to write (.png)")
     p.set_defaults(func=run)
 
 
 def load_target(target: str, signal: str):
     """A library gate name or a scene file -> Scene."""
     from mlc.gates.library import gate_scene
-    from mlc.scene.io import load_scene
+    from mlc.io.yamlsrc import read_text
+    from mlc.scene.io import parse_scene
     if target.lower().endswith((".yaml", ".yml")) or Path(target).exists():
-        return load_scene(target)
+        return parse_scene(read_text(target, "scene"), str(target))
     return gate_scene(target, signal)
 
 
 def run(args) -> int:
     from mlc.errors import MlcError
-    if args.mesh:
-        from mlc.mesh.render import render_mesh
-        render_mesh(args.mesh, args.output)
-        print(f"wrote {args.output}")
-        return 0
-    if not args.target:
+    from mlc.io.outputs import Outputs
+
+    if args.mesh and args.target:
+        raise MlcError(f"both a target ({args.target}) and --mesh given", "--mesh",
+                       "draw either a gate/scene or a mesh file, not both")
+    if not args.mesh and not args.target:
         raise MlcError("nothing to draw", "TARGET", "give a gate name, a scene file or --mesh FILE")
-    from mlc.draw import draw_scene_states
-    from mlc.verify.static import solve_states
-    scene = load_target(args.target, args.signal)
-    draw_scene_states(scene, solve_states(scene), args.output)
+    source = args.mesh or args.target
+    outs = Outputs(inputs=[source] if Path(source).exists() else [])
+    png = outs.file(args.output, "-o", suffixes=(".png",))
+    with outs:
+        if args.mesh:
+            from mlc.io.sniff import check_mesh_file
+            from mlc.mesh.render import render_mesh
+            check_mesh_file(args.mesh, max_triangles=400_000)
+            render_mesh(args.mesh, png.tmp)
+        else:
+            from mlc.draw import draw_scene_states
+            from mlc.verify.static import solve_states
+            scene = load_target(args.target, args.signal)
+            draw_scene_states(scene, solve_states(scene), png.tmp)
     print(f"wrote {args.output}")
     return 0

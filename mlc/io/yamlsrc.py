@@ -1,16 +1,40 @@
-"""YAML loading that remembers where every value came from.
+"""YAML loading that remembers where every value came from, and refuses hostile input.
 
 ``load(text, filename)`` returns plain Python data in which every mapping is a
 :class:`LocDict` and every sequence a :class:`LocList`.  Both behave as ``dict`` and
 ``list`` and also know the :class:`~mlc.errors.Loc` of themselves (``.loc``) and of
 each of their items (``.loc_of(key_or_index)``), so that later validation errors
 can quote ``file:line``.
+
+Every way a file can go wrong is one :class:`~mlc.errors.MlcError` at ``file:line:col``:
+
+* bytes that are not UTF-8 (:func:`load_file`, :func:`read_text`, or ``load`` given bytes);
+* YAML syntax errors and characters YAML does not allow;
+* nesting deeper than :data:`MAX_DEPTH` (PyYAML's composer recurses once per level);
+* aliases that expand the document by more than :data:`MAX_ALIAS_NODES` nodes (the
+  "billion laughs" bomb: nine levels of ten aliases are 10**9 nodes), or that refer to
+  the node they are inside of;
+* integers too large for a float (``float(10**400)`` overflows; Python refuses to
+  convert more than 4300 digits at all).
+
+Numbers follow YAML 1.2 where YAML 1.1 is surprising: ``1e308`` and ``2E-3`` (an
+exponent but no dot) are floats, not strings.
 """
 from __future__ import annotations
 
+import re
+
 import yaml
+from yaml.events import AliasEvent
 
 from mlc.errors import Loc, MlcError
+
+#: Deepest nesting of lists and mappings accepted (mlc's own files nest about 5 deep).
+MAX_DEPTH = 100
+#: Nodes that aliases may add to a document beyond the ones written out.
+MAX_ALIAS_NODES = 1_000_000
+#: Largest integer accepted (anything larger is not a finite float either).
+_MAX_INT = 2 ** 1024
 
 
 class LocDict(dict):
@@ -32,63 +56,156 @@ class LocList(list):
             return self.loc
 
 
-def _mark(node, filename) -> Loc:
-    return Loc(filename, node.start_mark.line + 1, node.start_mark.column + 1)
+def _at(filename, mark) -> Loc:
+    return Loc(filename, mark.line + 1, mark.column + 1) if mark is not None else Loc(filename)
 
 
-def _make_loader(filename: str):
-    class _Loader(yaml.SafeLoader):
-        pass
+class _Loader(yaml.SafeLoader):
+    """SafeLoader with source locations and limits on depth, alias expansion and integers."""
 
-    def construct_mapping(loader, node):
-        loader.flatten_mapping(node)
-        out = LocDict()
-        out.loc = _mark(node, filename)
-        out.item_locs = {}
-        for key_node, value_node in node.value:
-            key = loader.construct_object(key_node, deep=True)
-            try:
-                hash(key)
-            except TypeError:
-                raise MlcError("mapping key is not a scalar", _mark(key_node, filename)) from None
-            if key in out:
-                raise MlcError(f"duplicate key {key!r}", _mark(key_node, filename),
-                               f"first given at line {out.item_locs[key].line}")
-            out[key] = loader.construct_object(value_node, deep=True)
-            out.item_locs[key] = _mark(value_node, filename)
-        return out
+    filename = "<input>"
 
-    def construct_sequence(loader, node):
-        out = LocList(loader.construct_object(child, deep=True) for child in node.value)
-        out.loc = _mark(node, filename)
-        out.item_locs = [_mark(child, filename) for child in node.value]
-        return out
+    def __init__(self, stream, filename: str):
+        super().__init__(stream)
+        self.filename = filename
+        self._depth = 0
+        self._count = 0          # nodes of the document with every alias expanded
+        self._written = 0        # nodes written out in the text
+        self._size: dict = {}    # id(node) -> expanded size of its subtree
 
-    _Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, construct_mapping)
-    _Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_SEQUENCE_TAG, construct_sequence)
-    return _Loader
+    def compose_node(self, parent, index):
+        if self.check_event(AliasEvent):
+            event = self.peek_event()
+            node = super().compose_node(parent, index)
+            size = self._size.get(id(node))
+            if size is None:
+                raise MlcError(f"alias *{event.anchor} refers to a node that contains it",
+                               _at(self.filename, event.start_mark), "a YAML input cannot be recursive")
+            self._count += size
+            if self._count - self._written > MAX_ALIAS_NODES:
+                raise MlcError(f"aliases expand this document to more than {self._written + MAX_ALIAS_NODES:,} "
+                               f"nodes (an alias bomb?)", _at(self.filename, event.start_mark),
+                               f"aliases may add at most {MAX_ALIAS_NODES:,} nodes; write the data out")
+            return node
+        mark = self.peek_event().start_mark
+        self._depth += 1
+        if self._depth > MAX_DEPTH:
+            raise MlcError(f"lists and mappings nested more than {MAX_DEPTH} deep", _at(self.filename, mark),
+                           "flatten the data")
+        before = self._count
+        self._count += 1
+        self._written += 1
+        try:
+            node = super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+        self._size[id(node)] = self._count - before
+        return node
 
 
-def load(text: str, filename: str = "<input>"):
-    """Parse YAML ``text``; syntax errors become :class:`MlcError` at ``file:line:col``."""
+def _construct_mapping(loader, node):
+    loader.flatten_mapping(node)
+    out = LocDict()
+    out.loc = _at(loader.filename, node.start_mark)
+    out.item_locs = {}
+    for key_node, value_node in node.value:
+        key = loader.construct_object(key_node, deep=True)
+        try:
+            hash(key)
+        except TypeError:
+            raise MlcError("mapping key is not a scalar", _at(loader.filename, key_node.start_mark)) from None
+        if key in out:
+            raise MlcError(f"duplicate key {key!r}", _at(loader.filename, key_node.start_mark),
+                           f"first given at line {out.item_locs[key].line}")
+        out[key] = loader.construct_object(value_node, deep=True)
+        out.item_locs[key] = _at(loader.filename, value_node.start_mark)
+    return out
+
+
+def _construct_sequence(loader, node):
+    out = LocList(loader.construct_object(child, deep=True) for child in node.value)
+    out.loc = _at(loader.filename, node.start_mark)
+    out.item_locs = [_at(loader.filename, child.start_mark) for child in node.value]
+    return out
+
+
+def _construct_int(loader, node):
+    value = loader.construct_scalar(node)
+    digits = sum(c.isdigit() for c in value)
+    if digits > 400:   # int() of more than 4300 digits raises; anything over 309 digits is > 1e308
+        raise MlcError(f"integer with {digits} digits is too large", _at(loader.filename, node.start_mark),
+                       "numbers must be below 1.8e308")
+    n = yaml.SafeLoader.construct_yaml_int(loader, node)
+    if abs(n) >= _MAX_INT:
+        raise MlcError(f"integer {value[:20]}{'...' if len(value) > 20 else ''} is too large",
+                       _at(loader.filename, node.start_mark), "numbers must be below 1.8e308")
+    return n
+
+
+_Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_MAPPING_TAG, _construct_mapping)
+_Loader.add_constructor(yaml.resolver.BaseResolver.DEFAULT_SEQUENCE_TAG, _construct_sequence)
+_Loader.add_constructor("tag:yaml.org,2002:int", _construct_int)
+# YAML 1.2 floats that YAML 1.1 reads as strings: an exponent without a dot (1e308, -2E-3).
+_Loader.add_implicit_resolver("tag:yaml.org,2002:float",
+                              re.compile(r"^[-+]?[0-9][0-9_]*[eE][-+]?[0-9]+$"), list("-+0123456789"))
+
+
+def decode(data: bytes, filename: str = "<input>") -> str:
+    """UTF-8 bytes -> text; any other encoding is an :class:`MlcError` at the first bad byte."""
     try:
-        return yaml.load(text, Loader=_make_loader(filename))  # noqa: S506 (SafeLoader subclass)
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as e:
+        head = data[:e.start]
+        line = head.count(b"\n") + 1
+        col = len(head) - (head.rfind(b"\n") + 1) + 1
+        raise MlcError(f"byte 0x{data[e.start]:02x} is not UTF-8 text", Loc(filename, line, col),
+                       "save the file as UTF-8") from None
+
+
+def read_text(path, what: str = "file") -> str:
+    """Read a UTF-8 text file; a missing, unreadable or non-UTF-8 file is an :class:`MlcError`.
+
+    ``what`` names the file in the message ("scene", "profile", ...)."""
+    try:
+        with open(path, "rb") as f:
+            data = f.read()
+    except IsADirectoryError:
+        raise MlcError(f"cannot read {what}: it is a directory", str(path)) from None
+    except OSError as e:
+        raise MlcError(f"cannot read {what}: {e.strerror}", str(path)) from None
+    return decode(data, str(path))
+
+
+def load(text, filename: str = "<input>"):
+    """Parse YAML ``text`` (str, or UTF-8 bytes); every error is an :class:`MlcError` at ``file:line:col``."""
+    if isinstance(text, (bytes, bytearray)):
+        text = decode(bytes(text), filename)
+    loader = None
+    try:
+        loader = _Loader(text, filename)
+        return loader.get_single_data()
     except yaml.MarkedYAMLError as e:
         mark = e.problem_mark or e.context_mark
-        loc = Loc(filename, mark.line + 1, mark.column + 1) if mark else Loc(filename)
-        raise MlcError(f"YAML syntax error: {e.problem or e.context}", loc) from None
+        raise MlcError(f"YAML syntax error: {e.problem or e.context}", _at(filename, mark)) from None
+    except yaml.reader.ReaderError as e:
+        pos = e.position if isinstance(e.position, int) else 0
+        head = text[:pos]
+        loc = Loc(filename, head.count("\n") + 1, pos - (head.rfind("\n") + 1) + 1)
+        c = e.character if isinstance(e.character, int) else 0
+        raise MlcError(f"character U+{c:04X} is not allowed in YAML ({e.reason})", loc,
+                       f"remove it, or write it as the escape \\x{c:02x} inside double quotes") from None
     except yaml.YAMLError as e:  # pragma: no cover - other pyyaml errors carry no mark
         raise MlcError(f"YAML error: {e}", Loc(filename)) from None
+    except RecursionError:  # pragma: no cover - the depth limit stops this first
+        raise MlcError(f"nesting too deep (limit {MAX_DEPTH})", Loc(filename), "flatten the data") from None
+    finally:
+        if loader is not None:
+            loader.dispose()
 
 
-def load_file(path) -> object:
-    """Read and parse a YAML file; a missing or unreadable file is an :class:`MlcError`."""
-    try:
-        with open(path, encoding="utf-8") as f:
-            text = f.read()
-    except OSError as e:
-        raise MlcError(f"cannot read file: {e.strerror}", str(path)) from None
-    return load(text, str(path))
+def load_file(path, what: str = "file") -> object:
+    """Read and parse a YAML file; a missing, unreadable or non-UTF-8 file is an :class:`MlcError`."""
+    return load(read_text(path, what), str(path))
 
 
 def loc_of(container, key) -> Loc | None:

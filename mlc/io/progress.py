@@ -1,0 +1,102 @@
+"""One-line progress on standard error for anything that can take more than a few seconds.
+
+Silent when standard error is not a terminal (logs and pipes stay clean) and for work
+that ends within ``delay`` seconds.  Two forms::
+
+    with Progress("building meshes", total=len(parts)) as bar:   # a bar with an ETA
+        for i, p in enumerate(parts):
+            ...
+            bar.update(i + 1)
+
+    with Progress("computing the design space", expect=30.0):    # no count: a timer
+        slow_call()        # a background thread redraws "label  12 s (about 18 s left)"
+
+``expect`` (seconds) is the typical duration measured on a reference machine; the ETA
+shown is ``expect - elapsed`` (never below zero), so it is an estimate and says so.
+"""
+from __future__ import annotations
+
+import sys
+import threading
+import time
+
+
+class Progress:
+    def __init__(self, label: str, total: int | None = None, expect: float | None = None,
+                 show: bool | None = None, delay: float = 2.0, stream=None):
+        self.label, self.total, self.expect, self.delay = label, total, expect, delay
+        self.stream = stream or sys.stderr
+        if show is None:
+            try:
+                show = bool(self.stream.isatty())
+            except (AttributeError, ValueError):
+                show = False
+        self.show = show
+        self.t0 = time.perf_counter()
+        self.done = 0
+        self.drawn = False
+        self._stop = threading.Event()
+        self._thread = None
+        self._lock = threading.Lock()
+
+    def __enter__(self) -> "Progress":
+        if self.show and self.total is None:
+            self._thread = threading.Thread(target=self._tick, daemon=True)
+            self._thread.start()
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+        return False
+
+    def _tick(self):
+        while not self._stop.wait(0.5):
+            self._draw()
+
+    def update(self, done: int) -> None:
+        """``done`` of ``total`` items finished."""
+        self.done = done
+        if self.show:
+            self._draw()
+
+    def line(self) -> str:
+        """The text of the progress line now (also used by the tests)."""
+        el = time.perf_counter() - self.t0
+        if self.total:
+            frac = min(self.done / self.total, 1.0)
+            eta = el / frac - el if frac > 0 else float("nan")
+            w = 24
+            fill = int(w * frac)
+            eta_s = f"ETA {eta:5.0f} s" if eta == eta else "ETA     ? s"
+            return f"{self.label} [{'#' * fill}{'.' * (w - fill)}] {self.done}/{self.total}  {eta_s}"
+        s = f"{self.label}  {el:4.0f} s"
+        if self.expect:
+            s += f" (about {max(self.expect - el, 0):.0f} s left)"
+        return s
+
+    def _draw(self):
+        el = time.perf_counter() - self.t0
+        if el < self.delay and not self.drawn:
+            return
+        with self._lock:
+            try:
+                self.stream.write("\r" + self.line() + "  ")
+                self.stream.flush()
+            except (OSError, ValueError):
+                self.show = False
+                return
+            self.drawn = True
+
+    def close(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join()
+            self._thread = None
+        with self._lock:
+            if self.drawn:
+                try:
+                    self.stream.write("\r" + self.line() + "  \n")
+                    self.stream.flush()
+                except (OSError, ValueError):
+                    pass
+                self.drawn = False
