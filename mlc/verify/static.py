@@ -82,6 +82,7 @@ class _Problem:
         self.col = np.full(self.N, -1)
         self.col[1:] = np.arange(self.N - 1) * 6                    # body 0 is pinned
         self.n = 6 * max(self.N - 1, 0)
+        self.free = np.arange(1, self.N)
 
     def sites(self):
         A = self.A
@@ -103,8 +104,12 @@ class _Problem:
         out.append(np.sqrt(A.muscle_k) * (np.linalg.norm(dm, axis=1) - L_muscle))
         return np.concatenate(out)
 
-    def jacobian(self):
-        """Sparse d residual / d (t, w) of the free bodies at the current poses."""
+    def jacobian(self, x=None, L_muscle=None):
+        """Sparse d residual / d (t, w) of the free bodies at the current poses (``x``, if
+        given, must be zero: the linearisation is always about the current poses; the
+        muscle lengths do not enter the Jacobian)."""
+        if x is not None and np.any(x):
+            raise ValueError("jacobian() linearises about the current poses: x must be 0")
         A = self.A
         p, rs = self.sites()
         S = len(A.site_body)
