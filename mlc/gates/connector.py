@@ -113,7 +113,7 @@ class ConnectorGeometry:
     def branch_post(self) -> float:
         """Post length that lets pages of a branch, turned 90 degrees apart about one pair,
         clear each other: a little more than the largest half diagonal (sigma)."""
-        return self.reach + 0.1
+        return self.reach + 0.25
 
 
 def connector_geometry(signal: str = "expand", design: Design | None = None,
@@ -203,9 +203,12 @@ def half_unit_parts(prefix: str, centre, axis, tangent, state: int, geo: Connect
         sites = {**axis_sites(x, V[x], t, w), **axis_sites(y, V[y], t, w), post: J[post]}
         body = slab_body(name, [(V[x], V[y])], sites, t, w, geo.thickness)
         # the post: a thin rod from the layer face to the joint site (body frame)
+        # (it stops POST_WIDTH short of the joint site, where the joint part sits)
         face = V[post] + (0.5 * w if post in "DB" else -0.5 * w) * t
-        if np.linalg.norm(J[post] - face) > 1e-9:
-            body.boxes.append(segment_box(face - body.position, J[post] - body.position, u if post in "DB" else v,
+        run = float(np.linalg.norm(J[post] - face))
+        end = J[post] + (face - J[post]) * (POST_WIDTH / run) if run > POST_WIDTH else face
+        if np.linalg.norm(end - face) > 1e-6:
+            body.boxes.append(segment_box(face - body.position, end - body.position, u if post in "DB" else v,
                                           POST_WIDTH, POST_WIDTH))
         parts.bodies.append(body)
     for x, (s1, s2) in {"A": ("DA", "AB"), "B": ("AB", "BC"), "C": ("BC", "CD"), "D": ("CD", "DA")}.items():

@@ -10,9 +10,13 @@ their 3-vector, the others a scalar) is minimised by a damped Gauss-Newton
 (Levenberg-Marquardt) iteration on the sparse normal equations, factorised by SuperLU:
 each iteration linearises about the current poses, a body's update being a translation
 and a rotation vector ``w`` (R <- exp(w) R, d site/d w = -[R s]x), so no rotation
-parametrisation accumulates.  Body 0 is held fixed to remove the six rigid-body modes;
-floppy modes (a connector chain's bending) are handled by the damping, which picks the
-smallest move.  The Jacobian is assembled with numpy, without Python loops over bonds,
+parametrisation accumulates.  No body is pinned.  Zero-energy modes (the six rigid-body
+modes, a connector chain's floppy bending) are fixed by a weak term
+``REG/2 sum_bodies (|dx|^2 + |dw|^2)`` on each body's displacement since the start of the
+continuation step: among all equilibria the solver takes the one reached by the least
+motion, which is what overdamped dynamics does quasi-statically (a floppy mode has no
+force on it, and the drag makes the least-dissipation path the one taken).  ``REG`` is
+small enough (1e-9 k0) that it biases joint stretch by less than 1e-8 sigma.  The Jacobian is assembled with numpy, without Python loops over bonds,
 so a circuit of ~10^4 bodies solves in seconds.  The muscles are moved from the starting
 state to the target in a few continuation steps so that the solution stays on the
 mechanism's physical branch.
@@ -31,6 +35,8 @@ from mlc.scene.model import Scene
 CONTINUATION_STEPS = 4
 GN_MAX_ITER = 60            # Gauss-Newton iterations per continuation step
 GN_TOL = 1e-13              # converged when the largest update (sigma, rad) is below this
+REG = 1e-9                  # k0: weight of the least-motion term on zero-energy modes
+REG_POLISH = 1e-16          # k0: the same in the final polish (removes REG's bias on the pose)
 
 
 @dataclass
@@ -79,10 +85,14 @@ class _Problem:
         self.iv = np.nonzero(self.vec)[0]
         self.isc = np.nonzero(~self.vec)[0]
         self.m = 3 * len(self.iv) + len(self.isc) + len(A.muscle_i)
-        self.col = np.full(self.N, -1)
-        self.col[1:] = np.arange(self.N - 1) * 6                    # body 0 is pinned
-        self.n = 6 * max(self.N - 1, 0)
-        self.free = np.arange(1, self.N)
+        self.col = np.arange(self.N) * 6                            # no body is pinned
+        self.n = 6 * self.N
+        self.free = np.arange(self.N)
+        self.set_reference()
+
+    def set_reference(self):
+        """Start of a continuation step: the least-motion term measures from here."""
+        self.disp = np.zeros((self.N, 6))           # translation and rotation vector since then
 
     def sites(self):
         A = self.A
@@ -166,35 +176,42 @@ class _Problem:
         return sp.csr_matrix((vals, (rows, cols)), shape=(self.m, self.n))
 
     def apply(self, dx):
-        """Move the free bodies by dx = (t, w) per body (R <- exp(w) R)."""
+        """Move the bodies by dx = (t, w) per body (R <- exp(w) R)."""
         d = dx.reshape(-1, 6)
-        self.pos[1:] += d[:, :3]
-        self.R[1:] = _expmap_batch(d[:, 3:]) @ self.R[1:]
+        self.pos += d[:, :3]
+        self.R = _expmap_batch(d[:, 3:]) @ self.R
+        self.disp += d             # rotation vectors add to first order: enough for a weight
 
     def snapshot(self):
-        return self.pos.copy(), self.R.copy()
+        return self.pos.copy(), self.R.copy(), self.disp.copy()
 
     def restore(self, snap):
-        self.pos, self.R = snap[0].copy(), snap[1].copy()
+        self.pos, self.R, self.disp = snap[0].copy(), snap[1].copy(), snap[2].copy()
 
 
-def _minimise(prob: _Problem, L) -> int:
+def _minimise(prob: _Problem, L, reg: float = None) -> int:
     """Levenberg-Marquardt on 0.5 |r|^2 from the current poses; returns the iteration count."""
     from scipy.sparse.linalg import splu
 
+    reg = REG if reg is None else reg
+
+    def total(rr):
+        return 0.5 * float(rr @ rr) + 0.5 * reg * float(np.sum(prob.disp ** 2))
+
+    prob.set_reference()
     r = prob.residuals(L)
-    cost = 0.5 * float(r @ r)
+    cost = total(r)
     lam = 1e-6
     it = 0
     for it in range(1, GN_MAX_ITER + 1):
         if cost < 1e-30:
             break
         J = prob.jacobian()
-        g = J.T @ r
-        H = (J.T @ J).tocsc()
+        g = J.T @ r + reg * prob.disp.ravel()
+        H = (J.T @ J + sp.identity(prob.n, format="csr") * reg).tocsc()
         diag = H.diagonal()
         scale = np.maximum(diag, 1e-12 * max(float(diag.max(initial=0.0)), 1.0))
-        improved = False
+        improved = stalled = False
         for _ in range(12):
             M = (H + sp.diags(lam * scale + 1e-14, format="csc")).tocsc()
             try:
@@ -205,15 +222,16 @@ def _minimise(prob: _Problem, L) -> int:
             snap = prob.snapshot()
             prob.apply(dx)
             r_new = prob.residuals(L)
-            c_new = 0.5 * float(r_new @ r_new)
+            c_new = total(r_new)
             if c_new <= cost:
                 improved = True
+                stalled = (cost - c_new) < 1e-3 * cost
                 r, cost = r_new, c_new
                 lam = max(lam / 5.0, 1e-12)
                 break
             prob.restore(snap)
             lam *= 10.0
-        if not improved or float(np.abs(dx).max(initial=0.0)) < GN_TOL:
+        if not improved or stalled or float(np.abs(dx).max(initial=0.0)) < GN_TOL:
             break
     return it
 
@@ -240,6 +258,7 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
     if prob.m and prob.n:
         for t in path:
             nit += _minimise(prob, L0 + t * (L1 - L0))
+        nit += _minimise(prob, L1, reg=REG_POLISH)     # polish: the least-motion bias removed
     pos, R = prob.pos, prob.R
     p, _ = prob.sites()
     quat = np.array([matrix_to_quat(r) for r in R]) if len(R) else np.zeros((0, 4))
