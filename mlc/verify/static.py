@@ -76,7 +76,9 @@ def _quat_to_matrix_batch(q: np.ndarray) -> np.ndarray:
 class _Problem:
     """Residuals and sparse Jacobian of the bond energy about the current poses."""
 
-    def __init__(self, scene: Scene, pos0, quat0):
+    def __init__(self, scene: Scene, pos0, quat0, pin_first: bool = True):
+        """``pin_first`` holds body 0 fixed (its columns dropped): the rigidity analysis
+        uses that; :func:`equilibrium` pins nothing and uses the least-motion term."""
         self.A = A = scene.arrays()
         self.N = len(pos0)
         self.pos = np.array(pos0, float)
@@ -85,9 +87,10 @@ class _Problem:
         self.iv = np.nonzero(self.vec)[0]
         self.isc = np.nonzero(~self.vec)[0]
         self.m = 3 * len(self.iv) + len(self.isc) + len(A.muscle_i)
-        self.col = np.arange(self.N) * 6                            # no body is pinned
-        self.n = 6 * self.N
-        self.free = np.arange(self.N)
+        self.free = np.arange(1, self.N) if pin_first else np.arange(self.N)
+        self.col = np.full(self.N, -1)
+        self.col[self.free] = np.arange(len(self.free)) * 6
+        self.n = 6 * len(self.free)
         self.set_reference()
 
     def set_reference(self):
@@ -178,9 +181,10 @@ class _Problem:
     def apply(self, dx):
         """Move the bodies by dx = (t, w) per body (R <- exp(w) R)."""
         d = dx.reshape(-1, 6)
-        self.pos += d[:, :3]
-        self.R = _expmap_batch(d[:, 3:]) @ self.R
-        self.disp += d             # rotation vectors add to first order: enough for a weight
+        f = self.free
+        self.pos[f] += d[:, :3]
+        self.R[f] = _expmap_batch(d[:, 3:]) @ self.R[f]
+        self.disp[f] += d            # rotation vectors add to first order: enough for a weight
 
     def snapshot(self):
         return self.pos.copy(), self.R.copy(), self.disp.copy()
@@ -207,7 +211,7 @@ def _minimise(prob: _Problem, L, reg: float = None) -> int:
         if cost < 1e-30:
             break
         J = prob.jacobian()
-        g = J.T @ r + reg * prob.disp.ravel()
+        g = J.T @ r + reg * prob.disp[prob.free].ravel()
         H = (J.T @ J + sp.identity(prob.n, format="csr") * reg).tocsc()
         diag = H.diagonal()
         scale = np.maximum(diag, 1e-12 * max(float(diag.max(initial=0.0)), 1.0))
@@ -251,7 +255,7 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
     A = scene.arrays()
     target = _state_bits(scene, state)
     start = _state_bits(scene, start_state or "0" * len(scene.inputs))
-    prob = _Problem(scene, A.pos if pos is None else pos, A.quat if quat is None else quat)
+    prob = _Problem(scene, A.pos if pos is None else pos, A.quat if quat is None else quat, pin_first=False)
     L0, L1 = A.muscle_lengths(start), A.muscle_lengths(target)
     nit = 0
     path = [1.0] if np.allclose(L0, L1) else np.linspace(0, 1, steps + 1)[1:]
