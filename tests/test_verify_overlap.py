@@ -161,3 +161,65 @@ def test_broad_phase_matches_all_pairs():
     keep = B[i] != B[j]
     c2 = box_clearance(C[i][keep], A[i][keep], H[i][keep], C[j][keep], A[j][keep], H[j][keep])
     assert c2.min() > 0 and r2.min_clearance == pytest.approx(min(c2.min(), r2.reach), abs=1e-12)
+
+
+# ---------------------------------------------------------------------------
+# the gate library (issue 12, item 5)
+# ---------------------------------------------------------------------------
+
+from mlc.gates.library import GATE_NAMES, gate_scene  # noqa: E402
+from mlc.verify.overlap import static_poses, sweep_clearance  # noqa: E402
+
+
+@pytest.mark.parametrize("signal", ["expand", "contract"])
+def test_library_gates_do_not_interpenetrate(signal):
+    """Every gate, every input state and every half-way pose between states: no two slabs
+    of different bodies overlap beyond hinge contact."""
+    worst = []
+    for name in GATE_NAMES:
+        rep, frac, rows = sweep_clearance(gate_scene(name, signal), grid=3)
+        assert len(rows) == 9
+        print(f"{name:8s} {signal:8s} smallest clearance {rep.min_clearance:+.4f} sigma "
+              f"({rep.pair[0]}/{rep.pair[1]}) at strokes {frac}")
+        assert rep.ok() and not rep.overlaps, (name, signal, rep)
+        worst.append(rep.min_clearance)
+    assert min(worst) > 0.01
+
+
+def _old_core_cd(scene):
+    """The former core_cd: its end box at d centred on the core plane again."""
+    import copy
+    s = copy.deepcopy(scene)
+    body = s.body("core_cd")
+    R = body.rotation()
+    body.boxes[1].center = body.boxes[1].center + R.T @ np.array([0.0, 0.0, 0.25])
+    return s
+
+
+def test_output_lever_through_core_cd_is_caught():
+    """The defect of issue 12: with core_cd's end box back in the core plane, out_hi runs
+    through it from the universal joint at d, 0.1-0.2 sigma deep, in the rest pose."""
+    s = _old_core_cd(gate_scene("NIMPLY", "expand"))
+    r = clearance(s)
+    assert not r.ok() and r.overlaps[0][:2] == ("core_cd", "out_hi") and 0.1 < r.overlaps[0][2] < 0.25
+    # and in the actuated states (poses from the fixed gate: the kinematics is the same)
+    pos, quat, stretch = static_poses(gate_scene("NIMPLY", "expand"), [[1, 0]])[0]
+    assert stretch < 1e-6 and not clearance(s, pos, quat).ok()
+
+
+def test_check_gate_reports_clearance_and_fails_on_interpenetration(capsys, monkeypatch):
+    import json
+
+    from mlc.cli import main
+    import mlc.gates.library as lib
+    assert main(["check-gate", "AND", "--signal", "contract", "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["ok"] and d["clearance"][0]["min_clearance"] > 0 and d["clearance"][0]["poses"] == 9
+    assert all(r["clearance"] > 0 for r in d["rows"])
+    orig = lib.gate_scene
+    monkeypatch.setattr(lib, "gate_scene", lambda name, signal="expand", design=None:
+                        _old_core_cd(orig(name, signal, design)))
+    assert main(["check-gate", "AND", "--signal", "contract"]) == 1
+    out = capsys.readouterr().out
+    assert "4 of 4 gate states correct" not in out or "INTERPENETRATE" in out
+    assert "core_cd and out_hi interpenetrate" in out

@@ -14,13 +14,18 @@ def register(sub):
 
     c = sub.add_parser("check-gate", help="verify library gates (static equilibrium, or --dynamic Brownian dynamics)",
                        description="For every input state find the mechanical equilibrium and read the output "
-                                   "probe; exit 1 on any wrong bit. Lengths in sigma.")
+                                   "probe; then test the slabs for interpenetration over the input states and the "
+                                   "half-way poses between them (oriented boxes, hinge contact within 0.05 sigma of "
+                                   "a shared joint left out) and report the smallest clearance. Exit 1 on any wrong "
+                                   "bit or interpenetration. Lengths in sigma.")
     c.add_argument("name", help="gate name, or 'all'")
     c.add_argument("--signal", choices=("expand", "contract", "both"), default="both")
     c.add_argument("--json", action="store_true")
     c.add_argument("--dynamic", action="store_true", help="verify by Brownian dynamics instead of statics")
     c.add_argument("--kT", type=float, default=1e-5, help="thermal energy for --dynamic (k0 sigma^2)")
     c.add_argument("--seeds", type=int, default=4, help="number of seeds for --dynamic")
+    c.add_argument("--grid", type=int, default=3,
+                   help="muscle-stroke lattice per input for the overlap sweep (3: states and half-way poses)")
     c.set_defaults(func=run_check)
 
 
@@ -45,6 +50,7 @@ def _selection(args):
 
 def run_check(args) -> int:
     names, signals = _selection(args)
+    clear = []
     if args.dynamic:
         from mlc.errors import MlcError
         if args.seeds < 1:
@@ -55,23 +61,50 @@ def run_check(args) -> int:
         rows = check_gates_dynamic(names, signals, kT=args.kT, seeds=args.seeds, quiet=args.json)
         mode = "dynamic"
     else:
+        from mlc.errors import MlcError
+        if args.grid < 2:
+            raise MlcError(f"the overlap sweep needs at least 2 points per input, got {args.grid}", "--grid")
         from mlc.gates.library import gate_scene
+        from mlc.verify.overlap import sweep_clearance
         from mlc.verify.static import verify_scene
         rows = []
         for name in names:
             for signal in signals:
-                for r in verify_scene(gate_scene(name, signal)):
-                    rows.append({"gate": name, "signal": signal, **r})
+                scene = gate_scene(name, signal)
+                worst, frac, poses = sweep_clearance(scene, grid=args.grid)
+                at_state = {"".join(str(int(v)) for v in f): rep for f, rep in poses if all(v in (0.0, 1.0) for v in f)}
+                for r in verify_scene(scene):
+                    rep = at_state[r["state"]]
+                    rows.append({"gate": name, "signal": signal, **r, "clearance": rep.min_clearance,
+                                 "ok": bool(r["ok"] and rep.ok())})
+                clear.append({"gate": name, "signal": signal, "min_clearance": worst.min_clearance,
+                              "pair": list(worst.pair), "strokes": list(frac), "poses": len(poses),
+                              "overlaps": [[a, b, d] for a, b, d in worst.overlaps], "ok": worst.ok()})
         mode = "static"
-    ok = all(r["ok"] for r in rows)
+    ok = all(r["ok"] for r in rows) and all(c["ok"] for c in clear)
     if args.json:
-        print(json.dumps({"mode": mode, "ok": ok, "rows": rows}))
+        out = {"mode": mode, "ok": ok, "rows": rows}
+        if clear:
+            out["clearance"] = clear
+        print(json.dumps(out))
     else:
-        print(f"{'gate':8s} {'signal':8s} state exp  measured  margin    stretch   ok")
+        cl = " clearance" if clear else ""
+        print(f"{'gate':8s} {'signal':8s} state exp  measured  margin    stretch{cl}   ok")
         for r in rows:
             st = r.get("joint_stretch")
+            c = f"  {r['clearance']:+8.4f}" if "clearance" in r else ""
             print(f"{r['gate']:8s} {r['signal']:8s} {r['state']:5s}  {r['expected']}  {r['measured']:8.5f}  "
-                  f"{r['margin']:+.4f}  {'-' if st is None else format(st, '.1e'):>8s}  {'ok' if r['ok'] else 'WRONG'}")
+                  f"{r['margin']:+.4f}  {'-' if st is None else format(st, '.1e'):>8s}{c}  {'ok' if r['ok'] else 'WRONG'}")
         bad = sum(not r["ok"] for r in rows)
         print(f"{mode} check: {len(rows) - bad} of {len(rows)} gate states correct")
+        if clear:
+            w = min(clear, key=lambda c: c["min_clearance"])
+            nbad = sum(not c["ok"] for c in clear)
+            print(f"slab overlap: smallest clearance {w['min_clearance']:+.4f} sigma ({w['pair'][0]}/{w['pair'][1]}, "
+                  f"{w['gate']} {w['signal']}, strokes {tuple(w['strokes'])}) over {sum(c['poses'] for c in clear)} "
+                  f"poses; {'no interpenetration' if not nbad else f'{nbad} gate(s) INTERPENETRATE'}")
+            for c in clear:
+                for a, b, d in c["overlaps"]:
+                    print(f"  {c['gate']} {c['signal']}: {a} and {b} interpenetrate {d:.4f} sigma deep "
+                          f"at strokes {tuple(c['strokes'])}")
     return 0 if ok else 1

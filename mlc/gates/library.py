@@ -43,6 +43,7 @@ SIGNALS = ("expand", "contract")
 GATE_NAMES = ("AND", "NAND", "OR", "NOR", "NIMPLY", "CNIMPLY", "IMPLY", "CIMPLY")
 _EZ = np.array([0.0, 0.0, 1.0])
 _EX = np.array([1.0, 0.0, 0.0])
+CD_OFFSET = 0.6        # length (in units of Design.rest) of core_cd's offset end box at d
 
 
 @dataclass(frozen=True)
@@ -257,7 +258,12 @@ def gate_scene(name: str, signal: str = "expand", design: Design | None = None) 
     bodies.append(_body("core_ab", [(P["a"], P["b"])],
                         {**axis_sites("a", P["a"], _EZ, w), **axis_sites("b", P["b"], _EZ, w),
                          **axis_sites("m", m, _EX, w)}, _EZ, d))
-    bodies.append(_body("core_cd", [(P["c"], P["d"])],
+    # core_cd: full width at the hinge c; its last CD_OFFSET sigma towards d is shifted to
+    # z <= 0 so that the output lever, which leaves d towards +z, never crosses it
+    ucd = (P["d"] - P["c"]) / np.linalg.norm(P["d"] - P["c"])
+    q = P["d"] - CD_OFFSET * d.rest * ucd
+    off = -0.5 * w * _EZ
+    bodies.append(_body("core_cd", [(P["c"], q), (q + off, P["d"] + off)],
                         {**axis_sites("c", P["c"], _EZ, w), "d": P["d"]}, _EZ, d))
 
     muscles = []

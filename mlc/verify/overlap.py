@@ -383,3 +383,44 @@ def clearance(scene: Scene, pos=None, quat=None, *, skip_joined_contact: bool = 
         best = reach
     i, j = sorted((int(pb[0][best_x]), int(pb[1][best_x])))
     return ClearanceReport(best, (names[i], names[j]), overlaps, P, len(joined), reach, hinge_radius)
+
+
+# ---------------------------------------------------------------------------
+# sweeps over quasi-static poses
+# ---------------------------------------------------------------------------
+
+def static_poses(scene: Scene, fractions):
+    """Equilibrium poses of ``scene`` with every input's muscles at a fraction of their
+    stroke (0 = rest, 1 = actuated), one pose per row of ``fractions`` (shape (F, inputs)),
+    each reached from the scene's own (all-zero) pose by the static solver's continuation
+    (mlc.verify.static.equilibrium on a copy whose actuated lengths are the partial
+    strokes).  Returns a list of (pos, quat, max joint stretch in sigma)."""
+    import copy
+    import dataclasses
+
+    from mlc.verify.static import equilibrium
+
+    out = []
+    for f in np.atleast_2d(np.asarray(fractions, float)):
+        s = copy.copy(scene)
+        frac = dict(zip(scene.inputs, f))
+        s.muscles = [dataclasses.replace(m, actuated=m.rest + frac[m.input] * (m.actuated - m.rest))
+                     for m in scene.muscles]
+        eq = equilibrium(s, "1" * len(scene.inputs))
+        out.append((eq.pos, eq.quat, eq.max_joint_stretch))
+    return out
+
+
+def sweep_clearance(scene: Scene, grid: int = 3, **kw):
+    """Clearance of ``scene`` over the quasi-static poses with the input muscles on a
+    ``grid`` x ... x ``grid`` lattice of stroke fractions (grid = 3: the input states and
+    every half-way pose between them).  Returns (worst report, fractions of the worst
+    pose, list of (fractions, report))."""
+    n = len(scene.inputs)
+    ticks = np.linspace(0, 1, grid)
+    fr = np.array(np.meshgrid(*([ticks] * n), indexing="ij")).reshape(n, -1).T if n else np.zeros((1, 0))
+    rows = []
+    for f, (pos, quat, _) in zip(fr, static_poses(scene, fr)):
+        rows.append((tuple(float(v) for v in f), clearance(scene, pos, quat, **kw)))
+    worst = min(rows, key=lambda r: r[1].min_clearance)
+    return worst[1], worst[0], rows
