@@ -259,11 +259,12 @@ def gate_scene(name: str, signal: str = "expand", design: Design | None = None) 
                         {**axis_sites("a", P["a"], _EZ, w), **axis_sites("b", P["b"], _EZ, w),
                          **axis_sites("m", m, _EX, w)}, _EZ, d))
     # core_cd: full width at the hinge c; its last CD_OFFSET sigma towards d is shifted to
-    # z <= 0 so that the output lever, which leaves d towards +z, never crosses it
+    # z <= 0 so that the output lever, which leaves d towards +z, never crosses it (the two
+    # boxes overlap over w/2 along cd, so the body is one solid)
     ucd = (P["d"] - P["c"]) / np.linalg.norm(P["d"] - P["c"])
     q = P["d"] - CD_OFFSET * d.rest * ucd
     off = -0.5 * w * _EZ
-    bodies.append(_body("core_cd", [(P["c"], q), (q + off, P["d"] + off)],
+    bodies.append(_body("core_cd", [(P["c"], q), (q - 0.5 * w * ucd + off, P["d"] + off)],
                         {**axis_sites("c", P["c"], _EZ, w), "d": P["d"]}, _EZ, d))
 
     muscles = []
