@@ -77,6 +77,23 @@ def _quiet_stdout(stream) -> None:
         pass
 
 
+def _decode_error(e: UnicodeDecodeError) -> str:
+    """One line for a non-UTF-8 input file: the file (when a caller frame names it), line, column."""
+    data = e.object if isinstance(e.object, (bytes, bytearray)) else b""
+    head = data[:e.start]
+    line, col = head.count(b"\n") + 1, len(head) - (head.rfind(b"\n") + 1) + 1
+    name = None
+    tb = e.__traceback__
+    while tb is not None:                   # innermost frame with a `path` local wins
+        p = tb.tb_frame.f_locals.get("path")
+        if isinstance(p, (str, os.PathLike)):
+            name = os.fspath(p)
+        tb = tb.tb_next
+    where = f"{name}:{line}:{col}" if name else f"input file, line {line}, column {col}"
+    byte = f"byte 0x{data[e.start]:02x}" if e.start < len(data) else "a byte"
+    return f"{where}: {byte} is not UTF-8 text (save the file as UTF-8)"
+
+
 def main(argv=None) -> int:
     if sys.stdout is None:       # started as `mlc ... >&-`
         if sys.stderr is not None:
@@ -122,6 +139,9 @@ def _main(argv) -> int:
         return 130
     except BrokenPipeError:
         raise
+    except UnicodeDecodeError as e:     # a file read as UTF-8 outside mlc.io.yamlsrc.read_text
+        sys.stderr.write(f"mlc: error: {_decode_error(e)}\n")
+        return 2
     except MemoryError:
         sys.stderr.write("mlc: error: out of memory (try a smaller input or fewer outputs)\n")
         return 2

@@ -208,6 +208,9 @@ class Outputs:
             st = os.stat(p)
         except FileNotFoundError:
             st = None
+        except NotADirectoryError:
+            blocker = next(a for a in reversed(p.absolute().parents) if a.exists() and not a.is_dir())
+            raise out.error(f"{blocker} is not a directory", "choose another location") from None
         except OSError as e:
             raise out.error(f"cannot use: {_why(e)}", _fix_for(e)) from None
         if st is not None and stat.S_ISDIR(st.st_mode):

@@ -1,0 +1,435 @@
+"""Hostile inputs through the CLI (issue 14): bad output paths, hostile YAML, broken mesh
+files, extreme parameters, closed or full standard output.
+
+Every case must end in one clear line on stderr (``mlc: error: ...`` naming the file or
+option), a non-zero exit, no traceback, and nothing written: the output directory holds
+exactly what it held before (no partial file, no staging leftovers).  Commands run
+in-process through ``mlc.cli.main``; only the standard-output cases need a subprocess.
+"""
+import json
+import os
+import random
+import struct
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from mlc.cli import main
+from mlc.errors import MlcError
+from mlc.io import yamlsrc
+from mlc.io.outputs import Outputs
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def run(capsys, *argv):
+    code = main([str(a) for a in argv])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def listing(d: Path) -> dict:
+    return {str(p.relative_to(d)): p.read_bytes() for p in sorted(d.rglob("*")) if p.is_file()}
+
+
+def assert_clean_failure(code, err, before, d, *words):
+    """Exit 2, one line starting 'mlc: error:', containing ``words``, and ``d`` unchanged."""
+    assert code == 2, err
+    assert err.startswith("mlc: error: ") and err.count("\n") == 1, err
+    assert "Traceback" not in err
+    for w in words:
+        assert w in err, (w, err)
+    assert listing(d) == before, "something was written"
+
+
+def tetra_stl() -> bytes:
+    """A binary STL of one tetrahedron (4 triangles)."""
+    v = [(0, 0, 0), (10, 0, 0), (0, 10, 0), (0, 0, 10)]
+    tris = [(0, 2, 1), (0, 1, 3), (0, 3, 2), (1, 2, 3)]
+    body = b"".join(struct.pack("<12fH", 0, 0, 0, *v[a], *v[b], *v[c], 0) for a, b, c in tris)
+    return b"\0" * 80 + struct.pack("<I", len(tris)) + body
+
+
+@pytest.fixture(scope="module")
+def scene_text():
+    from mlc.gates.library import gate_scene
+    from mlc.scene.io import dump_scene
+    return dump_scene(gate_scene("NAND", "expand"))
+
+
+# ---------------------------------------------------------------------------------------
+# hostile YAML: one file:line error from yamlsrc, for every loader (scene via `draw`)
+# ---------------------------------------------------------------------------------------
+
+def _bomb(levels=9, width=10):
+    s = "meta:\n  l0: &l0 [" + ", ".join(["lol"] * width) + "]\n"
+    for i in range(1, levels):
+        s += f"  l{i}: &l{i} [" + ", ".join([f"*l{i - 1}"] * width) + "]\n"
+    return s
+
+
+def _insert_meta(scene_text, block: str) -> str:
+    """Put ``block`` (a `meta:` mapping) in place of the scene's meta mapping."""
+    head, rest = scene_text.split("\nmeta:\n", 1)
+    lines = rest.splitlines(keepends=True)
+    i = next(k for k, l in enumerate(lines) if not l.startswith(" "))
+    return head + "\n" + block + "".join(lines[i:])
+
+
+HOSTILE = {
+    # name: (text maker, words expected in the error)
+    "alias_bomb": (lambda t: _insert_meta(t, _bomb()), ["alias", "1,000,000"]),
+    "recursive_alias": (lambda t: _insert_meta(t, "meta:\n  r: &r [1, *r]\n"), ["refers to a node that contains it"]),
+    "deep_lists": (lambda t: _insert_meta(t, "meta:\n  d: " + "[" * 5000 + "]" * 5000 + "\n"), ["nested more than"]),
+    "deep_maps": (lambda t: _insert_meta(t, "meta:\n  d: " + "{a: " * 3000 + "1" + "}" * 3000 + "\n"),
+                  ["nested more than"]),
+    "int_5000_digits": (lambda t: _insert_meta(t, "meta:\n  n: " + "7" * 5000 + "\n"), ["5000 digits"]),
+    "int_over_float": (lambda t: _insert_meta(t, "meta:\n  n: 1" + "0" * 330 + "\n"), ["too large"]),
+    "hex_int_huge": (lambda t: _insert_meta(t, "meta:\n  n: 0x" + "f" * 300 + "\n"), ["too large"]),
+    "float_overflow": (lambda t: t.replace("  k: 1.0", "  k: 1e400", 1), ["finite"]),
+    "nan": (lambda t: t.replace("  k: 1.0", "  k: .nan", 1), ["finite"]),
+    "control_char": (lambda t: t.replace("name: NAND_expand", "name: NAND\x07", 1), ["U+0007"]),
+    "tab_indent": (lambda t: t.replace("\n  sigma:", "\n\tsigma:", 1), ["YAML syntax error"]),
+    "two_documents": (lambda t: t + "---\nmlc_scene: 1\n", ["YAML syntax error"]),
+    "duplicate_key": (lambda t: t.replace("name: NAND_expand\n", "name: a\nname: b\n", 1), ["duplicate key"]),
+    "not_a_mapping": (lambda t: "- 1\n- 2\n", ["mapping"]),
+    "empty": (lambda t: "", ["mapping"]),
+    "python_tag": (lambda t: t.replace("name: NAND_expand", "name: !!python/object:os.system x", 1),
+                   ["YAML syntax error"]),
+}
+
+
+@pytest.mark.parametrize("case", sorted(HOSTILE))
+def test_hostile_scene_yaml_through_draw(case, scene_text, tmp_path, capsys):
+    make, words = HOSTILE[case]
+    src = tmp_path / "in" / f"{case}.yaml"
+    src.parent.mkdir()
+    src.write_text(make(scene_text), encoding="utf-8")
+    out = tmp_path / "out"
+    out.mkdir()
+    before = listing(out)
+    code, _, err = run(capsys, "draw", src, "-o", out / "x.png")
+    assert_clean_failure(code, err, before, out, f"{src}", *words)
+    if case not in ("not_a_mapping", "empty"):
+        assert f"{src}:" in err and err.split(f"{src}:")[1][0].isdigit(), err   # file:line
+
+
+def test_non_utf8_scene_gives_line_and_column(scene_text, tmp_path, capsys):
+    src = tmp_path / "latin1.yaml"
+    src.write_bytes(scene_text.replace("name: NAND_expand", "name: NAND_\xe9", 1).encode("latin-1"))
+    line = 1 + scene_text.split("name: NAND_expand")[0].count("\n")
+    before = listing(tmp_path)
+    code, _, err = run(capsys, "draw", src, "-o", tmp_path / "x.png")
+    assert_clean_failure(code, err, before, tmp_path, f"{src}:{line}:12:", "0xe9", "UTF-8")
+    # every loader that reads a scene file gets the same answer (simulate reads it itself)
+    code, _, err = run(capsys, "simulate", src, "--time", "1")
+    assert_clean_failure(code, err, before, tmp_path, f"{src}:{line}:12:", "0xe9")
+
+
+def test_yaml_1_2_floats_without_a_dot_are_numbers(scene_text):
+    from mlc.scene.io import parse_scene
+    s = parse_scene(scene_text.replace("  k: 1.0", "  k: 1e3", 1).replace("  k: 1.0", "  k: 2E-1", 1), "f.yaml")
+    assert [b.k for b in s.bonds[:2]] == [1000.0, 0.2]
+    assert yamlsrc.load("a: 1e308\nb: -2e-3\nc: +5E2\nd: 1e\ne: e5\n") == \
+        {"a": 1e308, "b": -0.002, "c": 500.0, "d": "1e", "e": "e5"}
+
+
+def test_alias_limit_allows_ordinary_reuse():
+    # anchors used for reuse (not a bomb) still load, and share the value
+    d = yamlsrc.load("base: &b {x: 1, y: [1, 2, 3]}\n" + "".join(f"k{i}: *b\n" for i in range(1000)))
+    assert len(d) == 1001 and d["k999"]["y"] == [1, 2, 3]
+    # a bomb just over the limit fails, at the line of the alias that crossed it
+    with pytest.raises(MlcError) as e:
+        yamlsrc.load(_bomb(levels=7, width=10), "b.yaml")      # 10**7 nodes
+    assert str(e.value).startswith("b.yaml:7:")
+
+
+def test_yaml_fuzz_only_mlc_errors(scene_text):
+    """Seeded random damage to a valid scene: parse to a Scene or raise MlcError, nothing else."""
+    from mlc.scene.io import parse_scene
+    rng = random.Random(14)
+    lines = scene_text.splitlines(keepends=True)
+    values = ["-1", "0", "1e308", "1e400", ".nan", "-.inf", "null", "[]", "{}", "'x'", "9" * 400, "true",
+              "[1e308, 1e308, 1e308]", "0x10", "*nope", "&a", "!!binary AAAA", "2001-12-14", "[[[[1]]]]"]
+    errors = 0
+    for i in range(60):
+        kind = i % 4
+        if kind == 0:          # a value replaced by a hostile one
+            j = rng.randrange(len(lines))
+            l = lines[j]
+            k = l.find(":")
+            l = (l[:k + 1] + " " + rng.choice(values) + "\n") if k >= 0 else rng.choice(values) + "\n"
+            text = "".join(lines[:j] + [l] + lines[j + 1:])
+        elif kind == 1:        # truncated
+            text = scene_text[:rng.randrange(len(scene_text))]
+        elif kind == 2:        # random bytes
+            b = bytearray(scene_text.encode())
+            for _ in range(3):
+                b[rng.randrange(len(b))] = rng.randrange(256)
+            text = bytes(b)
+        else:                  # a line duplicated somewhere else
+            j, k = rng.randrange(len(lines)), rng.randrange(len(lines))
+            text = "".join(lines[:j] + [lines[k]] + lines[j:])
+        try:
+            parse_scene(text, "fuzz.yaml")
+        except MlcError as e:
+            errors += 1
+            assert str(e).startswith("fuzz.yaml"), str(e)
+    assert errors >= 30        # the damage is real: most mutants are refused
+
+
+# ---------------------------------------------------------------------------------------
+# output paths: checked before the work, all or nothing
+# ---------------------------------------------------------------------------------------
+
+@pytest.fixture
+def mesh(tmp_path):
+    p = tmp_path / "src" / "tetra.stl"
+    p.parent.mkdir()
+    p.write_bytes(tetra_stl())
+    return p
+
+
+def test_draw_mesh_writes_png(mesh, tmp_path, capsys):
+    png = tmp_path / "t.png"
+    code, out, err = run(capsys, "draw", "--mesh", mesh, "-o", png)
+    assert code == 0 and png.read_bytes()[:8] == b"\x89PNG\r\n\x1a\n" and out == f"wrote {png}\n"
+    assert not [p for p in tmp_path.iterdir() if p.name.startswith(".mlc-")]
+
+
+BAD_OUTPUTS = {
+    # name: (output path maker, words)
+    "is_directory": (lambda d: d, ["is a directory"]),
+    "missing_directory": (lambda d: d / "no" / "x.png", ["does not exist", "create it first"]),
+    "read_only_fs": (lambda d: Path("/proc/mlc-test.png"), ["cannot write in /proc"]),
+    "jpg_name": (lambda d: d / "x.jpg", ["must end in .png"]),
+    "no_suffix": (lambda d: d / "x", ["must end in .png"]),
+    "dev_full": (lambda d: Path("/dev/full"), ["No space left"]),
+    "empty": (lambda d: "", ["empty output path"]),
+    "parent_is_file": (lambda d: d / "f.txt" / "x.png", ["not a directory"]),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_OUTPUTS))
+def test_draw_bad_output(case, mesh, tmp_path, capsys):
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "f.txt").write_text("keep")
+    before = listing(out)
+    make, words = BAD_OUTPUTS[case]
+    code, _, err = run(capsys, "draw", "--mesh", mesh, "-o", make(out))
+    assert_clean_failure(code, err, before, out, "-o", *words)
+
+
+@pytest.mark.parametrize("argv,words", [
+    (["--plot", "{d}/a.png", "--data", "{d}/a.png"], ["must end in .json"]),
+    (["--plot", "{d}/a.png", "--data", "{d}/sub/a.json"], ["--data", "does not exist"]),
+    (["--plot", "/proc/fig.png"], ["--plot", "cannot write in /proc"]),
+    (["--data", "{d}"], ["--data", "is a directory"]),
+    (["--plot", "{d}/a.jpg"], ["--plot", "must end in .png"]),
+    (["--plot", "{d}/a.png", "--din", "5"], ["accessible range"]),
+    (["--plot", "{d}/a.png", "--din", "nan"], ["din"]),
+])
+def test_core_outputs_checked_before_the_work(argv, words, tmp_path, capsys):
+    """Each fails at once (the design space takes ~30 s): the checks come first."""
+    before = listing(tmp_path)
+    code, _, err = run(capsys, "core", *[a.format(d=tmp_path) for a in argv])
+    assert_clean_failure(code, err, before, tmp_path, *words)
+
+
+def test_outputs_all_or_nothing(tmp_path):
+    d = tmp_path
+    (d / "old.json").write_text("old")
+    # an exception during the work: nothing written, the old file kept, no staging left
+    outs = Outputs()
+    a = outs.file(d / "a.png", "--a")
+    b = outs.file(d / "old.json", "--b")
+    with pytest.raises(KeyboardInterrupt):
+        with outs:
+            a.write_bytes(b"A")
+            b.write_text("new")
+            raise KeyboardInterrupt
+    assert listing(d) == {"old.json": b"old"}
+    # a move that fails half way (the second target became a directory after the checks):
+    # the first file is taken back and the overwritten one restored
+    outs = Outputs()
+    a = outs.file(d / "old.json", "--a")
+    b = outs.file(d / "b.png", "--b")
+    with pytest.raises(MlcError) as e:
+        with outs:
+            a.write_text("new")
+            b.write_bytes(b"B")
+            (d / "b.png").mkdir()
+            (d / "b.png" / "x").write_text("blocks the rename")
+    assert "--b" in str(e.value)
+    assert listing(d) == {"old.json": b"old", "b.png/x": b"blocks the rename"}
+    assert not [p for p in d.iterdir() if p.name.startswith(".mlc-")]
+
+
+def test_outputs_directory_and_duplicates(tmp_path):
+    inp = tmp_path / "scene.yaml"
+    inp.write_text("x")
+    with pytest.raises(MlcError, match="is an input"):
+        o = Outputs(inputs=[inp])
+        o.file(tmp_path / "." / "scene.yaml", "-o")
+        o.check()
+    with pytest.raises(MlcError, match="also the output of -o"):
+        o = Outputs()
+        o.file(tmp_path / "x.json", "-o")
+        o.file(tmp_path / "sub" / ".." / "x.json", "--report", parents=True)
+        o.check()
+    # a directory output is created with its parents at the end; a file written into it by
+    # another option as well is refused before anything moves
+    o = Outputs()
+    parts = o.directory(tmp_path / "p" / "q", "--parts")
+    clash = o.file(tmp_path / "p" / "q" / "a.stl", "--stl", parents=True)
+    with pytest.raises(MlcError, match="--stl also writes|--parts also writes"):
+        with o:
+            parts.write_bytes("a.stl", b"1")
+            clash.write_bytes(b"2")
+    assert listing(tmp_path) == {"scene.yaml": b"x"} and not (tmp_path / "p").exists()
+    o = Outputs()
+    parts = o.directory(tmp_path / "p" / "q", "--parts")
+    with o:
+        parts.write_bytes("a.stl", b"1")
+        parts.write_bytes("sub/b.stl", b"2")
+    assert listing(tmp_path / "p") == {"q/a.stl": b"1", "q/sub/b.stl": b"2"}
+    assert sorted(o.written) == sorted([str(tmp_path / "p/q/a.stl"), str(tmp_path / "p/q/sub/b.stl")])
+
+
+def test_outputs_special_files_are_written_not_replaced(tmp_path):
+    st = os.stat("/dev/null")
+    o = Outputs()
+    f = o.file("/dev/null", "-o", suffixes=(".png",))      # special files need no suffix
+    with o:
+        f.write_bytes(b"x" * 1000)
+    after = os.stat("/dev/null")
+    assert (after.st_mode, after.st_rdev, after.st_ino) == (st.st_mode, st.st_rdev, st.st_ino)
+
+
+# ---------------------------------------------------------------------------------------
+# draw: target and mesh arguments
+# ---------------------------------------------------------------------------------------
+
+BAD_MESHES = {
+    "random_bytes": (bytes(random.Random(3).randrange(256) for _ in range(3000)), ["not an STL or 3MF"]),
+    "text": (b"hello world\n", ["not an STL or 3MF"]),
+    "empty": (b"", ["not an STL or 3MF"]),
+    "ascii_no_facets": (b"solid x\nendsolid x\n", ["no triangles"]),
+    "ascii_with_binary": (b"solid x\n\xff\xfe\x00facet", ["binary bytes"]),
+    "binary_zero_triangles": (b"\0" * 80 + b"\0\0\0\0", ["no triangles"]),
+    "binary_too_many": (b"\0" * 80 + struct.pack("<I", 400_001) + b"\0" * 50 * 400_001, ["too many"]),
+}
+
+
+@pytest.mark.parametrize("case", sorted(BAD_MESHES))
+def test_draw_bad_mesh(case, tmp_path, capsys):
+    data, words = BAD_MESHES[case]
+    src = tmp_path / f"{case}.stl"
+    src.write_bytes(data)
+    before = listing(tmp_path)
+    code, _, err = run(capsys, "draw", "--mesh", src, "-o", tmp_path / "x.png")
+    assert_clean_failure(code, err, before, tmp_path, str(src), *words)
+
+
+def test_draw_argument_conflicts(mesh, tmp_path, capsys):
+    before = listing(tmp_path)
+    for argv, words in [
+        (["NAND", "--mesh", mesh], ["--mesh", "not both"]),
+        ([], ["nothing to draw"]),
+        (["--mesh", tmp_path / "missing.stl"], ["not found"]),
+        (["--mesh", tmp_path], ["directory"]),
+        (["--mesh", tmp_path / "bad.3mf"], ["not found"]),
+        (["XOR"], ["no library gate", "NAND"]),
+        (["NAND", "--signal", "sideways"], ["invalid choice"]),
+    ]:
+        code, _, err = run(capsys, "draw", *argv, "-o", tmp_path / "x.png")
+        assert code == 2 and "Traceback" not in err, (argv, err)
+        assert err.strip().splitlines()[-1].startswith("mlc: error: "), (argv, err)
+        for w in words:
+            assert w in err, (argv, err)
+        assert listing(tmp_path) == before
+    bad3mf = tmp_path / "bad.3mf"
+    bad3mf.write_bytes(b"PK\x03\x04 not really a zip")
+    code, _, err = run(capsys, "draw", "--mesh", bad3mf, "-o", tmp_path / "x.png")
+    assert code == 2 and "not a 3MF" in err and not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.parametrize("din,h", [("nan", "2"), ("inf", "2"), ("-1", "2"), ("1e308", "2"), ("0.5", "0"),
+                                   ("0.5", "1e308"), ("0.5", "-inf")])
+def test_core_extreme_parameters(din, h, capsys):
+    code, out, err = run(capsys, "core", f"--din={din}", f"--h={h}")
+    assert code == 2 and out == "" and err.startswith("mlc: error: --din/--h: ") and err.count("\n") == 1, err
+
+
+# ---------------------------------------------------------------------------------------
+# standard output: closed, full, broken pipe; unexpected exceptions
+# ---------------------------------------------------------------------------------------
+
+def _mlc(args, **kw):
+    code = f"import sys; from mlc.cli import main; sys.exit(main({args!r}))"
+    return subprocess.run([sys.executable, "-c", code], capture_output=False, stderr=subprocess.PIPE,
+                          text=True, timeout=120, **kw)
+
+
+def test_stdout_closed_and_full():
+    r = subprocess.run(["sh", "-c", f"'{sys.executable}' -c 'import sys; from mlc.cli import main; "
+                                    f"sys.exit(main([\"info\"]))' >&-"], stderr=subprocess.PIPE, text=True,
+                       timeout=120)
+    assert r.returncode == 2 and r.stderr == "mlc: error: standard output is closed " \
+                                             "(redirect it, e.g. >/dev/null)\n"
+    with open("/dev/full", "w") as full:
+        r = _mlc(["gate", "NAND"], stdout=full)
+    assert r.returncode == 2 and "No space left on device" in r.stderr and r.stderr.count("\n") == 1, r.stderr
+
+
+def test_broken_pipe_is_quiet(monkeypatch, capsys):
+    class Gone:
+        def write(self, s):
+            raise BrokenPipeError(32, "Broken pipe")
+
+        def flush(self):
+            raise BrokenPipeError(32, "Broken pipe")
+
+    monkeypatch.setattr(sys, "stdout", Gone())
+    assert main(["info"]) == 0
+    assert capsys.readouterr().err == ""
+
+
+def test_unexpected_exception_is_one_line(monkeypatch, capsys):
+    import mlc.commands.version as version
+
+    def boom(args):
+        raise ValueError("an mlc bug")
+
+    monkeypatch.setattr(version, "run", boom)       # main() builds the parser, so it takes boom
+    code, _, err = run(capsys, "info")
+    assert code == 3 and err.count("\n") == 1 and "internal error: ValueError: an mlc bug" in err
+    assert "MLC_TRACEBACK=1" in err
+
+
+def test_info_json(capsys):
+    code, out, _ = run(capsys, "info", "--json")
+    d = json.loads(out)
+    assert code == 0 and Path(d["stdlib_gates"], "nand.yaml").is_file()
+
+
+def test_argparse_errors_return_2_in_process(capsys):
+    code, _, err = run(capsys, "core", "--din", "half")
+    assert code == 2 and "invalid float value" in err
+
+
+# ---------------------------------------------------------------------------------------
+# packaging: every data directory of mlc/ ships
+# ---------------------------------------------------------------------------------------
+
+def test_every_data_directory_is_a_listed_package():
+    import tomllib
+    conf = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    listed = set(conf["tool"]["setuptools"]["packages"])
+    assert isinstance(conf["project"]["license"], str)      # SPDX string, not the deprecated table
+    dirs = {".".join(p.parent.relative_to(ROOT).parts) for p in (ROOT / "mlc").rglob("*")
+            if p.is_file() and "__pycache__" not in p.parts}
+    assert dirs - listed == set(), "add these to [tool.setuptools] packages in pyproject.toml"
