@@ -30,6 +30,10 @@ class _Dec:
         self.memo: dict[tuple[int, int], tuple[int, object]] = {}
         self.vars = [T.var(n, i) for i in range(n)]
         self.shannon_limit = {1: 6, 2: 9, 3: 11}.get(effort, 6)
+        # functions already built (by earlier outputs): (f, care) -> plan; reusing one
+        # costs nothing, so a step whose remainder is available is preferred
+        self.avail: dict[tuple[int, int], object] = {}
+        self._key: dict[int, tuple[int, int]] = {}
 
     # -------------------------------------------------------------- analysis
     def reduce_support(self, f: int, care: int) -> tuple[int, int, list[int]]:
@@ -59,7 +63,50 @@ class _Dec:
             return r
         r = self._rec(f, care)
         self.memo[key] = r
+        self._key[id(r[1])] = key
         return r
+
+    def shared_step(self, f: int, care: int, sup: list[int]):
+        """A one-step decomposition ``x op g`` whose remainder ``g`` (or its
+        complement) an earlier output has already built: (cost, plan) or None."""
+        if not self.avail:
+            return None
+        n = self.n
+        off = care & ~f
+        best = None
+        for i in sup:
+            on0, on1 = T.cof0(f, n, i), T.cof1(f, n, i)
+            of0, of1 = T.cof0(off, n, i), T.cof1(off, n, i)
+            c0, c1 = T.cof0(care, n, i), T.cof1(care, n, i)
+            x = 2 * (i + 1)
+            steps = []
+            if on0 == 0:
+                steps.append((1, "and", x, on1, c1))
+            if on1 == 0:
+                steps.append((1, "and", x ^ 1, on0, c0))
+            if of1 == 0:
+                steps.append((1, "or", x, on0, c0))
+            if of0 == 0:
+                steps.append((1, "or", x ^ 1, on1, c1))
+            if on0 & on1 == 0 and of0 & of1 == 0:
+                steps.append((3, "xor", x, on0 | of1, c0 | c1))
+            for cost, kind, lit, g, gc in steps:
+                g &= gc
+                p = self._find_avail(g, gc)
+                if p is not None and (best is None or cost < best[0]):
+                    best = (cost, (kind, lit, p))
+        return best
+
+    def _find_avail(self, g: int, gc: int):
+        """A built plan computing ``g`` on the care set ``gc``, or its complement
+        (as a ("not", plan)); exact care match only."""
+        p = self.avail.get((g, gc))
+        if p is not None:
+            return p
+        p = self.avail.get((gc & ~g, gc))
+        if p is not None:
+            return ("not", p)
+        return None
 
     def _rec(self, f: int, care: int):
         n, full = self.n, self.full
@@ -74,8 +121,12 @@ class _Dec:
                 return 0, ("lit", 2 * (i + 1))
             if (~self.vars[i]) & care == f:
                 return 0, ("lit", 2 * (i + 1) + 1)
+        sh = self.shared_step(f, care, sup)
         if len(sup) <= 4:
-            return self.exact(f, care, sup)
+            ex = self.exact(f, care, sup)
+            return sh if sh is not None and sh[0] < ex[0] else ex
+        if sh is not None:
+            return sh
         off = care & ~f
         # disjoint-support steps
         for i in sup:
@@ -175,7 +226,16 @@ class _Dec:
 
     # -------------------------------------------------------------- building
     def build(self, g: AIG, plan) -> int:
+        lit = self._build(g, plan)
+        key = self._key.get(id(plan))
+        if key is not None:
+            self.avail.setdefault(key, plan)
+        return lit
+
+    def _build(self, g: AIG, plan) -> int:
         kind = plan[0]
+        if kind == "not":
+            return self.build(g, plan[1]) ^ 1
         if kind == "const":
             return plan[1]
         if kind == "lit":
@@ -204,8 +264,15 @@ def from_table(spec: TableSpec, effort: int = 2, rng=None) -> AIG:
     d = _Dec(n, effort, rng)
     g = AIG(spec.inputs)
     full = d.full
-    for name, on, dc in zip(spec.outputs, spec.on, spec.dc):
-        care = full & ~dc
-        _, plan = d.rec(on & care, care)
-        g.add_output(name, d.build(g, plan))
+    # outputs of small support first: larger ones may then reuse them (XOR prefixes)
+    order = sorted(range(len(spec.outputs)),
+                   key=lambda o: (len(T.support(spec.on[o] | spec.dc[o], n))
+                                  + len(T.support(spec.dc[o], n)), o))
+    lits = [0] * len(spec.outputs)
+    for o in order:
+        care = full & ~spec.dc[o]
+        _, plan = d.rec(spec.on[o] & care, care)
+        lits[o] = d.build(g, plan)
+    for name, lit in zip(spec.outputs, lits):
+        g.add_output(name, lit)
     return g.cleanup()

@@ -914,10 +914,36 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
     return best
 
 
+CANON_NETWORK_INPUTS = 12
+
+
 def optimize(spec, effort: int, time_budget: float | None = None) -> AIG:
     """Best AIG for ``spec`` at ``effort``.  ``time_budget`` is in seconds of the
     deterministic work clock (:mod:`mlc.logic.work`), so the result never depends on
-    the machine's load."""
+    the machine's load.
+
+    Tables (up to :data:`canon.MAX_INPUTS` inputs) and networks of up to
+    :data:`CANON_NETWORK_INPUTS` inputs are first put into their canonical input and
+    output order (:mod:`mlc.logic.canon`), so the result does not depend on how the
+    specification lists them; the circuit is mapped back to the given order."""
+    from mlc.logic import canon
+    n = len(spec.inputs)
+    if isinstance(spec, TableSpec) and 0 < n <= canon.MAX_INPUTS:
+        c = canon.canonical(spec)
+        g = _optimize(c.spec, effort, time_budget)
+        return canon.restore(g, c, spec)
+    if isinstance(spec, NetworkSpec) and 0 < n <= CANON_NETWORK_INPUTS:
+        from mlc.logic.equiv import spec_tables
+        on, dc = spec_tables(spec)
+        c = canon.canonical(TableSpec(list(spec.inputs), list(spec.outputs), on, dc, spec.source))
+        structural = canon.to_canonical(from_spec(spec), c)
+        g = _optimize(c.spec, effort, time_budget, [structural])
+        return canon.restore(g, c, spec)
+    return _optimize(spec, effort, time_budget)
+
+
+def _optimize(spec, effort: int, time_budget: float | None = None,
+              extra: list[AIG] | None = None) -> AIG:
     work.reset()
     t0 = work.now()
     if time_budget is None:
@@ -925,7 +951,7 @@ def optimize(spec, effort: int, time_budget: float | None = None) -> AIG:
         # -O2 answers within a second up to 10 inputs, a few seconds at 16
         time_budget = {0: 1.0, 1: 0.5, 2: (1.0 if n <= 8 else 0.6) + 0.8 * max(0, min(n, 20) - 10),
                        3: 5.0 + 2.0 * max(0, min(n, 20) - 10)}[effort]
-    cands = initial_candidates(spec, effort)
+    cands = initial_candidates(spec, effort) + list(extra or [])
     if effort == 0:
         return min(cands, key=cost)
     care = _care(spec)
@@ -937,34 +963,56 @@ def optimize(spec, effort: int, time_budget: float | None = None) -> AIG:
         results.append(improve(c, effort, care, deadline))
     best = min(results, key=cost)
     n = len(spec.inputs)
-    if effort >= 3 and (n <= 4 or (n == 5 and best.num_ands() <= 9)):
+    exact = effort >= 3 and (n <= 4 or (n == 5 and best.num_ands() <= 9))
+    if effort >= 2 and 2 <= n <= TT_LIMIT:
+        best = _restarts(spec, effort, care, best, t0 + time_budget, time_budget,
+                         8 if exact else None)
+    if exact:
         from mlc.logic import exact_multi
         e = exact_multi.try_exact(spec, best, t0 + time_budget)
         if e is not None and cost(e) < cost(best):
             best = e
-    elif effort >= 2 and 5 <= n <= TT_LIMIT:
-        # restarts: randomised decompositions, each improved, until the budget is spent
-        from mlc.logic import decomp
-        from mlc.logic.equiv import spec_tables
-        if isinstance(spec, TableSpec):
-            ts = spec
+    return best
+
+
+def _restarts(spec, effort: int, care, best: AIG, end: float, time_budget: float,
+              cap: int | None = None) -> AIG:
+    """Restarts: decompositions of the specification listed in random orders of its
+    inputs and outputs (fixed seed) with a randomised Shannon choice, each mapped back
+    to the given order and improved; the best network is kept.  -O2 does a fixed
+    number (deterministic unless the budget runs out), -O3 runs until 25 restarts in
+    a row bring nothing or the budget is spent."""
+    from mlc.logic import canon, decomp
+    from mlc.logic.equiv import spec_tables
+    n = len(spec.inputs)
+    if isinstance(spec, TableSpec):
+        ts = spec
+    else:
+        on, dc = spec_tables(spec)
+        ts = TableSpec(list(spec.inputs), list(spec.outputs), on, dc, spec.source)
+    rng = random.Random(12345)
+    stale = 0
+    restarts = 0
+    if effort == 2:
+        max_restarts = 8 if n <= 4 else 4 if n <= 8 else 0
+    else:
+        max_restarts = 10 ** 9
+    if cap is not None:
+        max_restarts = min(max_restarts, cap)
+    m = len(ts.outputs)
+    while work.now(best.num_nodes) < end and stale < 25 and restarts < max_restarts:
+        restarts += 1
+        pi, po = list(range(n)), list(range(m))
+        rng.shuffle(pi)
+        rng.shuffle(po)
+        ps = canon.permuted(ts, pi, po)
+        c = decomp.from_table(ps, effort, rng)
+        c = canon.restore(c, canon.Canon(ps, pi, po, True), ts)
+        step_end = min(end, work.now() + max(0.5, 0.2 * time_budget))
+        c = improve(c, effort, care, step_end)
+        if cost(c) < cost(best):
+            best = c
+            stale = 0
         else:
-            on, dc = spec_tables(spec)
-            ts = TableSpec(list(spec.inputs), list(spec.outputs), on, dc, spec.source)
-        rng = random.Random(12345)
-        end = t0 + time_budget
-        stale = 0
-        restarts = 0
-        # -O2: a fixed number of restarts (deterministic unless the budget runs out)
-        max_restarts = 4 if effort == 2 and n <= 8 else (0 if effort == 2 else 10 ** 9)
-        while work.now(best.num_nodes) < end and stale < 25 and restarts < max_restarts:
-            restarts += 1
-            c = decomp.from_table(ts, effort, rng)
-            step_end = min(end, work.now() + max(0.5, 0.2 * time_budget))
-            c = improve(c, effort, care, step_end)
-            if cost(c) < cost(best):
-                best = c
-                stale = 0
-            else:
-                stale += 1
+            stale += 1
     return best
