@@ -1,0 +1,258 @@
+"""Dynamic verification of any scene with a truth table: Brownian dynamics from rest into
+every input row, every probe read once the mechanism has relaxed.
+
+For each input row and seed the scene starts from its own poses (the all-zero row,
+at rest), the inputs switch to the row at t = 0 (constant drives) and the Brownian
+dynamics runs (:class:`mlc.sim.integrator.Simulation`, stiff scheme by default) until
+**every** probe has relaxed.  Relaxation is detected, not assumed, by two conditions:
+
+1. **plateau**: the last third of the run (at least ``MIN_WINDOWS`` windows of
+   ``window`` t0), cut into three equal blocks, has block means of every probe that
+   agree within ``tol = 2e-3 + 3 sqrt(kT/k0)`` sigma (a drift test: block means, not
+   single windows, so that thermal noise does not keep a long run from passing);
+2. **time scale**: when the row's inputs differ from the starting row, the run has
+   lasted at least ``tau_factor`` times the mechanism's slowest relaxation time
+   ``tau`` (:func:`relaxation_time`).
+
+The plateau alone is not enough.  A signal crosses a long connector chain by
+diffusion (``tau`` grows as the square of the length: 0.03, 0.8, 3.0, 12 t0 for
+1, 5, 10, 20 full units), and the far end of a 20-unit chain sits still, within
+0.02 sigma of its old length, for the first ~1 t0 after the input switched: a
+plateau test run alone declares it relaxed and reads the wrong bit.  ``tau`` comes
+from the linearised overdamped dynamics about the starting pose,
+
+    d x/dt = -M H x,    H = J^T J (k0/sigma^2),   M = diag(1/gamma, 1/gamma_r)
+
+(``J``: the Jacobian of the bond and muscle residuals of :mod:`mlc.verify.static`, per
+body a translation and a rotation vector), ``tau = 1 / lambda_min`` with
+``lambda_min`` the smallest non-zero eigenvalue of ``M^(1/2) H M^(1/2)``; the zero
+eigenvalues (rigid-body motion and floppy modes such as a connector's bending) have
+no restoring force and do not move a probe.  After ``tau_factor = 3`` times ``tau``
+the slowest mode has fallen to e^-3 = 5% of its start and the plateau test over the
+last third of the run then bounds what is left by about ``tol``.
+
+The measured value of a probe is the mean of its window means over the plateau
+(averaged over seeds); the margin is its signed distance from the probe's threshold
+towards the expected bit (the smallest over seeds).  A row is ``ok`` when every seed
+relaxed and read the expected bit with a positive margin.  Units: lengths sigma,
+times t0 = gamma / (1e-3 k0), energies k0 sigma^2.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from mlc.errors import MlcError
+from mlc.sim.drive import Drive
+from mlc.sim.integrator import SimOptions, Simulation
+
+WINDOW = 0.05          # t0: shortest window
+MIN_WINDOWS = 3        # windows on the plateau, at least
+PLATEAU = 1.0 / 3.0    # the plateau spans this fraction of the run
+TAU_FACTOR = 3.0       # the run lasts at least this many slowest relaxation times
+MAX_TIME = 20.0        # t0: the run stops here (or at MAX_TAUS tau if longer) unrelaxed
+MAX_TAUS = 12.0
+DT = {"stiff": 0.01, "euler": None}      # t0; None: the integrator's own (half the Euler limit)
+DENSE_MAX = 1800       # degrees of freedom up to which the spectrum is computed densely
+ZERO = 1e-9            # eigenvalues below ZERO * lambda_max count as zero modes
+
+
+def relaxation_time(scene, pos=None, quat=None, gamma_r: float | None = None,
+                    dense_max: int = DENSE_MAX) -> float:
+    """Slowest relaxation time (t0) of the linearised overdamped dynamics of ``scene``
+    about the pose ``pos``/``quat`` (default: the scene's own): 1 / the smallest non-zero
+    eigenvalue of ``M^(1/2) J^T J M^(1/2)`` (see the module docstring).  0 for a scene
+    with no bonds or muscles.  ``gamma_r``: rotational drag (default gamma, as
+    :class:`SimOptions`).  Dense eigenvalues up to ``dense_max`` degrees of freedom, a
+    sparse shift-invert Lanczos above."""
+    from mlc.verify.static import _Problem
+
+    A = scene.arrays()
+    prob = _Problem(scene, A.pos if pos is None else pos, A.quat if quat is None else quat, pin_first=False)
+    if prob.m == 0 or prob.n == 0:
+        return 0.0
+    u = scene.units
+    gamma, k0 = float(u.get("gamma", 1.0)), float(u.get("k0", 1.0))
+    gr = gamma if gamma_r is None else float(gamma_r)
+    mob = np.tile(np.r_[np.full(3, 1.0 / gamma), np.full(3, 1.0 / gr)], prob.N)
+    J = prob.jacobian()
+    Js = J @ _diag(np.sqrt(mob))
+    H = (Js.T @ Js).tocsc()            # rate matrix, k0/gamma units (bond k in k0)
+    if prob.n <= dense_max:
+        ev = np.linalg.eigvalsh(H.toarray())
+        nz = ev[ev > ZERO * max(ev[-1], 1e-300)]
+        lam = float(nz[0]) if len(nz) else 0.0
+    else:
+        lam = _smallest_nonzero_sparse(H)
+    if lam <= 0.0:
+        return 0.0
+    t_unit = gamma / (1e-3 * k0)       # the integrator's time per t0
+    return 1.0 / lam / t_unit
+
+
+def _diag(v):
+    import scipy.sparse as sp
+
+    return sp.diags(v, format="csr")
+
+
+def _smallest_nonzero_sparse(H) -> float:
+    """Smallest eigenvalue of the symmetric positive semi-definite ``H`` above its cluster
+    of zero modes (shift-invert Lanczos, asking for more eigenvalues until a non-zero
+    one shows up)."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import LinearOperator, eigsh, splu
+
+    n = H.shape[0]
+    lam_max = float(eigsh(H, k=1, which="LA", return_eigenvectors=False, tol=1e-3)[0])
+    shift = 1e-7 * lam_max
+    lu = splu((H + sp.identity(n, format="csc") * shift).tocsc())
+    op = LinearOperator((n, n), matvec=lu.solve, dtype=float)
+    k = 16
+    while True:
+        k = min(k, n - 2)
+        vals = eigsh(op, k=k, which="LM", return_eigenvectors=False)
+        ev = np.sort(1.0 / vals - shift)
+        nz = ev[ev > ZERO * lam_max]
+        if len(nz) or k >= n - 2:
+            return float(nz[0]) if len(nz) else 0.0
+        k *= 2
+
+
+def _seed_list(seeds) -> list[int]:
+    if isinstance(seeds, (int, np.integer)):
+        if seeds < 1:
+            raise MlcError(f"seeds must be >= 1, got {seeds}", "--seeds", "give at least one seed")
+        return list(range(int(seeds)))
+    out = [int(s) for s in seeds]
+    if not out:
+        raise MlcError("no seeds given", "--seeds", "give at least one seed")
+    return out
+
+
+def _check_rows(scene, rows) -> list[str]:
+    states = scene.states()
+    if rows is None:
+        return states
+    out = []
+    for r in rows:
+        r = str(r)
+        if r not in states:
+            raise MlcError(f"row {r!r} is not an input state of scene {scene.name} (inputs {scene.inputs})",
+                           "--rows", f"give {len(scene.inputs)}-bit strings like {states[-1]!r}")
+        out.append(r)
+    return out
+
+
+def relax_all(sim: Simulation, probes: list[str], kT: float, t_min: float = 0.0, window: float = WINDOW,
+              max_time: float = MAX_TIME, tol: float | None = None):
+    """Run ``sim`` until every probe in ``probes`` has relaxed (the three block means of
+    the last third of the run, at least ``MIN_WINDOWS`` windows, agree within ``tol``;
+    and time >= ``t_min`` t0).
+    Returns (means: dict probe -> plateau mean in sigma, time t0, relaxed)."""
+    tol = 2e-3 + 3.0 * math.sqrt(max(kT, 0.0) / sim.k0) if tol is None else tol
+    ends, means = [], {p: [] for p in probes}
+    t = 0.0
+    start = sim.t / sim.t_unit
+    while True:
+        res = sim.run(window, record_interval=window / 10, quiet=True)
+        if res.interrupted:
+            raise KeyboardInterrupt
+        t = res.time - start
+        ends.append(t)
+        for p in probes:
+            v = res.probes[p]
+            means[p].append(float(np.mean(v[1:] if len(v) > 1 else v)))
+        # the plateau: windows that started in the last third of the run
+        first = len(ends) - MIN_WINDOWS
+        cut = (1.0 - PLATEAU) * t
+        while first > 0 and ends[first - 1] - window >= cut - 1e-12:
+            first -= 1
+        if first >= 0 and t >= t_min - 1e-12:
+            flat = all(np.ptp([np.mean(b) for b in np.array_split(means[p][first:], MIN_WINDOWS)]) < tol
+                       for p in probes)
+            if flat:
+                return {p: float(np.mean(means[p][first:])) for p in probes}, t, True
+        if t >= max_time - 1e-12:
+            k = max(len(ends) - MIN_WINDOWS, 0)
+            return {p: float(np.mean(means[p][k:])) for p in probes}, t, False
+
+
+def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "stiff", rows=None,
+                              progress=None, dt: float | None = None, tau_factor: float = TAU_FACTOR,
+                              max_time: float | None = None, window: float | None = None,
+                              tau: float | None = None) -> list[dict]:
+    """Brownian-dynamics check of ``scene`` against its truth table (any number of inputs,
+    outputs and probes).  For each input row (``rows``: bit strings in ``scene.inputs``
+    order, default all) and seed (``seeds``: a count, meaning seeds 0..n-1, or a list),
+    start from the scene's poses at rest, switch the inputs to the row and run until every
+    probe has relaxed (see the module docstring).
+
+    Returns one row per (input row, probe), in row then probe order, with keys: state,
+    output, probe, expected (0/1, or None for a don't-care), measured (sigma, mean over
+    seeds), bit, margin (sigma, smallest over seeds; None for a don't-care), ok,
+    relaxed, relax_time (t0, largest over seeds; None if a seed did not relax),
+    per_seed (the measured value of each seed), seeds, tau (t0), scheme, kT.
+
+    ``progress``: None (a bar on a terminal for long runs), False (silent), True (a
+    bar) or a callable ``f(done, total)`` called after each (row, seed) run.  ``tau``
+    (t0): the slowest relaxation time, if already known (default :func:`relaxation_time`).
+    ``max_time`` (t0): give up on a run after this long (default the larger of 20 t0 and
+    12 tau).  ``window`` (t0): averaging window (default the larger of 0.05 t0 and tau/20)."""
+    from mlc.io.progress import Progress
+
+    if scene.truth_table is None:
+        raise MlcError(f"scene {scene.name} has no truth table to verify against", scene.source or scene.name,
+                       "add a truth_table mapping input bits to output bits")
+    if not scene.probes:
+        raise MlcError(f"scene {scene.name} has no probes to read", scene.source or scene.name,
+                       "add a probe for each output")
+    if not (math.isfinite(kT) and kT >= 0):
+        raise MlcError(f"kT must be finite and >= 0, got {kT}", "--kT")
+    seed_list = _seed_list(seeds)
+    states = _check_rows(scene, rows)
+    opt0 = SimOptions(scheme=scheme)
+    tau = relaxation_time(scene, gamma_r=opt0.gamma_r) if tau is None else float(tau)
+    max_time = max(MAX_TIME, MAX_TAUS * tau) if max_time is None else float(max_time)
+    window = max(WINDOW, tau / 20.0) if window is None else float(window)
+    rest = "0" * len(scene.inputs)
+    names = [p.name for p in scene.probes]
+    total = len(states) * len(seed_list)
+    out = []
+    show = None if progress is None else (progress if isinstance(progress, bool) else False)
+    bar = Progress(f"dynamic check of {scene.name}", total=total, show=show)
+    done = 0
+    with bar:
+        for state in states:
+            want = scene.truth_table.get(state)
+            drives = {inp: Drive.constant(int(bit)) for inp, bit in zip(scene.inputs, state)}
+            t_min = tau_factor * tau if state != rest else 0.0
+            per = []
+            for seed in seed_list:
+                opt = SimOptions(scheme=scheme, kT=kT, seed=seed, dt=dt if dt is not None else DT.get(scheme))
+                sim = Simulation(scene, drives, opt)
+                means, t_rel, relaxed = relax_all(sim, names, kT, t_min, window, max_time)
+                per.append((means, t_rel, relaxed))
+                done += 1
+                bar.update(done)
+                if callable(progress):
+                    progress(done, total)
+            for pr in scene.probes:
+                idx = scene.outputs.index(pr.output)
+                bit = None if want is None or want[idx] == "-" else int(want[idx])
+                vals = [m[pr.name] for m, _, _ in per]
+                mean = float(np.mean(vals))
+                relaxed = all(r for _, _, r in per)
+                margins = None if bit is None else [float(pr.margin(v, bit)) for v in vals]
+                ok = relaxed and (bit is None or all(pr.bit(v) == bit and m > 0 for v, m in zip(vals, margins)))
+                out.append({"state": state, "output": pr.output, "probe": pr.name, "expected": bit,
+                            "measured": mean, "bit": pr.bit(mean),
+                            "margin": None if margins is None else min(margins), "ok": bool(ok),
+                            "relaxed": relaxed,
+                            "relax_time": max(t for _, t, _ in per) if relaxed else None,
+                            "per_seed": vals, "seeds": seed_list, "tau": tau, "scheme": scheme, "kT": kT})
+    return out
+
+
+__all__ = ["check_scene_dynamic_multi", "relax_all", "relaxation_time"]

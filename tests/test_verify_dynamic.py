@@ -1,0 +1,108 @@
+"""mlc.verify.dynamic: the multi-probe Brownian-dynamics check and its relaxation time.
+
+The relaxation time is checked against closed forms (springs between point bodies) and
+against the integrator itself (the decay rate of a deterministic run); the check is
+run on a two-input gate (all rows, several seeds) and shown to catch a wrong truth table
+and to need the time-scale condition (a plateau test alone reads a long chain wrong)."""
+import numpy as np
+import pytest
+
+from mlc.errors import MlcError
+from mlc.gates.connector import chain_scene
+from mlc.gates.library import gate_scene
+from mlc.scene.model import Body, Box, Muscle, Probe, Scene
+from mlc.sim.drive import Drive
+from mlc.sim.integrator import SimOptions, Simulation
+from mlc.verify.dynamic import check_scene_dynamic_multi, relaxation_time
+
+
+def _points(n: int, k: float, gamma: float = 1.0) -> Scene:
+    """``n`` point-like bodies along x, 1 sigma apart, neighbours joined by muscles of
+    stiffness ``k`` and rest 1 (sites at the body centres: no torques)."""
+    bodies = [Body(f"b{i}", np.array([float(i), 0, 0]), np.array([1.0, 0, 0, 0]),
+                   [Box(np.array([0.1, 0.1, 0.1]))], {"c": np.zeros(3)}) for i in range(n)]
+    muscles = [Muscle(f"m{i}", "a", f"b{i}.c", f"b{i + 1}.c", 1.0, 1.2, k) for i in range(n - 1)]
+    probes = [Probe("out", "out", "b0.c", f"b{n - 1}.c", n - 1.0, 1.2 * (n - 1))]
+    return Scene("points", bodies, [], muscles, probes, ["a"], ["out"], {"0": "0", "1": "1"},
+                 units={"sigma": 1.0, "k0": 1.0, "gamma": gamma}).check()
+
+
+@pytest.mark.parametrize("n,k,gamma,rate", [
+    (2, 0.5, 1.0, 1.0),          # relative coordinate: 2k/gamma
+    (2, 1.0, 2.0, 1.0),          # 2k/gamma again, but t0 is twice as long
+    (3, 1.0, 1.0, 1.0),          # k [[1,-1,0],[-1,2,-1],[0,-1,1]]/gamma: eigenvalues 0, k, 3k
+    (4, 1.0, 1.0, 2 - 2 ** 0.5),  # free chain of 4: 2k(1 - cos(pi/4))
+])
+def test_relaxation_time_closed_forms(n, k, gamma, rate):
+    """tau = 1/lambda_min (rate in 1/(gamma/k0) time units), expressed in t0 =
+    gamma/(1e-3 k0); the transverse and rotational modes of point bodies have no
+    restoring force and are left out."""
+    tau = relaxation_time(_points(n, k, gamma))
+    assert tau == pytest.approx(1.0 / rate / (gamma / 1e-3), rel=1e-9)
+
+
+def test_sparse_and_dense_spectra_agree():
+    sc = chain_scene(3, "contract")
+    dense = relaxation_time(sc)
+    sparse = relaxation_time(sc, dense_max=0)
+    assert sparse == pytest.approx(dense, rel=1e-6)
+
+
+def test_relaxation_time_is_the_decay_time_of_the_dynamics():
+    """Independent check by the integrator: at kT = 0 a 5-unit chain switched to 1 approaches
+    its far-end length exponentially, at the rate the linearised spectrum predicts."""
+    sc = chain_scene(5, "expand")
+    tau = relaxation_time(sc)
+    sim = Simulation(sc, {"a": Drive.constant(1)}, SimOptions(scheme="stiff", kT=0.0, dt=0.01))
+    res = sim.run(8 * tau, record_interval=0.05, quiet=True)
+    t, dev = res.times, np.abs(1.5 - res.probes["out"])
+    late = (t > 3 * tau) & (t < 7 * tau)
+    fitted = -1.0 / np.polyfit(t[late], np.log(dev[late]), 1)[0]
+    assert fitted == pytest.approx(tau, rel=0.05)
+    assert dev[-1] < 1e-3
+
+
+def test_two_input_gate_every_row_and_seed():
+    sc = gate_scene("NAND", "expand")
+    seen = []
+    rows = check_scene_dynamic_multi(sc, kT=1e-5, seeds=[3, 4], progress=lambda d, n: seen.append((d, n)))
+    assert [r["state"] for r in rows] == ["00", "01", "10", "11"]
+    assert seen[-1] == (8, 8) and len(seen) == 8
+    for r in rows:
+        assert r["ok"] and r["relaxed"], r
+        assert r["bit"] == r["expected"] == int(sc.truth_table[r["state"]])
+        assert r["margin"] > 0.2 and len(r["per_seed"]) == 2 and r["seeds"] == [3, 4]
+
+
+def test_a_wrong_truth_table_is_caught_on_its_row_and_output():
+    sc = gate_scene("NAND", "contract")
+    sc.truth_table = dict(sc.truth_table, **{"11": "1"})
+    rows = check_scene_dynamic_multi(sc, kT=1e-5, seeds=1, rows=["00", "11"], progress=False)
+    bad = [(r["state"], r["output"]) for r in rows if not r["ok"]]
+    assert bad == [("11", "out")]
+    assert rows[-1]["margin"] < -0.2
+
+
+def test_a_plateau_alone_is_fooled_by_a_long_chain():
+    """Why the time-scale condition exists: without it the far end of a 10-unit chain, still
+    at its old length when the first windows agree, is declared relaxed and read wrong;
+    with it (the default) the same run reads the right bit."""
+    sc = chain_scene(10, "expand")
+    tau = relaxation_time(sc)
+    early = check_scene_dynamic_multi(sc, 1e-5, [0], rows=["1"], tau_factor=0.0, window=0.05, tau=tau)[0]
+    assert early["relaxed"] and not early["ok"] and early["relax_time"] < tau
+    good = check_scene_dynamic_multi(sc, 1e-5, [0], rows=["1"], tau=tau)[0]
+    assert good["ok"] and good["relax_time"] >= 3 * tau
+
+
+def test_bad_arguments_are_one_clear_error():
+    sc = gate_scene("AND", "expand")
+    with pytest.raises(MlcError, match="row '1' is not an input state"):
+        check_scene_dynamic_multi(sc, rows=["1"])
+    with pytest.raises(MlcError, match="seeds"):
+        check_scene_dynamic_multi(sc, seeds=0)
+    with pytest.raises(MlcError, match="kT"):
+        check_scene_dynamic_multi(sc, kT=-1.0)
+    sc.truth_table = None
+    with pytest.raises(MlcError, match="no truth table"):
+        check_scene_dynamic_multi(sc)
