@@ -53,24 +53,24 @@ def test_hand_encoded_half_adder():
 
 
 def test_multi_byte_deltas_decode():
-    """A chain in which every AND also reads input 1: the second delta grows past one and
-    two bytes (2**14 <= delta < 2**21 at the end)."""
-    n, depth = 3, 9000
-    lines = [f"aag {n + depth} {n} 0 1 {depth}", "2", "4", "6", str(2 * (n + depth) + 1)]
-    prev = 6
-    for k in range(depth):
-        lhs = 2 * (n + 1 + k)
-        lines.append(f"{lhs} {prev ^ (k & 1)} {2 if k % 2 else 4}")
-        prev = lhs
+    """Many inputs and ANDs that read both the last and the first ones: deltas of one,
+    two and three bytes (2**14 <= delta < 2**21)."""
+    from mlc.logic.netsim import simulate_network
+    n = 9000
+    pairs = [(2 * n, 2), (2 * n - 1, 2 * n - 301), (2 * n + 2, 2 * n - 2), (2 * n + 5, 2 * n + 2)]
+    lines = [f"aag {n + len(pairs)} {n} 0 2 {len(pairs)}", *[str(2 * (i + 1)) for i in range(n)],
+             str(2 * (n + len(pairs))), str(2 * (n + 1) + 1)]
+    lines += [f"{2 * (n + 1 + k)} {a} {b}" for k, (a, b) in enumerate(pairs)]
     text = "\n".join(lines) + "\n"
     data = aag_to_aig(text)
-    raw, spec = read(data, "chain.aig")
-    lhs, r0, r1 = raw.ands[-1]
-    assert r1 == 2 and 2 ** 14 <= r0 - r1 < 2 ** 21
-    assert data.endswith(encode_delta(lhs - r0) + encode_delta(r0 - r1))
-    assert len(encode_delta(r0 - r1)) == 3
-    assert raw.ands == [tuple(int(x) for x in ln.split()) for ln in lines[5:]]
-    assert truth_tables(spec) == truth_tables(parse(text, "chain.aag"))
+    raw, spec = read(data, "wide.aig")
+    assert raw.ands == [(2 * (n + 1 + k), a, b) for k, (a, b) in enumerate(pairs)]
+    sizes = [len(encode_delta(d)) for lhs, a, b in raw.ands for d in (lhs - a, a - b)]
+    assert sizes == [1, 3, 1, 2, 1, 1, 1, 1]
+    assert data.endswith(b"".join(encode_delta(d) for lhs, a, b in raw.ands for d in (lhs - a, a - b)))
+    rng = random.Random(3)
+    words = [rng.getrandbits(64) for _ in range(n)]
+    assert simulate_network(spec, words, 64) == simulate_network(parse(text, "wide.aag"), words, 64)
 
 
 # ----------------------------------------------------------------------------- round trips
