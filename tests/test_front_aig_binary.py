@@ -309,3 +309,37 @@ def same_functions(a, b, width=256, seed=5) -> bool:
     va = dict(zip(a.outputs, simulate_network(a, [words[x] for x in a.inputs], width)))
     vb = dict(zip(b.outputs, simulate_network(b, [words[x] for x in b.inputs], width)))
     return va == vb
+
+
+# ----------------------------------------------------------------------------- hostile bytes
+
+from hypothesis import HealthCheck, given, settings  # noqa: E402
+from hypothesis import strategies as st  # noqa: E402
+
+LOC_RE = r"fz(:\d+){1,2}: |fz:byte \d+: "
+
+
+@settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(edits=st.lists(st.tuples(st.integers(0, 10 ** 6), st.integers(0, 255), st.sampled_from("rid")), max_size=4),
+       cut=st.integers(0, 10 ** 6), seed=st.integers(0, 3))
+def test_mutated_binary_files_parse_or_fail_cleanly(edits, cut, seed):
+    """Bytes replaced, inserted or deleted and the file cut short anywhere: the parser
+    returns a well-formed spec or raises one MlcError located at a line or a byte."""
+    import re
+    from mlc.front.load import check_spec
+    data = bytearray(write_aiger_binary(random_aig(seed, n=4, steps=30, outs=3)))
+    for pos, byte, op in edits:
+        pos %= len(data) + 1
+        if op == "r" and pos < len(data):
+            data[pos] = byte
+        elif op == "i":
+            data.insert(pos, byte)
+        elif pos < len(data):
+            del data[pos]
+    data = bytes(data[:len(data) - cut % (len(data) + 1) // 2])
+    try:
+        spec = parse(data, "fz")
+    except MlcError as e:
+        assert re.match(LOC_RE, str(e)), str(e)
+        return
+    check_spec(spec)
