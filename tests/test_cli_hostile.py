@@ -433,3 +433,28 @@ def test_every_data_directory_is_a_listed_package():
     dirs = {".".join(p.parent.relative_to(ROOT).parts) for p in (ROOT / "mlc").rglob("*")
             if p.is_file() and "__pycache__" not in p.parts}
     assert dirs - listed == set(), "add these to [tool.setuptools] packages in pyproject.toml"
+
+
+# ---------------------------------------------------------------------------------------
+# progress: a line with an ETA on a terminal, nothing elsewhere
+# ---------------------------------------------------------------------------------------
+
+def test_progress_bar_and_timer():
+    import io
+    import time as _time
+    from mlc.io.progress import Progress
+    s = io.StringIO()
+    with Progress("work", total=4, show=True, delay=0.0, stream=s) as bar:
+        bar.update(1)
+        _time.sleep(0.02)
+        bar.update(2)
+    text = s.getvalue()
+    assert "work [" in text and "2/4" in text and "ETA" in text and text.endswith("\n")
+    s = io.StringIO()
+    with Progress("solve", expect=100.0, show=True, delay=0.0, stream=s):
+        _time.sleep(0.7)                                     # the timer thread draws every 0.5 s
+    assert "solve" in s.getvalue() and "s left)" in s.getvalue()
+    s = io.StringIO()                                        # StringIO is not a terminal: silent
+    with Progress("quiet", total=2, delay=0.0, stream=s) as bar:
+        bar.update(2)
+    assert s.getvalue() == ""

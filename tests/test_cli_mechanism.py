@@ -70,3 +70,25 @@ def test_unknown_gate_and_missing_dir(tmp_path, capsys):
     assert code == 2 and "choose one of" in err
     code, _, err = run(capsys, "gate", "AND", "-o", str(tmp_path / "no" / "x.yaml"))
     assert code == 2 and "does not exist" in err
+
+
+def test_gate_picture_geometry_names_every_part():
+    """The first panel of `mlc draw` names every slab and joint: each label sits at a distinct
+    place (the two halves of a scissor lever share a centre, so labels are moved off it) and
+    every joint is drawn where its bonded sites are."""
+    import numpy as np
+
+    from mlc.draw import _scene_geometry
+    from mlc.gates.library import gate_scene
+    from mlc.verify.static import solve_states
+    scene = gate_scene("NAND", "expand")
+    eq = solve_states(scene)["00"]
+    faces, labels, site, joints = _scene_geometry(scene, eq.pos, eq.quat)
+    assert set(labels) == {b.name for b in scene.bodies}
+    pts = np.array(list(labels.values()))
+    gaps = np.linalg.norm(pts[:, None] - pts[None], axis=-1) + np.eye(len(pts)) * 1e9
+    assert gaps.min() > 0.1                           # sigma: no two slab names on one spot
+    assert set(joints) == {b.joint or b.name for b in scene.bonds}
+    for b in scene.bonds:                             # a hinge's two sites coincide at equilibrium
+        kind, x = joints[b.joint or b.name]
+        assert kind == b.kind and np.linalg.norm(site[b.a] - x) < 0.3 and np.linalg.norm(site[b.b] - x) < 0.3
