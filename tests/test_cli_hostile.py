@@ -146,6 +146,17 @@ def test_alias_limit_allows_ordinary_reuse():
     assert str(e.value).startswith("b.yaml:7:")
 
 
+def test_yaml_size_limit(scene_text, tmp_path, monkeypatch, capsys):
+    src = tmp_path / "s.yaml"
+    src.write_text(scene_text)
+    monkeypatch.setattr(yamlsrc, "MAX_BYTES", len(scene_text.encode()) - 1)   # one byte too many
+    before = listing(tmp_path)
+    code, _, err = run(capsys, "draw", src, "-o", tmp_path / "x.png")
+    assert_clean_failure(code, err, before, tmp_path, str(src), "larger than")
+    monkeypatch.setattr(yamlsrc, "MAX_BYTES", len(scene_text.encode()))
+    assert yamlsrc.read_text(src) == scene_text
+
+
 def test_yaml_fuzz_only_mlc_errors(scene_text):
     """Seeded random damage to a valid scene: parse to a Scene or raise MlcError, nothing else."""
     from mlc.scene.io import parse_scene

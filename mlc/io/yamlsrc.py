@@ -14,6 +14,7 @@ Every way a file can go wrong is one :class:`~mlc.errors.MlcError` at ``file:lin
 * aliases that expand the document by more than :data:`MAX_ALIAS_NODES` nodes (the
   "billion laughs" bomb: nine levels of ten aliases are 10**9 nodes), or that refer to
   the node they are inside of;
+* inputs larger than :data:`MAX_BYTES` (64 MB);
 * integers too large for a float (``float(10**400)`` overflows; Python refuses to
   convert more than 4300 digits at all).
 
@@ -33,6 +34,9 @@ from mlc.errors import Loc, MlcError
 MAX_DEPTH = 100
 #: Nodes that aliases may add to a document beyond the ones written out.
 MAX_ALIAS_NODES = 1_000_000
+#: Largest YAML input accepted, in bytes (PyYAML reads roughly 0.1 to 1 MB/s; a scene of
+#: 20000 bodies is about 20 MB).
+MAX_BYTES = 64 * 2 ** 20
 #: Largest integer accepted (anything larger is not a finite float either).
 _MAX_INT = 2 ** 1024
 
@@ -168,7 +172,10 @@ def read_text(path, what: str = "file") -> str:
     ``what`` names the file in the message ("scene", "profile", ...)."""
     try:
         with open(path, "rb") as f:
-            data = f.read()
+            data = f.read(MAX_BYTES + 1)
+        if len(data) > MAX_BYTES:
+            raise MlcError(f"{what} is larger than {MAX_BYTES // 2 ** 20} MB", str(path),
+                           "mlc reads YAML files up to that size")
     except IsADirectoryError:
         raise MlcError(f"cannot read {what}: it is a directory", str(path)) from None
     except OSError as e:
@@ -180,6 +187,9 @@ def load(text, filename: str = "<input>"):
     """Parse YAML ``text`` (str, or UTF-8 bytes); every error is an :class:`MlcError` at ``file:line:col``."""
     if isinstance(text, (bytes, bytearray)):
         text = decode(bytes(text), filename)
+    if len(text) > MAX_BYTES:
+        raise MlcError(f"YAML input is larger than {MAX_BYTES // 2 ** 20} MB", Loc(filename),
+                       "mlc reads YAML files up to that size")
     loader = None
     try:
         loader = _Loader(text, filename)
