@@ -29,7 +29,9 @@ nothing is written.  Checks made by :meth:`Outputs.check` (also run by ``with``)
 
 Special files (``/dev/null``, ``/dev/stdout``, a FIFO) are written directly, first, at
 commit time, so ``/dev/full`` fails before any regular file is moved into place.  If a
-move fails half way, the files already moved are put back as they were.
+move fails half way, the files already moved are put back as they were.  An output that
+is a symbolic link is replaced by the new file (the link's target is left alone), as
+with any write-then-rename.
 """
 from __future__ import annotations
 
