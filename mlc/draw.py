@@ -70,6 +70,8 @@ def box_faces(box, pos, R) -> list[np.ndarray]:
 # paper Fig. 1A) is drawn vertical and the core plane faces the viewer.
 _VIEW = [0, 2, 1]
 _JOINT_MARKERS = {"hinge": ("o", "hinge"), "universal": ("D", "universal joint"), "bond": ("s", "bond")}
+#: Largest extent drawn (sigma): a gate spans about 5, a large circuit a few thousand.
+MAX_SPAN = 1e6
 #: Scenes with more bodies than this get no slab names (they would cover the picture).
 MAX_NAMED_BODIES = 40
 
@@ -153,6 +155,13 @@ def draw_scene_states(scene, equilibria: dict, path, title: str | None = None) -
     ``equilibria`` maps state -> object with ``pos``, ``quat`` and ``probes``.  The first
     panel names the slabs and joints; every panel marks each muscle actuated (thick, solid)
     or at rest (thin, dashed) and reads the output probe."""
+    from mlc.errors import MlcError
+    for st, eq in equilibria.items():
+        with np.errstate(all="ignore"):
+            span = float(np.ptp(np.asarray(eq.pos), axis=0).max()) if len(eq.pos) else 0.0
+        if not (np.isfinite(np.asarray(eq.pos)).all() and span <= MAX_SPAN):
+            raise MlcError(f"cannot draw input state {st}: the mechanism spans {span:.3g} sigma (limit {MAX_SPAN:g})",
+                           scene.source or scene.name, "check the scene's lengths and positions (sigma)")
     plt = _plt()
     states = list(equilibria)
     n = len(states)

@@ -128,6 +128,15 @@ def test_non_utf8_scene_gives_line_and_column(scene_text, tmp_path, capsys):
     assert_clean_failure(code, err, before, tmp_path, f"{src}:{line}:12:", "0xe9")
 
 
+def test_draw_refuses_a_scene_too_large_to_draw(scene_text, tmp_path, capsys):
+    import re
+    src = tmp_path / "far.yaml"
+    src.write_text(re.sub(r"position: \[[^\]]*\]", "position: [1e300, 0, 0]", scene_text, count=1))
+    before = listing(tmp_path)
+    code, _, err = run(capsys, "draw", src, "-o", tmp_path / "x.png")
+    assert_clean_failure(code, err, before, tmp_path, str(src), "spans 1e+300 sigma")
+
+
 def test_yaml_1_2_floats_without_a_dot_are_numbers(scene_text):
     from mlc.scene.io import parse_scene
     s = parse_scene(scene_text.replace("  k: 1.0", "  k: 1e3", 1).replace("  k: 1.0", "  k: 2E-1", 1), "f.yaml")
