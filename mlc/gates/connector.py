@@ -299,7 +299,8 @@ def chain_scene(units: int, signal: str = "expand", bend: float = 0.0, design: D
         raise ValueError("a chain has at least one unit")
     geo = connector_geometry(signal, design, gap)
     n = 2 * units
-    bends = [0.0] + [bend if i % 2 == 0 else 0.0 for i in range(1, n)]
+    # the even junctions' axes alternate in sign (u_{i+2} = -u_i): alternate the bend to bend one way
+    bends = [0.0] + [(bend if i % 4 == 2 else -bend) if i % 2 == 0 else 0.0 for i in range(1, n)]
     if abs(bend) > max_bend(geo) + 1e-12:
         raise ValueError(f"bend {bend:.3f} rad exceeds the junction's largest bend {max_bend(geo):.3f} rad "
                          f"at gap {gap} sigma")
