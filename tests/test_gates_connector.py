@@ -69,15 +69,22 @@ from mlc.verify.dynamic import check_scene_dynamic_multi, relaxation_time  # noq
 from mlc.verify.overlap import clearance, static_poses, sweep_clearance  # noqa: E402
 from mlc.verify.static import _Problem, equilibrium  # noqa: E402
 
-BENT = 0.9          # bent chains: every other junction at this fraction of its largest bend
+BENT = 0.9          # bent chains: the junctions between units at this fraction of their largest bend ...
 
 
-def _bend(signal: str, frac: float = BENT) -> float:
-    return frac * max_bend(connector_geometry(signal))
+def _bend(signal: str, units: int = 2, frac: float = BENT) -> float:
+    """... or less, so that the chain's planar arc turns by at most 180 degrees in all (a
+    longer arc would come back onto itself)."""
+    b = frac * max_bend(connector_geometry(signal))
+    return b if units < 2 else min(b, math.pi / (units - 1))
 
 
 def _chain(units: int, signal: str, bent: bool):
-    return chain_scene(units, signal, _bend(signal) if bent else 0.0, probe_every_unit=True)
+    """A chain with a probe after every unit; a bent 1-unit chain is the full unit bent at
+    its one junction (chain_scene bends only the junctions between units)."""
+    if units == 1 and bent:
+        return full_unit_scene(signal, bend=_bend(signal))
+    return chain_scene(units, signal, _bend(signal, units) if bent else 0.0, probe_every_unit=True)
 
 
 def _null_dim(scene, pos, quat) -> tuple[int, np.ndarray, np.ndarray]:
@@ -114,9 +121,28 @@ def test_three_way_branch_statically(signal):
         assert r["bit"] == 1 - int(r["state"]) and r["error"] < 1e-9 and r["joint_stretch"] < 1e-9
 
 
+@pytest.mark.parametrize("signal", SIGNALS)
+def test_a_bent_chain_is_a_planar_arc(signal):
+    """Bending the junctions between units by b turns the chain's far end by (units - 1) b
+    about one axis (an arc, not a zigzag), and keeps it in the plane of the first turn."""
+    units, b = 5, _bend(signal, 5)
+    straight, bent = chain_scene(units, signal), chain_scene(units, signal, b)
+    from mlc.geometry.rotation import quat_to_matrix
+
+    def rel(sc):       # the last slab's orientation relative to the first (bodies are built unrotated)
+        return quat_to_matrix(sc.bodies[-1].boxes[0].orientation) @ quat_to_matrix(sc.bodies[0].boxes[0].orientation).T
+
+    turn = rel(bent) @ rel(straight).T
+    angle = np.arccos(np.clip((np.trace(turn) - 1) / 2, -1, 1))
+    assert angle == pytest.approx((units - 1) * b, abs=1e-6)
+    # every layer's centre lies in the plane through the first layer normal to the bend axis
+    axis = np.array([1.0, 0.0, 0.0])          # the even junctions' axes are +-x (first input axis x, tangent z)
+    assert max(abs(float(bd.position @ axis)) for bd in bent.bodies) < 1.0
+
+
 def test_static_check_refutes_a_chain_claimed_to_invert():
-    sc = chain_scene(5, "contract", _bend("contract"))
-    sc.truth_table = {"0": "1", "1": "0"}
+    sc = _chain(5, "contract", True)
+    sc.truth_table = {"0": "1" * 5, "1": "0" * 5}
     assert not any(r["ok"] for r in verify_scene(sc))
 
 
@@ -125,8 +151,8 @@ def test_static_check_refutes_a_chain_claimed_to_invert():
 ELEMENTS = {
     "half_unit": lambda s: half_unit_scene(s),
     "full_unit": lambda s: full_unit_scene(s),
-    "full_unit_bent": lambda s: full_unit_scene(s, bend=_bend(s)),
-    "chain1": lambda s: _chain(1, s, False),
+    "full_unit_bent": lambda s: _chain(1, s, True),
+    "chain5_bent": lambda s: _chain(5, s, True),
     "chain20_straight": lambda s: _chain(20, s, False),
     "chain20_bent": lambda s: _chain(20, s, True),
     "branch3": lambda s: branch_scene(3, s),
