@@ -201,6 +201,32 @@ def gray_to_bin(n: int = 4):
     return table(f"gray2bin{n}", ins, [f"b{i}" for i in range(n)], fn)
 
 
+def parity_prefix(n: int):
+    """Prefix parities ``p_k = x0 ^ ... ^ xk``, k = 0 .. n-1 (outputs share an XOR chain)."""
+    ins = [f"x{i}" for i in range(n)]
+    return table(f"parity_prefix{n}", ins, [f"p{k}" for k in range(n)],
+                 lambda x: [sum(x[:k + 1]) & 1 for k in range(n)])
+
+
+def reversed_bits(spec: TableSpec) -> TableSpec:
+    """``spec`` with its inputs and its outputs listed in reverse order (most
+    significant bit first, for the library's least-significant-first functions)."""
+    from mlc.logic.canon import permuted
+    n, m = spec.n, len(spec.outputs)
+    r = permuted(spec, list(range(n - 1, -1, -1)), list(range(m - 1, -1, -1)))
+    r.source = spec.source + "_msb"
+    return r
+
+
+def xor_suite() -> list[TableSpec]:
+    """Multi-output functions whose outputs share XOR chains (issue 15): code
+    converters, parity prefixes, comparators and adders, in both bit orders."""
+    base = [gray(4), gray_to_bin(4), gray(6), gray_to_bin(6), gray_to_bin(8),
+            parity_prefix(4), parity_prefix(6), parity_prefix(8),
+            comparator(2), comparator(3), comparator(4), adder(2), adder(3), adder(4)]
+    return [f for b in base for f in (b, reversed_bits(b))]
+
+
 def random_function(n: int, m: int, seed: int, dc_fraction: float = 0.0):
     rng = random.Random(seed)
     ins = [f"x{i}" for i in range(n)]
