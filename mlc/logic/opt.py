@@ -291,6 +291,69 @@ def resub(g: AIG, care_out: list[int] | None = None, max_new: int = 2, max_div: 
     return rebuild(g, repl)
 
 
+def odc_care(g: AIG, x: int, vals: list[int], care_out: list[int] | None, full: int) -> int:
+    """Observability care set of node ``x`` (global tables): the minterms where
+    complementing ``x`` changes some output inside that output's care set."""
+    n = g.num_inputs
+    flip = {x: vals[x] ^ full}
+    for k in range(x - n, len(g.ands)):
+        a, b = g.ands[k]
+        if (a >> 1) in flip or (b >> 1) in flip:
+            va = flip.get(a >> 1, vals[a >> 1]) ^ (full if a & 1 else 0)
+            vb = flip.get(b >> 1, vals[b >> 1]) ^ (full if b & 1 else 0)
+            flip[n + 1 + k] = va & vb
+    care = 0
+    for o, lit in enumerate(g.output_lits):
+        y = lit >> 1
+        if y in flip:
+            d = flip[y] ^ vals[y]
+            care |= d & (care_out[o] if care_out is not None else full)
+    return care
+
+
+def resub_odc(g: AIG, care_out: list[int] | None = None, max_new: int = 2,
+              max_div: int = 150, deadline: float | None = None, max_moves: int = 50) -> AIG:
+    """Resubstitution with observability don't cares (global tables, ``n <=
+    TT_LIMIT``): a node may be replaced by a cheaper expression that differs from it
+    only where no output observes it.  Don't-care moves interact, so one move is
+    made per scan and the network rebuilt before the next (at most ``max_moves``)."""
+    n = g.num_inputs
+    if n > TT_LIMIT or not g.ands or len(g.ands) > 400:
+        return g
+    full = T.mask(n)
+    for _ in range(max_moves):
+        vals = g.node_tables()
+        refs = refcounts(g)
+        N = g.num_nodes
+        done = None
+        for x in range(n + 1, N):
+            if deadline is not None and work.now(g.num_nodes) > deadline:
+                return g
+            if refs[x] == 0:
+                continue
+            cone = mffc(g, x, refs)
+            if len(cone) < 2:
+                continue
+            care = odc_care(g, x, vals, care_out, full)
+            if care == full:
+                continue
+            incone = set(cone)
+            lo, hi = max(n + 1, x - max_div), min(N, x + max_div // 3)
+            tfo = tfo_mark(g, x, hi)
+            divs = list(range(1, n + 1)) + [d for d in range(lo, hi) if d not in incone
+                                            and not tfo[d] and refs[d] > 0]
+            e = _find_resub(vals[x] & care, care, full, divs, vals,
+                            min(max_new, len(cone) - 1), 16)
+            if e is None:
+                continue
+            done = (x, e)
+            break
+        if done is None:
+            return g
+        g = rebuild(g, {done[0]: done[1]})
+    return g
+
+
 def resub_window(g: AIG, max_leaves: int = 10, max_new: int = 2, max_window: int = 150,
                  deadline: float | None = None) -> AIG:
     """Resubstitution for networks too wide for global tables: each node gets a
@@ -879,6 +942,9 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
             rf = refactor(cur, deadline=deadline)
             if cost(rf) < cost(cur):
                 cur = rf
+            od = resub_odc(cur, care, deadline=deadline, max_moves=10 if effort == 2 else 50)
+            if cost(od) < cost(cur):
+                cur = resub(od, care, max_new=2, deadline=deadline)
             if effort >= 3:
                 cur = rewrite(cur, zero_gain=True, deadline=deadline)
                 cur = resub(cur, care, max_new=2, deadline=deadline)
