@@ -875,6 +875,90 @@ def balance_xor(g: AIG) -> AIG:
     return R.finish()
 
 
+def extract_and(g: AIG, max_leaves: int = 16) -> AIG:
+    """Common sub-conjunction extraction (the AND case of fast extract): every
+    multi-input AND (a tree of uncomplemented single-fanout AND nodes, collapsed to
+    its leaf literals) is a set of literals; a pair of literals that occurs in
+    several sets becomes one shared node, most frequent pair first, until no pair
+    occurs twice.  Then every set is rebuilt as a balanced tree."""
+    n = g.num_inputs
+    if not g.ands:
+        return g
+    refs = refcounts(g)
+    plain = [0] * g.num_nodes          # uncomplemented references from AND nodes
+    for a, b in g.ands:
+        if not a & 1:
+            plain[a >> 1] += 1
+        if not b & 1:
+            plain[b >> 1] += 1
+    absorbed = [x > n and refs[x] == 1 and plain[x] == 1 for x in range(g.num_nodes)]
+    sets: dict[int, list] = {}
+    for x in range(n + 1, g.num_nodes):
+        if absorbed[x] or refs[x] == 0:
+            continue
+        leaves: list = []
+        stack = list(g.ands[x - n - 1])
+        while stack:
+            lit = stack.pop()
+            y = lit >> 1
+            if not lit & 1 and absorbed[y] and len(leaves) + len(stack) < max_leaves:
+                stack.extend(g.ands[y - n - 1])
+            else:
+                leaves.append(("l", lit))
+        sets[x] = list(dict.fromkeys(leaves))
+    pairs_made: list[tuple] = []
+    while True:
+        cnt: dict[tuple, int] = {}
+        for lv in sets.values():
+            if len(lv) < 2:
+                continue
+            srt = sorted(lv)
+            for i in range(len(srt)):
+                for j in range(i + 1, len(srt)):
+                    k = (srt[i], srt[j])
+                    cnt[k] = cnt.get(k, 0) + 1
+        if not cnt:
+            break
+        best = max(cnt.items(), key=lambda kv: (kv[1], kv[0]))
+        if best[1] < 2:
+            break
+        (p, q), _ = best
+        v = ("v", len(pairs_made))
+        pairs_made.append((p, q))
+        for x, lv in sets.items():
+            if p in lv and q in lv:
+                sets[x] = [y for y in lv if y != p and y != q] + [v]
+    if not pairs_made:
+        return g
+    R = _Rebuild(g)
+    vlit: dict[int, int] = {}
+
+    def leaf(t) -> int:
+        if t[0] == "l":
+            return R.lit(t[1])
+        k = t[1]
+        r = vlit.get(k)
+        if r is None:
+            p, q = pairs_made[k]
+            r = vlit[k] = R.and_(leaf(p), leaf(q))
+        return r
+
+    for x in range(n + 1, g.num_nodes):
+        lv = sets.get(x)
+        if lv is None:
+            continue
+        lits = [leaf(t) for t in lv]
+        if any((l ^ 1) in lits for l in lits):
+            R.m[x] = 0
+            continue
+        lits = list(dict.fromkeys(lits))
+        while len(lits) > 1:
+            lits.sort(key=R.level)
+            lits = lits[2:] + [R.and_(lits[0], lits[1])]
+        R.m[x] = lits[0] if lits else 1
+    return R.finish()
+
+
 # ----------------------------------------------------------------------------- initial
 def _filled(spec: TableSpec, mode: str) -> TableSpec:
     """``spec`` with its don't cares assigned: by the ISOP cover, to 0 or to 1."""
@@ -891,6 +975,23 @@ def _filled(spec: TableSpec, mode: str) -> TableSpec:
     return TableSpec(list(spec.inputs), list(spec.outputs), on, [0] * len(on), spec.source)
 
 
+def _two_level(spec: TableSpec) -> AIG:
+    """Each output as its ISOP (of the interval [on, on|dc]): balanced ANDs of
+    literals ORed by a balanced tree, cubes shared between outputs."""
+    n = spec.n
+    full = T.mask(n)
+    g = AIG(spec.inputs)
+    for name, on, dc in zip(spec.outputs, spec.on, spec.dc):
+        cubes, _ = T.isop(on & full, (on | dc) & full, n)
+        terms = []
+        for p, q in cubes:
+            lits = [2 * (i + 1) for i in range(n) if (p >> i) & 1]
+            lits += [2 * (i + 1) + 1 for i in range(n) if (q >> i) & 1]
+            terms.append(g.and_many(lits))
+        g.add_output(name, g.or_many(terms) if terms else 0)
+    return g.cleanup()
+
+
 def initial_candidates(spec, effort: int) -> list[AIG]:
     big_table = isinstance(spec, TableSpec) and spec.n >= 9 and effort >= 1
     # (for wide tables the decomposition's SOP step subsumes the plain lowering)
@@ -903,6 +1004,10 @@ def initial_candidates(spec, effort: int) -> list[AIG]:
             # the passes still see the don't cares (resubstitution at the outputs)
             for mode in ("isop", "zero", "one"):
                 cands.append(decomp.from_table(_filled(spec, mode), effort))
+    if effort >= 2 and isinstance(spec, TableSpec) and spec.n <= 8 and len(spec.outputs) > 1:
+        # the two-level form (cubes shared between outputs by structural hashing):
+        # unfactored, it leaves the passes more to share (comparators)
+        cands.append(_two_level(spec))
     if effort >= 1 and isinstance(spec, NetworkSpec) and len(spec.inputs) <= 12:
         # collapse to tables and decompose: finds structure the network hides
         from mlc.logic import decomp
