@@ -22,8 +22,12 @@ def register(sub):
     c.add_argument("--signal", choices=("expand", "contract", "both"), default="both")
     c.add_argument("--json", action="store_true")
     c.add_argument("--dynamic", action="store_true", help="verify by Brownian dynamics instead of statics")
-    c.add_argument("--kT", type=float, default=1e-5, help="thermal energy for --dynamic (k0 sigma^2)")
+    c.add_argument("--kT", type=float, default=1e-5,
+                   help="thermal energy for --dynamic and the --branches risk (k0 sigma^2)")
     c.add_argument("--seeds", type=int, default=4, help="number of seeds for --dynamic")
+    c.add_argument("--branches", action="store_true",
+                   help="also estimate the energy barrier to each lever's other assembly branch in every state "
+                        "(slow: about a minute per gate and convention) and the thermal escape risk at --kT")
     c.add_argument("--grid", type=int, default=3,
                    help="muscle-stroke lattice per input for the overlap sweep (3: states and half-way poses)")
     c.set_defaults(func=run_check)
@@ -48,9 +52,41 @@ def _selection(args):
     return names, signals
 
 
+RISK_KT = 20.0     # a fold barrier below this many kT is reported as a risk
+
+
+def _branch_risk(scene, name, signal, kT) -> dict:
+    """Lowest barrier (k0 sigma^2) to fold a lever side (a, b, out output sides) to its
+    other assembly branch over the input states (mlc.verify.branches.fold_barrier), and
+    the Arrhenius escape rate exp(-barrier/kT) per t0 (attempt rate of order 1 per t0:
+    overdamped Kramers sqrt(k_well k_saddle)/(2 pi gamma) with stiffnesses ~ sigma_min^2 k0
+    ~ 0.01 k0, i.e. ~1.6e-3 per gamma/k0 = 1.6 per t0)."""
+    import math
+
+    from mlc.verify.branches import fold_barrier
+    from mlc.verify.static import equilibrium
+    best = None
+    for state in scene.states():
+        eq = equilibrium(scene, state)
+        for ind in ("a.out", "b.out", "out.out"):
+            fb = fold_barrier(scene, state, ind, eq.pos, eq.quat, steps=6)
+            if best is None or fb.peak < best[0]:
+                best = (fb.peak, ind, state)
+    ratio = best[0] / kT
+    rate = math.exp(-ratio)
+    return {"gate": name, "signal": signal, "barrier": best[0], "indicator": best[1], "state": best[2],
+            "kT": kT, "barrier_kT": ratio, "rate_per_t0": rate, "risk": ratio < RISK_KT}
+
+
 def run_check(args) -> int:
     names, signals = _selection(args)
-    clear = []
+    clear, branch_rows = [], []
+    if args.branches and args.dynamic:
+        from mlc.errors import MlcError
+        raise MlcError("--branches is part of the static check", "--branches", "drop --dynamic")
+    if args.branches and not args.kT > 0:
+        from mlc.errors import MlcError
+        raise MlcError(f"the branch risk needs kT > 0, got {args.kT}", "--kT")
     if args.dynamic:
         from mlc.errors import MlcError
         if args.seeds < 1:
@@ -77,6 +113,8 @@ def run_check(args) -> int:
                     rep = at_state[r["state"]]
                     rows.append({"gate": name, "signal": signal, **r, "clearance": rep.min_clearance,
                                  "ok": bool(r["ok"] and rep.ok())})
+                if args.branches:
+                    branch_rows.append(_branch_risk(scene, name, signal, args.kT))
                 clear.append({"gate": name, "signal": signal, "min_clearance": worst.min_clearance,
                               "pair": list(worst.pair), "strokes": list(frac), "poses": len(poses),
                               "overlaps": [[a, b, d] for a, b, d in worst.overlaps], "ok": worst.ok()})
@@ -86,6 +124,8 @@ def run_check(args) -> int:
         out = {"mode": mode, "ok": ok, "rows": rows}
         if clear:
             out["clearance"] = clear
+        if branch_rows:
+            out["branches"] = branch_rows
         print(json.dumps(out))
     else:
         cl = " clearance" if clear else ""
@@ -107,4 +147,8 @@ def run_check(args) -> int:
                 for a, b, d in c["overlaps"]:
                     print(f"  {c['gate']} {c['signal']}: {a} and {b} interpenetrate {d:.4f} sigma deep "
                           f"at strokes {tuple(c['strokes'])}")
+        for b in branch_rows:
+            print(f"branches: {b['gate']} {b['signal']}: lowest fold barrier {b['barrier']:.4f} k0 sigma^2 "
+                  f"({b['indicator']}, state {b['state']}) = {b['barrier_kT']:.1f} kT at kT = {b['kT']:g}; "
+                  f"escape rate ~ {b['rate_per_t0']:.1e} per t0{'  RISK' if b['risk'] else ''}")
     return 0 if ok else 1

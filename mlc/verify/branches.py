@@ -13,7 +13,8 @@ them on their design side:
 * ``<lever>.in`` = (A - P) . u < 0 and ``<lever>.out`` = (B - P) . u > 0, for the levers
   ``a``, ``b`` and ``out``: P is the pivot, A and B the midpoints of the input and output
   ends, u the unit vector from A to B;
-* ``core.abc`` = ((b - a) x (c - a)) . z > 0 (c above ab) and ``core.cd`` =
+* ``core.abc`` = ((b - a) x (c - a)) . n > 0 (c above ab; n the hinge axis at a, +z as
+  built, so that a rigid rotation of the whole gate changes nothing) and ``core.cd`` =
   (d - c) . (c - m) > 0 (d beyond c).
 
 **Barrier.**  Any path from the design branch to a folded one crosses the surface where
@@ -69,7 +70,8 @@ def _indicators_from_sites(p, ix) -> dict:
     b = _mid(W("core_ab.b_0"), W("core_ab.b_1"))
     c = _mid(W("core_cd.c_0"), W("core_cd.c_1"))
     d = W("core_cd.d")
-    out["core.abc"] = float(np.cross(b - a, c - a)[2])
+    axis = W("core_ab.a_1") - W("core_ab.a_0")          # the core's hinge axis (+z as built)
+    out["core.abc"] = float(np.cross(b - a, c - a) @ axis)
     out["core.cd"] = float((d - c) @ (c - _mid(a, b)))
     return out
 
