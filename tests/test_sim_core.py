@@ -269,22 +269,119 @@ def test_gsd_mesh_faces_point_outward():
                 assert np.dot(n, (v[a] + v[b] + v[c]) / 3 - centre) > 0
 
 
-def test_neighbour_list_overflow_falls_back_and_grows():
-    sc = free_bodies(2)
+def test_neighbour_list_overflow_grows_and_redoes_the_work():
     bodies = [Body(f"f{i}", np.array([0.15 * i, 0.01 * i * i, 0.0]), np.array([1.0, 0, 0, 0]),
                    [Box(np.array([0.5, 0.5, 0.01]))], {}) for i in range(6)]
     sc = Scene("row", bodies).check()
     ref = Simulation(sc, None, SimOptions(kT=0))
     ref._eval()
     small = Simulation(sc, None, SimOptions(kT=0))
-    small.nl = np.zeros(1, np.int64)           # far too small: the cell list takes over
+    small.nl = np.zeros(1, np.int64)           # far too small: the evaluation stops, grows it, redoes
     small._eval()
-    assert np.allclose(small.F, ref.F) and small.nlstate[2] == 1
-    small._eval()                              # grown, the list is used again
-    assert small.nl.shape[0] >= 2 * 8 and small.nlstate[0] == 1
-    assert np.allclose(small.F, ref.F)
+    assert np.allclose(small.F, ref.F) and small.nl.shape[0] >= 2 * 8 and small.nlstate[0] == 1
+    assert small.nlstate[2] == 0
     # moving a body past half the skin rebuilds the list
     builds = ref.nlstate[1]
     ref.pos[0, 0] -= 0.06
     ref._eval()
     assert ref.nlstate[1] == builds + 1
+    # in a run, an overflow redoes the chunk with a larger list: the same trajectory bit for bit
+    bodies = [Body(f"f{i}", np.array([0.25 * i, 0.0, 0.0]), np.array([1.0, 0, 0, 0]),
+                   [Box(np.array([0.5, 0.5, 0.01]))], {}) for i in range(6)]
+    sc = Scene("row", bodies).check()          # neighbours within the list radius 0.3
+    for scheme in ("euler", "stiff"):
+        dt = 1e-5 if scheme == "euler" else 0.01
+        a = Simulation(sc, None, SimOptions(kT=1e-3, seed=2, scheme=scheme, dt=dt))
+        b = Simulation(sc, None, SimOptions(kT=1e-3, seed=2, scheme=scheme, dt=dt))
+        b.nl = np.zeros(1, np.int64)
+        ra, rb = a.run(0.02, record_interval=0.005), b.run(0.02, record_interval=0.005)
+        assert b.nl.shape[0] > 1 and np.array_equal(a.pos, b.pos) and np.array_equal(a.quat, b.quat)
+        assert np.allclose(ra.times, rb.times, rtol=0, atol=1e-12)
+
+
+def test_one_neighbour_search_in_the_kernels():
+    import inspect
+
+    src = inspect.getsource(K)
+    # the cell-block walk (2x2x2 block of cells around a body) exists once: in the list build
+    assert src.count("for ix in range(") == 1
+
+
+# -- run length, refusals, interrupts (issue 14 item 5) -----------------------------------------
+
+def test_last_step_ends_exactly_at_time(tmp_path, capsys):
+    from mlc.gates.library import gate_scene
+
+    p = tmp_path / "g.yaml"
+    write_scene(gate_scene("AND"), p)
+    assert main(["simulate", str(p), "--time", "0.01", "--dt", "0.003", "--json"]) == 0
+    js = json.loads(capsys.readouterr().out)
+    assert js["time"] == pytest.approx(0.01, abs=1e-15) and js["steps"] == 4
+    res = Simulation(gate_scene("AND"), None, SimOptions(dt=0.3)).run(1.0)
+    assert res.time == 1.0 and res.steps == 4 and res.times[-1] == 1.0
+
+
+@pytest.mark.parametrize("args, words", [
+    (["--time", "0.01", "--dt", "1"], "no larger than --time"),
+    (["--time", "1", "--dt", "1e6"], "no larger than --time"),
+    (["--time", "1", "--dt", "1e-12"], "steps"),
+    (["--time", "1", "--record", "-1"], "--record"),
+    (["--time", "1", "--record", "nan"], "--record"),
+    (["--time", "1", "--threads", "-3"], "--threads"),
+    (["--time", "1", "--fluct", "--scheme", "euler"], "--fluct"),
+])
+def test_cli_refuses_bad_run_lengths(tmp_path, capsys, args, words):
+    from mlc.gates.library import gate_scene
+
+    p = tmp_path / "g.yaml"
+    write_scene(gate_scene("AND"), p)
+    out = tmp_path / "t.gsd"
+    assert main(["simulate", str(p), "--out", str(out)] + args) == 2
+    err = capsys.readouterr().err
+    assert words in err and "Traceback" not in err and not out.exists()
+
+
+def test_ctrl_c_stops_within_a_second_with_complete_files(tmp_path, capsys):
+    import os
+    import signal
+    import threading
+    import time
+
+    import gsd.hoomd
+
+    p = tmp_path / "c.yaml"
+    write_scene(chain_scene(30), p)
+    out, probes = tmp_path / "t.gsd", tmp_path / "p.csv"
+    main(["simulate", str(p), "--time", "0.001", "--scheme", "euler", "--quiet"])      # compile outside the clock
+    capsys.readouterr()
+    sent = []
+    timer = threading.Timer(1.0, lambda: (sent.append(time.perf_counter()), os.kill(os.getpid(), signal.SIGINT)))
+    timer.start()
+    rc = main(["simulate", str(p), "--time", "1e5", "--dt", "1e-4", "--scheme", "euler", "--out", str(out),
+               "--frames", "50", "--probes", str(probes), "--quiet"])
+    back = time.perf_counter() - sent[0]
+    timer.cancel()
+    err = capsys.readouterr().err
+    print(f"\nCtrl-C: run returned {back:.2f} s after the signal")
+    assert rc == 130 and "interrupted at t =" in err
+    assert back < 3.0                           # stops between chunks of ~0.25 s (not after 1e9 steps)
+    with gsd.hoomd.open(str(out)) as f:
+        assert len(f) >= 1 and np.all(np.isfinite(f[-1].particles.position))
+    assert np.load(tmp_path / "p.npz")["time"][-1] > 0
+
+
+def test_fluct_mode_reported_in_json(tmp_path, capsys):
+    from mlc.gates.library import gate_scene
+
+    p = tmp_path / "g.yaml"
+    write_scene(gate_scene("NAND"), p)
+    assert main(["simulate", str(p), "--time", "0.2", "--fluct", "--json"]) == 0
+    js = json.loads(capsys.readouterr().out)
+    assert js["fluct"] and js["variance_bias"]["ratio_min"] == 1.0 and js["warnings"] == []
+    assert main(["simulate", str(p), "--time", "0.2", "--json"]) == 0
+    js = json.loads(capsys.readouterr().out)
+    assert js["variance_bias"]["ratio_min"] < 0.5           # plain SK-ROCK at dt = 0.05 t0: biased modes
+    assert main(["simulate", str(p), "--time", "0.5", "--kT", "1", "--json"]) == 0
+    cap = capsys.readouterr()
+    js = json.loads(cap.out)
+    assert js["warnings"] and "not bits" in cap.err

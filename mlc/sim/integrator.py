@@ -57,6 +57,10 @@ class SimOptions:
     accept: float = 1.0              # split a stiff step whose end state has a bond beyond this fraction of its bound
     rot_acc: float = 0.3             # ... or a body turned by more than this (rad) in a substep
     disp_acc: float = 0.01           # ... or drifted more than this (sigma; < r0/2: no tunnelling through WCA)
+    rot_var_max: float = 0.1         # with rot_noise: substeps no longer than this rotational noise variance (rad^2)
+    fluct: bool = False              # stiff scheme, fluctuation mode: eta = 0 and post-processed records
+                                     # (exact stationary variance of linear modes; see docs/simulation.md)
+    max_steps: float = 1e9           # refuse runs of more steps than this
 
 
 # default time steps (t0); see docs/simulation.md and benchmarks/results/sim_speed_error.json
@@ -80,6 +84,9 @@ class SimResult:
     frame_quat: np.ndarray = field(default_factory=lambda: np.zeros((0, 0, 4)))
     force_evals: int = 0
     stages: int = 1
+    interrupted: bool = False        # stopped by Ctrl-C: everything up to ``time`` is valid
+    warnings: list = field(default_factory=list)
+    variance_bias: dict = field(default_factory=dict)
 
     def final_probes(self) -> dict:
         return {k: float(v[-1]) for k, v in self.probes.items() if len(v)}
@@ -94,6 +101,9 @@ class Simulation:
         self.opt = o = options or SimOptions()
         if o.scheme not in SCHEMES:
             raise MlcError(f"unknown scheme {o.scheme!r}", "--scheme", "use euler or stiff")
+        if o.fluct and o.scheme != "stiff":
+            raise MlcError("the fluctuation mode is a variant of the stiff scheme", "--fluct",
+                           "use --scheme stiff, or Euler well below its limit (see docs/simulation.md)")
         if not (math.isfinite(o.kT) and o.kT >= 0):
             raise MlcError(f"kT must be finite and >= 0, got {o.kT}", "--kT")
         u = scene.units
@@ -193,7 +203,11 @@ class Simulation:
         self.qn = np.zeros((N, 4))
         self.xs = np.zeros((N, 3))
         self.qs = np.zeros((N, 4))
-        self.xl = np.zeros((N, 3))
+        self.Bc, self.Bn, self.zb = (np.zeros((N, 6)) for _ in range(3))
+        self.ppos = np.zeros((N, 3))
+        self.pquat = np.zeros((N, 4))
+        self._pos0, self._quat0 = self.pos.copy(), self.quat.copy()
+        self._drive_arg = dict(drives or {})
         self.arm_max = float(np.max(np.linalg.norm(self.site_local, axis=1))) if S else 0.0
         threads = o.threads
         import numba
@@ -250,14 +264,21 @@ class Simulation:
         return float(dt)
 
     def _grow_nlist(self):
-        """Enlarge the neighbour list after an overflow (the kernels fell back to the cell list)."""
+        """Enlarge the neighbour list after an overflow (the kernels stopped; the caller redoes the work)."""
         if self.nlstate[2] > 0:
             self.nl = np.zeros(int(2 * self.nlstate[3]) + 64, np.int64)
             self.nlstate[0] = 0.0
             self.nlstate[2] = 0.0
 
     def _eval(self):
-        self._grow_nlist()
+        """Forces, torques, site positions and monitors at the current state (grows the
+        neighbour list and re-evaluates when it overflowed)."""
+        self._eval_once()
+        while self.nlstate[2] > 0:
+            self._grow_nlist()
+            self._eval_once()
+
+    def _eval_once(self):
         eps, s, rc = self._wca()
         self._k["eval"](self.pos, self.quat, float(self.t), self.site_body, self.site_local, self.bsite0, self.sp_i,
                         self.sp_j, self.sp_k, self.sp_rest0, self.sp_rest1, self.sp_tol, self.sp_inp, self.sp_bound,
@@ -277,66 +298,132 @@ class Simulation:
                 for k, p in enumerate(self.scene.probes)}
 
     # -- running --------------------------------------------------------------------------
-    def advance(self, nsteps: int, rec_every: int = 0, frame_every: int = 0):
-        """Run ``nsteps`` steps in one compiled call; returns (records, frames_pos, frames_quat, done)."""
+    def _lev_min(self, dt_int: float) -> int:
+        """Smallest substep level of the stiff scheme: with rotational noise, substeps whose
+        rotational noise variance 2 kT h / gamma_r stays below ``rot_var_max`` (the exponential
+        map of a Gaussian rotation vector is accurate to ~0.08 sigma^2 in D_r); set before any
+        noise is drawn, so it does not condition on the noise."""
+        o = self.opt
+        if not (o.rot_noise and o.kT > 0 and o.scheme == "stiff"):
+            return 0
+        var = 2.0 * o.kT * dt_int / self.gamma_r
+        lev = max(0, math.ceil(math.log2(var / o.rot_var_max))) if var > o.rot_var_max else 0
+        if lev > K.LMAX - 4:
+            lim = o.rot_var_max * self.gamma_r / (2.0 * o.kT) * 2.0 ** (K.LMAX - 4) / self.t_unit
+            raise MlcError(f"dt = {dt_int / self.t_unit:g} t0 is too large for rotational noise at kT = {o.kT:g}",
+                           "--dt", f"use --dt {float(f'{lim:.1g}'):g} or less")
+        return lev
+
+    def advance(self, nsteps: int, rec_every: int = 0, frame_every: int = 0, rec_phase: int = 0,
+                frame_phase: int = 0, dt: float | None = None):
+        """Run ``nsteps`` steps of ``dt`` t0 (default the simulation's) in one compiled call,
+        recording probes at steps whose global index (``rec_phase`` + local) is a multiple of
+        ``rec_every`` and frames likewise; returns (records, frames_pos, frames_quat, done).
+        A neighbour-list overflow grows the list and redoes the call from its start."""
         o = self.opt
         P = len(self.scene.probes)
-        nrec = (nsteps + rec_every - 1) // rec_every if rec_every > 0 else 0
-        nfr = (nsteps + frame_every - 1) // frame_every if frame_every > 0 else 0
+        nrec = nsteps // rec_every + 1 if rec_every > 0 else 0
+        nfr = nsteps // frame_every + 1 if frame_every > 0 else 0
         rec = np.zeros((nrec, 1 + P))
         fpos = np.zeros((nfr, self.N, 3))
         fquat = np.zeros((nfr, self.N, 4))
         eps, s, rc = self._wca()
-        dt = self.dt * self.t_unit
-        self.status[:] = 0
-        self._grow_nlist()
+        dt = (self.dt if dt is None else dt) * self.t_unit
+        rph = rec_phase % rec_every if rec_every > 0 else 0       # global index = phase + local index
+        fph = frame_phase % frame_every if frame_every > 0 else 0
+        saved = (self.pos.copy(), self.quat.copy(), self.stages_out.copy(), self.pv.copy())
         a = self.arrays
-        common = (self.pos, self.quat, float(self.t), int(self.step), int(nsteps), float(dt), float(o.kT),
-                  float(self.gamma), float(self.gamma_r), bool(o.rot_noise), np.uint64(int(o.seed) & 0xFFFFFFFFFFFFFFFF),
-                  self.site_body, self.site_local, self.bsite0, self.sp_i, self.sp_j, self.sp_k, self.sp_rest0,
-                  self.sp_rest1, self.sp_tol, self.sp_inp, self.sp_bound, self.end0, self.end_sp, self.end_sign,
-                  self.dkind, self.dpar, self.tab_t, self.tab_v, eps, s, rc, float(o.wca_min), self.ex0, self.ex_list,
-                  self.head, self.nxt, self.cell, self.nl0, self.nl, self.pos_nl, self.nlstate,
-                  float(o.max_disp), float(o.max_rot), a.probe_i, a.probe_j,
-                  int(rec_every), rec, int(frame_every), fpos, fquat, self.uval, self.ws, self.arm, self.fsp, self.ratio, self.dmin,
-                  self.dpart, self.F, self.T, self.disp, self.mon, self.status)
-        if o.scheme == "euler":
-            done = self._k["euler"](*common)
-            self.stages_out[0] += done
-            self.stages_out[1] = 1
-        else:
-            done = self._k["skrock"](*common, float(o.eta), float(o.rho_safety), int(o.rho_every), 60, self.pv, self.pw,
-                                     self.sp_tmp, int(o.stages), self.stages_out, self.K0, self.K1, self.K2,
-                                     self.Qn, self.qn, self.xs, self.qs, float(o.accept), float(o.rot_acc),
-                                     float(o.disp_acc), self.arm_max)
+        while True:
+            self.status[:] = 0
+            self._grow_nlist()
+            common = (self.pos, self.quat, float(self.t), int(self.step), int(nsteps), float(dt), float(o.kT),
+                      float(self.gamma), float(self.gamma_r), bool(o.rot_noise),
+                      np.uint64(int(o.seed) & 0xFFFFFFFFFFFFFFFF),
+                      self.site_body, self.site_local, self.bsite0, self.sp_i, self.sp_j, self.sp_k, self.sp_rest0,
+                      self.sp_rest1, self.sp_tol, self.sp_inp, self.sp_bound, self.end0, self.end_sp, self.end_sign,
+                      self.dkind, self.dpar, self.tab_t, self.tab_v, eps, s, rc, float(o.wca_min), self.ex0,
+                      self.ex_list, self.head, self.nxt, self.cell, self.nl0, self.nl, self.pos_nl, self.nlstate,
+                      float(o.max_disp), float(o.max_rot), a.probe_i, a.probe_j,
+                      int(rec_every), int(rph), rec, int(frame_every), int(fph), fpos, fquat, self.uval, self.ws,
+                      self.arm, self.fsp, self.ratio, self.dmin, self.dpart, self.F, self.T, self.disp, self.mon,
+                      self.status)
+            if o.scheme == "euler":
+                done = self._k["euler"](*common)
+                self.stages_out[0] += done
+                self.stages_out[1] = 1
+            else:
+                eta = 0.0 if o.fluct else float(o.eta)
+                done = self._k["skrock"](*common, eta, float(o.rho_safety), int(o.rho_every), 60, self.pv,
+                                         self.pw, self.sp_tmp, int(o.stages), self.stages_out, self.K0, self.K1,
+                                         self.K2, self.Qn, self.qn, self.xs, self.qs, float(o.accept),
+                                         float(o.rot_acc), float(o.disp_acc), self.arm_max, self.Bc, self.Bn,
+                                         self.zb, self.ppos, self.pquat, bool(o.fluct), self._lev_min(dt))
+            if self.status[0] != K.OVERFLOW:
+                break
+            # the neighbour list outgrew its buffer: grow it and redo the call from its start
+            self.pos[:], self.quat[:], self.stages_out[:], self.pv[:] = saved
+            rec[:] = 0.0
         self.step += done
         self.t += done * dt
         if self.status[0] != K.OK:
-            self._fail()
-        nr = (done + rec_every - 1) // rec_every if rec_every > 0 else 0
-        nf = (done + frame_every - 1) // frame_every if frame_every > 0 else 0
+            self._fail(dt / self.t_unit)
+        nr, nf = _count(done, rec_every, rph), _count(done, frame_every, fph)
         return rec[:nr], fpos[:nf], fquat[:nf], done
 
-    def _fail(self):
+    # -- failures -------------------------------------------------------------------------
+    def _check_initial(self):
+        """The initial state's monitors (a bond beyond its bound, overlapping WCA centres):
+        reported at t = 0, whatever the time step."""
+        self._eval()
+        self.status[:] = 0
+        if K._failed(self.mon, float(self.opt.wca_min), self.status, 0):
+            self._fail()
+
+    def _suggest_euler_dt(self, t_fail: float, dt_failed: float):
+        """A dt for Euler computed from the scene at rest (its initial state, drives at t = 0),
+        checked by running it from that state past the failure time (at most 2e5 steps);
+        returns (dt or None, checked, Euler limit at rest in t0)."""
+        o = self.opt
+        trial_opt = SimOptions(**{**o.__dict__, "dt": None, "scheme": "euler"})
+        try:
+            rest = Simulation(self.scene, self._drive_arg, trial_opt, pos=self._pos0, quat=self._quat0)
+            lim = rest.euler_limit()
+        except MlcError:
+            return None, False, math.nan
+        if not math.isfinite(lim):
+            return None, False, lim
+        dt = float(f"{min(0.5 * lim, 0.5 * dt_failed):.1g}")
+        horizon = t_fail + 20 * dt_failed
+        for _ in range(3):
+            if horizon / dt > 2e5:
+                return dt, False, lim            # too long to check here
+            try:
+                trial = Simulation(self.scene, self._drive_arg, SimOptions(**{**trial_opt.__dict__, "dt": dt}),
+                                   pos=self._pos0, quat=self._quat0)
+                trial.run(horizon, record_interval=horizon, quiet=True)
+                return dt, True, lim
+            except MlcError:
+                dt = float(f"{dt / 4:.1g}")
+        return None, False, lim
+
+    def _fail(self, dt_t0: float | None = None):
         st = self.status
         code, step = int(st[0]), int(st[1])
-        t = step * self.dt
+        dt_t0 = self.dt if dt_t0 is None else dt_t0
+        t = self.t / self.t_unit - (self.step - step) * dt_t0
         names = [b.name for b in self.scene.bodies]
         o = self.opt
         if o.scheme == "euler":
-            try:
-                self._rho = None
-                lim = self.euler_limit()
-            except Exception:  # noqa: BLE001 - the state may be garbage; the estimate is advisory
-                lim = math.nan
-            if math.isfinite(lim) and self.dt > 0.5 * lim:
-                fix = f"use --dt {float(f'{0.5 * lim:.1g}'):g} or less (Euler's limit here is about {lim:.2g} t0)"
+            sug, checked, lim = (None, False, math.nan) if step == 0 else self._suggest_euler_dt(t, dt_t0)
+            if sug is not None:
+                fix = (f"use --dt {sug:g} or less (from the scene at rest, where Euler's limit is about "
+                       f"{lim:.2g} t0" + ("; checked: it runs past this point)" if checked else ")"))
             else:
-                fix = (f"use --dt {float(f'{self.dt / 4:.1g}'):g} or --scheme stiff; "
-                       "if that fails too, the scene itself is at fault")
+                fix = ("use --scheme stiff: no Euler step checked from the scene at rest gets past this point, "
+                       "so the scene itself may be at fault")
         else:
             lim = self.euler_limit()
-            fix = ("no time step helps: the stiff scheme refined this step 2^20-fold; the scene itself drives "
+            fix = ("no time step helps: the stiff scheme refined this step 2^30-fold; the scene itself drives "
                    "it (a muscle pulling a joint apart, bodies pushed together), check it"
                    + (f"; --scheme euler --dt {float(f'{0.5 * lim:.1g}'):g} shows the motion up to here"
                       if math.isfinite(lim) else ""))
@@ -359,25 +446,89 @@ class Simulation:
                    f"{o.wca_min:g} sigma (WCA cores overlap)")
         elif code == K.DISPLACEMENT:
             b = int(st[2])
-            msg = (f"unstable at t = {t:.6g} t0 (step {step}): body {names[b]} moved more than "
-                   f"{o.max_disp:g} sigma or {o.max_rot:g} rad in one step")
+            msg = (f"unstable at t = {t:.6g} t0 (step {step}): body {names[b]} drifted more than "
+                   f"{o.max_disp:g} sigma or {o.max_rot:g} rad in one step (deterministic part; noise not counted)")
         else:
             msg = f"unstable at t = {t:.6g} t0 (step {step}): non-finite forces or positions"
         raise MlcError(msg, "--dt", fix)
 
+    # -- what a run can and cannot claim ------------------------------------------------------
+    def variance_bias(self, dt: float | None = None) -> dict:
+        """Linear-theory stationary variance of a harmonic mode over its exact value kT/(k),
+        for the modes this scheme and dt integrate (the stiffest at rho, the estimate of
+        :meth:`rho`): Euler 1/(1 - h lambda/2); SK-ROCK (eta > 0) oscillates with h lambda
+        (min and max over the modes up to rho); the fluctuation mode is exact (1.0) for every
+        mode.  Keys: scheme, h_rho (stiffest mode's h lambda), ratio_min, ratio_max."""
+        dt = self.dt if dt is None else dt
+        h = dt * self.t_unit
+        r = self.rho()
+        hr = h * r
+        if self.opt.scheme == "euler":
+            v = 1.0 / (1.0 - 0.5 * hr) if hr < 2 else math.inf
+            return {"scheme": "euler", "h_rho": hr, "ratio_min": 1.0, "ratio_max": v,
+                    "note": "stiffest mode 1/(1 - h lambda/2); softer modes lie between"}
+        if self.opt.fluct:
+            return {"scheme": "stiff-fluct", "h_rho": hr, "ratio_min": 1.0, "ratio_max": 1.0,
+                    "note": "post-processed SK-ROCK with eta = 0: exact for every linear mode"}
+        lo, hi = skrock_variance_range(hr, self.opt.eta, hr * self.opt.rho_safety)
+        return {"scheme": "stiff", "h_rho": hr, "ratio_min": lo, "ratio_max": hi,
+                "note": "SK-ROCK variance ratio over modes with h lambda in (0, h rho]"}
+
+    def thermal_warnings(self, res) -> list[str]:
+        """Warnings for a run whose thermal bond fluctuations reach the logic margin: the
+        a-priori bond scale sqrt(kT/k) of the softest spring against half the smallest probe
+        margin, and the measured probe readings (spread over the second half of the run, or
+        a reading outside the probe's range by more than its margin)."""
+        out = []
+        kT = self.opt.kT
+        probes = self.scene.probes
+        if not probes or kT <= 0:
+            return out
+        margins = {p.name: 0.5 * abs(p.actuated - p.rest) for p in probes}
+        mmin = min(margins.values())
+        if len(self.sp_k):
+            kmin = float(np.min(self.sp_k))
+            th = math.sqrt(kT / kmin)
+            if th >= 0.5 * mmin:
+                out.append(f"kT = {kT:g}: thermal bond fluctuations sqrt(kT/k) = {th:.3g} sigma reach the logic "
+                           f"margin ({mmin:.3g} sigma from a probe's threshold): the outputs are not bits")
+        for p in probes:
+            v = np.asarray(res.probes.get(p.name, []))
+            if len(v) < 4:
+                continue
+            tail = v[len(v) // 2:]
+            lo, hi = min(p.rest, p.actuated), max(p.rest, p.actuated)
+            m = margins[p.name]
+            sd = float(np.std(tail))
+            mean = float(np.mean(tail))
+            if 3.0 * sd >= m or mean < lo - m or mean > hi + m:
+                out.append(f"probe {p.name}: reads {mean:.3g} +- {sd:.2g} sigma over the second half of the run, "
+                           f"against a margin of {m:.3g} sigma around [{lo:.3g}, {hi:.3g}]: not a bit")
+        return out
+
     def run(self, time: float, record_interval: float | None = None, frames: int = 0,
             progress: bool | None = None, quiet: bool = False) -> SimResult:
-        """Advance by ``time`` t0; record probes every ``record_interval`` t0 (default: about
-        2000 records) and ``frames`` snapshots.  Shows a progress bar on a TTY for long runs."""
+        """Advance by ``time`` t0 in steps of at most the simulation's dt (the last step ends
+        exactly at ``time``: the run's step is time / ceil(time / dt)); record probes every
+        ``record_interval`` t0 (default: about 2000 records) and ``frames`` snapshots.  Shows
+        a progress bar on a TTY for long runs.  Ctrl-C stops within about a second and
+        returns what was computed (``interrupted`` set)."""
         if not (math.isfinite(time) and time >= 0):
             raise MlcError(f"time must be a finite number >= 0 of t0, got {time}", "--time")
-        nsteps = int(round(time / self.dt))
-        if nsteps == 0 and time > 0:
-            nsteps = 1
+        if record_interval is not None and not (math.isfinite(record_interval) and record_interval > 0):
+            raise MlcError(f"record interval must be a positive number of t0, got {record_interval}", "--record")
+        nsteps = math.ceil(time / self.dt - 1e-9) if time > 0 else 0
+        if self.step == 0:
+            self._check_initial()
+        if nsteps > self.opt.max_steps:
+            raise MlcError(f"--time {time:g} at --dt {self.dt:g} is {nsteps:.3g} steps (more than "
+                           f"{self.opt.max_steps:.3g})", "--dt",
+                           "use a larger --dt (the stiff scheme takes any dt) or a shorter --time")
+        dt = time / nsteps if nsteps else self.dt
         if record_interval is None:
             rec_every = max(1, nsteps // 2000)
         else:
-            rec_every = max(1, int(round(record_interval / self.dt)))
+            rec_every = max(1, int(round(record_interval / dt)))
         # sampled frames plus the final state
         frame_every = max(1, -(-nsteps // max(frames - 1, 1))) if frames else 0
         show = progress if progress is not None else (not quiet and sys.stderr.isatty())
@@ -386,26 +537,32 @@ class Simulation:
         t_wall = _time.perf_counter()
         evals0 = self.stages_out[0]
         done_total = 0
-        # chunks are whole multiples of the record and frame intervals (sampling indices are chunk-local)
-        lcm = rec_every * (frame_every or 1) // math.gcd(rec_every, frame_every or 1)
-        chunk = lcm * max(1, -(-16 // lcm))
-        while done_total < nsteps:
-            n = min(chunk, nsteps - done_total)
-            t_before = self.t
-            c0 = _time.perf_counter()
-            rec, fp, fq, done = self.advance(n, rec_every, frame_every)
-            el = _time.perf_counter() - c0
-            recs.append(rec)
-            if len(fp):
-                fps.append(fp)
-                fqs.append(fq)
-                ftimes.extend((t_before + np.arange(len(fp)) * frame_every * self.dt * self.t_unit) / self.t_unit)
-            done_total += done
-            bar.update(done_total)
-            # aim at ~0.25 s per chunk
-            per = el / max(done, 1)
-            target = int(0.25 / per) if per > 0 else chunk * 2
-            chunk = max(lcm, (min(max(target, chunk // 2), chunk * 4) // lcm) * lcm)
+        interrupted = False
+        t_start = self.t
+        chunk = 16
+        stop = _Interrupt()
+        with stop:
+            while done_total < nsteps and not stop.hit:
+                n = min(chunk, nsteps - done_total)
+                c0 = _time.perf_counter()
+                rec, fp, fq, done = self.advance(n, rec_every, frame_every, done_total, done_total, dt)
+                el = _time.perf_counter() - c0
+                recs.append(rec)
+                if len(fp):
+                    fps.append(fp)
+                    fqs.append(fq)
+                    g = np.arange(done_total, done_total + done)
+                    g = g[g % frame_every == 0]
+                    ftimes.extend((t_start + g * dt * self.t_unit) / self.t_unit)
+                done_total += done
+                bar.update(done_total)
+                # aim at ~0.25 s per chunk (Ctrl-C is seen between chunks)
+                per = el / max(done, 1)
+                target = int(0.25 / per) if per > 0 else chunk * 2
+                chunk = max(1, min(max(target, chunk // 2), chunk * 4))
+        interrupted = stop.hit
+        if done_total == nsteps:
+            self.t = t_start + time * self.t_unit          # exactly, without round-off of the step sum
         # final sample
         last = self.probe_lengths()
         if frames:
@@ -417,12 +574,80 @@ class Simulation:
         R = np.concatenate(recs) if recs else np.zeros((0, 1 + len(self.scene.probes)))
         times = np.concatenate([R[:, 0] / self.t_unit, [self.t / self.t_unit]])
         probes = {p.name: np.concatenate([R[:, 1 + k], [last[p.name]]]) for k, p in enumerate(self.scene.probes)}
-        return SimResult(
+        res = SimResult(
             scheme=self.opt.scheme, dt=self.dt, steps=done_total, time=self.t / self.t_unit, wall=wall,
             times=times, probes=probes, pos=self.pos.copy(), quat=self.quat.copy(),
             frame_times=np.array(ftimes), frame_pos=np.concatenate(fps) if fps else np.zeros((0, self.N, 3)),
             frame_quat=np.concatenate(fqs) if fqs else np.zeros((0, self.N, 4)),
-            force_evals=int(self.stages_out[0] - evals0), stages=int(self.stages_out[1]))
+            force_evals=int(self.stages_out[0] - evals0), stages=int(self.stages_out[1]), interrupted=interrupted)
+        res.warnings = self.thermal_warnings(res)
+        return res
+
+
+def _count(done: int, every: int, phase: int) -> int:
+    """How many local indices n in [0, done) have (n + phase) % every == 0."""
+    if every <= 0 or done <= 0:
+        return 0
+    first = (-phase) % every
+    return 0 if first >= done else (done - 1 - first) // every + 1
+
+
+def skrock_variance_range(h_rho: float, eta: float, h_rho_max: float | None = None) -> tuple[float, float]:
+    """Min and max over h lambda in (0, h_rho] of SK-ROCK's stationary variance of the mode
+    dX = -lambda X dt + sqrt(2) dW over the exact 1/lambda, with the stage count the scheme
+    uses for the bound ``h_rho_max`` (default h_rho): 2|p| S(p)^2 / (1 - R(p)^2),
+    R = T_s(w0 + w1 p)/T_s(w0), S = U_{s-1}(w0 + w1 p)/U_{s-1}(w0) (1 + w1 p/2)."""
+    if h_rho <= 0:
+        return 1.0, 1.0
+    hm = h_rho if h_rho_max is None else max(h_rho_max, h_rho)
+    s = max(2, math.ceil(math.sqrt(hm / (2.0 - 4.0 * eta / 3.0))))
+    w0 = 1.0 + eta / s ** 2
+
+    def tu(n, x):
+        t0, t1 = np.ones_like(x), x.copy()
+        u0, u1 = np.ones_like(x), 2 * x
+        for _ in range(2, n + 1):
+            t0, t1 = t1, 2 * x * t1 - t0
+            u0, u1 = u1, 2 * x * u1 - u0
+        return t1, u0                  # T_n, U_{n-1} (n >= 2)
+
+    x0 = np.array([w0])
+    ts0, us10 = tu(s, x0)
+    w1 = float(ts0[0] / (s * us10[0]))
+    p = -np.linspace(1e-6 * h_rho, h_rho, 20001)
+    x = w0 + w1 * p
+    ts, us1 = tu(s, x)
+    R = ts / ts0[0]
+    S = us1 / us10[0] * (1 + w1 * p / 2)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        r = 2 * (-p) * S * S / (1 - R * R)
+    r = r[np.isfinite(r)]
+    return float(np.min(r)), float(np.max(r))
+
+
+class _Interrupt:
+    """Within ``with``: Ctrl-C (SIGINT) sets ``hit`` instead of raising, so a run stops
+    cleanly between two compiled chunks (each ~0.25 s).  Outside the main thread: no-op."""
+
+    def __init__(self):
+        self.hit = False
+        self._old = None
+
+    def __enter__(self):
+        import signal
+        import threading
+        if threading.current_thread() is threading.main_thread():
+            self._old = signal.signal(signal.SIGINT, self._handler)
+        return self
+
+    def _handler(self, signum, frame):
+        self.hit = True
+
+    def __exit__(self, *exc):
+        import signal
+        if self._old is not None:
+            signal.signal(signal.SIGINT, self._old)
+        return False
 
 
 class _Progress:

@@ -29,7 +29,8 @@ import numpy as np
 from numba import njit, prange
 
 # failure codes returned in status[0]
-OK, STRETCH, WCA_CLOSE, DISPLACEMENT, NONFINITE = 0, 1, 2, 3, 4
+OK, STRETCH, WCA_CLOSE, DISPLACEMENT, NONFINITE, OVERFLOW = 0, 1, 2, 3, 4, 5
+LMAX = 30          # deepest substep level of the stiff scheme: dt / 2^30
 
 _M1 = np.uint64(0xBF58476D1CE4E5B9)
 _M2 = np.uint64(0x94D049BB133111EB)
@@ -142,9 +143,9 @@ def build_cells(pos, h, head, nxt, cell):
 def nlist_update(pos, rc, skin, head, nxt, cell, ex0, ex_list, nl0, nl, pos_nl, nlstate):
     """Verlet neighbour list of radius rc + skin (bonded pairs left out), rebuilt through
     the cell list when a body moved more than skin/2 since the last build.  Returns
-    True when the list is valid; False when it overflowed ``nl`` (the caller then uses
-    the cell list, just built; nlstate[2] counts overflows, nlstate[3] the size needed).
-    nlstate[0] = list valid, nlstate[1] = builds."""
+    True when the list is valid; False when it overflowed ``nl`` (nlstate[2] counts
+    overflows, nlstate[3] the size needed: the caller stops, grows ``nl`` and redoes the
+    work).  nlstate[0] = list valid, nlstate[1] = builds."""
     N = pos.shape[0]
     need = nlstate[0] == 0.0
     if not need:
@@ -279,12 +280,11 @@ def _eval_py(pos, quat, t, site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_r
         fsp[m, 0] = c * dx
         fsp[m, 1] = c * dy
         fsp[m, 2] = c * dz
-    # gather per body, then WCA through the Verlet list (or the cell list if it overflowed)
+    # gather per body, then WCA through the Verlet list.  A list that overflowed its buffer
+    # leaves WCA out and nlstate[2] > 0: the caller grows the list and redoes the step.
     nlok = True
     if wca_eps > 0.0:
         nlok = nlist_update(pos, wca_rc, 0.5 * wca_rc, head, nxt, cell, ex0, ex_list, nl0, nl, pos_nl, nlstate)
-    mask = head.shape[0] - 1
-    h = 2.0 * (wca_rc + 0.5 * wca_rc)      # the cell size nlist_update builds with
     rc2 = wca_rc * wca_rc
     s2 = wca_s * wca_s
     for b in prange(N):
@@ -325,6 +325,7 @@ def _eval_py(pos, quat, t, site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_r
                 if r2 < rc2:
                     ir2 = s2 / r2
                     ir6 = ir2 * ir2 * ir2
+                    # F = -dU/dr rhat = 24 eps (2 (s/r)^12 - (s/r)^6) / r^2 * d
                     c = 24.0 * wca_eps * (2.0 * ir6 * ir6 - ir6) / r2
                     fx += c * dx
                     fy += c * dy
@@ -333,46 +334,6 @@ def _eval_py(pos, quat, t, site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_r
                     if r < dm:
                         dm = r
                         dp = j
-        elif wca_eps > 0.0:
-            px = pos[b, 0]
-            py = pos[b, 1]
-            pz = pos[b, 2]
-            # the 2x2x2 block of cells (size 2 (rc + skin)) nearest to the body
-            cx0 = cell[b, 0]
-            cy0 = cell[b, 1]
-            cz0 = cell[b, 2]
-            ox = -1 if px - cx0 * h < 0.5 * h else 0
-            oy = -1 if py - cy0 * h < 0.5 * h else 0
-            oz = -1 if pz - cz0 * h < 0.5 * h else 0
-            for ix in range(cx0 + ox, cx0 + ox + 2):
-                for iy in range(cy0 + oy, cy0 + oy + 2):
-                    for iz in range(cz0 + oz, cz0 + oz + 2):
-                        j = head[_cell_key(ix, iy, iz, mask)]
-                        while j >= 0:
-                            if j != b and cell[j, 0] == ix and cell[j, 1] == iy and cell[j, 2] == iz:
-                                dx = px - pos[j, 0]
-                                dy = py - pos[j, 1]
-                                dz = pz - pos[j, 2]
-                                r2 = dx * dx + dy * dy + dz * dz
-                                if r2 < rc2:
-                                    excluded = False
-                                    for x in range(ex0[b], ex0[b + 1]):
-                                        if ex_list[x] == j:
-                                            excluded = True
-                                            break
-                                    if not excluded:
-                                        ir2 = s2 / r2
-                                        ir6 = ir2 * ir2 * ir2
-                                        # F = -dU/dr rhat = 24 eps (2 (s/r)^12 - (s/r)^6) / r^2 * d
-                                        c = 24.0 * wca_eps * (2.0 * ir6 * ir6 - ir6) / r2
-                                        fx += c * dx
-                                        fy += c * dy
-                                        fz += c * dz
-                                        r = math.sqrt(r2)
-                                        if r < dm:
-                                            dm = r
-                                            dp = j
-                            j = nxt[j]
         F[b, 0] = fx
         F[b, 1] = fy
         F[b, 2] = fz
@@ -495,22 +456,42 @@ def _spectral_py(site_body, arm, sp_i, sp_j, sp_k, end0, end_sp, end_sign, sp_tm
 
 
 @njit(cache=True)
-def _record(n, t, rec_every, rec, nrec, probe_i, probe_j, ws, frame_every, fpos, fquat, nfr, pos, quat):
-    """Record the probe lengths (every ``rec_every`` steps) and a frame (every ``frame_every``)
-    at step ``n``; returns the new counts ``(nrec, nfr)``."""
-    if rec_every > 0 and n % rec_every == 0 and nrec < rec.shape[0]:
+def _site_world(pos, quat, b, lx, ly, lz):
+    """World position of the body-frame point (lx, ly, lz) of body b."""
+    q0 = quat[b, 0]
+    q1 = quat[b, 1]
+    q2 = quat[b, 2]
+    q3 = quat[b, 3]
+    x = pos[b, 0] + (1 - 2 * (q2 * q2 + q3 * q3)) * lx + 2 * (q1 * q2 - q0 * q3) * ly + 2 * (q1 * q3 + q0 * q2) * lz
+    y = pos[b, 1] + 2 * (q1 * q2 + q0 * q3) * lx + (1 - 2 * (q1 * q1 + q3 * q3)) * ly + 2 * (q2 * q3 - q0 * q1) * lz
+    z = pos[b, 2] + 2 * (q1 * q3 - q0 * q2) * lx + 2 * (q2 * q3 + q0 * q1) * ly + (1 - 2 * (q1 * q1 + q2 * q2)) * lz
+    return x, y, z
+
+
+@njit(cache=True)
+def _record(n, t, rec_every, rec_phase, rec, nrec, probe_i, probe_j, site_body, site_local,
+            frame_every, frame_phase, fpos, fquat, nfr, pos, quat):
+    """Record the probe lengths (when (n + rec_phase) is a multiple of ``rec_every``) and a
+    frame (likewise with ``frame_every``) of the state (pos, quat); returns ``(nrec, nfr)``."""
+    if rec_every > 0 and (n + rec_phase) % rec_every == 0 and nrec < rec.shape[0]:
         rec[nrec, 0] = t
         for p in range(probe_i.shape[0]):
-            dx = ws[probe_j[p], 0] - ws[probe_i[p], 0]
-            dy = ws[probe_j[p], 1] - ws[probe_i[p], 1]
-            dz = ws[probe_j[p], 2] - ws[probe_i[p], 2]
-            rec[nrec, 1 + p] = math.sqrt(dx * dx + dy * dy + dz * dz)
+            i = probe_i[p]
+            j = probe_j[p]
+            xi, yi, zi = _site_world(pos, quat, site_body[i], site_local[i, 0], site_local[i, 1], site_local[i, 2])
+            xj, yj, zj = _site_world(pos, quat, site_body[j], site_local[j, 0], site_local[j, 1], site_local[j, 2])
+            rec[nrec, 1 + p] = math.sqrt((xj - xi) ** 2 + (yj - yi) ** 2 + (zj - zi) ** 2)
         nrec += 1
-    if frame_every > 0 and n % frame_every == 0 and nfr < fpos.shape[0]:
+    if frame_every > 0 and (n + frame_phase) % frame_every == 0 and nfr < fpos.shape[0]:
         fpos[nfr] = pos
         fquat[nfr] = quat
         nfr += 1
     return nrec, nfr
+
+
+@njit(cache=True)
+def _due(n, every, phase):
+    return every > 0 and (n + phase) % every == 0
 
 
 @njit(cache=True)
@@ -535,10 +516,12 @@ def _euler_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_noi
               site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_rest0, sp_rest1, sp_tol, sp_inp, sp_bound,
               end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v, wca_eps, wca_s, wca_rc, wca_min,
               ex0, ex_list, head, nxt, cell, nl0, nl, pos_nl, nlstate, max_disp, max_rot,
-              probe_i, probe_j, rec_every, rec, frame_every, fpos, fquat,
+              probe_i, probe_j, rec_every, rec_phase, rec, frame_every, frame_phase, fpos, fquat,
               uval, ws, arm, fsp, ratio, dmin, dpart, F, T, disp, mon, status):
     """Euler-Maruyama for ``nsteps`` steps; returns the number of steps done.
-    Stops early with status[0] != OK (status[1] = step, status[2..] = culprit)."""
+    Stops early with status[0] != OK (status[1] = step, status[2..] = culprit).  The
+    per-step motion monitor looks at the deterministic part (drift) only: noise alone,
+    however large, is never an instability."""
     N = pos.shape[0]
     amp = math.sqrt(2.0 * kT * dt / gamma)
     amp_r = math.sqrt(2.0 * kT * dt / gamma_r) if rot_noise else 0.0
@@ -553,35 +536,39 @@ def _euler_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_noi
               sp_inp, sp_bound, end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v,
               wca_eps, wca_s, wca_rc, ex0, ex_list, head, nxt, cell, nl0, nl, pos_nl, nlstate,
               uval, ws, arm, fsp, ratio, dmin, dpart, F, T, mon)
-        nrec, nfr = _record(n, t, rec_every, rec, nrec, probe_i, probe_j, ws, frame_every, fpos, fquat, nfr,
-                            pos, quat)
+        if nlstate[2] > 0.0:
+            status[0] = OVERFLOW
+            status[1] = step
+            return n
+        nrec, nfr = _record(n, t, rec_every, rec_phase, rec, nrec, probe_i, probe_j, site_body, site_local,
+                            frame_every, frame_phase, fpos, fquat, nfr, pos, quat)
         if _failed(mon, wca_min, status, step):
             return n
         for b in prange(N):
             xi0, xi1 = gauss2(seed, step, 2 * b)
             xi2, xi3 = gauss2(seed, step, 2 * b + 1)
-            dx = mt * F[b, 0] + amp * xi0
-            dy = mt * F[b, 1] + amp * xi1
-            dz = mt * F[b, 2] + amp * xi2
+            fx = mt * F[b, 0]
+            fy = mt * F[b, 1]
+            fz = mt * F[b, 2]
             wx = mr * T[b, 0]
             wy = mr * T[b, 1]
             wz = mr * T[b, 2]
+            # squared drift ratios: <= 1 exactly when the ratios are
+            disp[b] = max((fx * fx + fy * fy + fz * fz) / (max_disp * max_disp),
+                          (wx * wx + wy * wy + wz * wz) / (max_rot * max_rot))
             if rot_noise:
                 e0, e1 = gauss2(seed, step, 2 * N + 2 * b)
                 wx += amp_r * xi3
                 wy += amp_r * e0
                 wz += amp_r * e1
-            pos[b, 0] += dx
-            pos[b, 1] += dy
-            pos[b, 2] += dz
+            pos[b, 0] += fx + amp * xi0
+            pos[b, 1] += fy + amp * xi1
+            pos[b, 2] += fz + amp * xi2
             q0, q1, q2, q3 = quat_exp_mul(wx, wy, wz, quat[b, 0], quat[b, 1], quat[b, 2], quat[b, 3])
             quat[b, 0] = q0
             quat[b, 1] = q1
             quat[b, 2] = q2
             quat[b, 3] = q3
-            # squared displacement ratios: <= 1 exactly when the ratios are
-            disp[b] = max((dx * dx + dy * dy + dz * dz) / (max_disp * max_disp),
-                          (wx * wx + wy * wy + wz * wz) / (max_rot * max_rot))
         worst = 0.0
         wb = -1
         for b in range(N):
@@ -598,18 +585,97 @@ def _euler_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_noi
     return nsteps
 
 
-def _sk_step_py(pos, quat, t, h, kT, gamma, gamma_r, rot_noise, seed, key, s, eta,
+@njit(cache=True)
+def _normals3(seed, key, b, rot, out):
+    """Three (or six with ``rot``) standard normals for counter (seed, key, body b) into out[0:6]."""
+    a0, a1 = gauss2(seed, key, 3 * b)
+    a2, a3 = gauss2(seed, key, 3 * b + 1)
+    out[0] = a0
+    out[1] = a1
+    out[2] = a2
+    if rot:
+        a4, a5 = gauss2(seed, key, 3 * b + 2)
+        out[3] = a3
+        out[4] = a4
+        out[5] = a5
+    else:
+        out[3] = 0.0
+        out[4] = 0.0
+        out[5] = 0.0
+
+
+@njit(cache=True)
+def brownian_at(seed, step, k, lev, b, rot, out, z):
+    """Standard Brownian path of macro step ``step``, body ``b``, at the dyadic point
+    u = k / 2^lev of the step (B(0) = 0, Var B(u) = u), into out[0:6] (3 components, 6 with
+    ``rot``).  Levy's construction: B(1) and the midpoint of every dyadic interval (heap
+    index H, the root interval H = 1) come from counter-based normals keyed by
+    (seed, step * 2^31 + H); the midpoint is the mean of the ends plus sqrt(width/4) times
+    its normal.  So the value at a point does not depend on which other points were
+    visited: refining a substep keeps the Brownian path (no conditioning on the noise)."""
+    while lev > 0 and (k & 1) == 0:
+        k >>= 1
+        lev -= 1
+    key0 = np.uint64(step) * np.uint64(2147483648)
+    if k == 0:
+        for c in range(6):
+            out[c] = 0.0
+        return
+    _normals3(seed, key0, b, rot, out)        # B(1)
+    if lev == 0:
+        return
+    ba0, ba1, ba2, ba3, ba4, ba5 = 0.0, 0.0, 0.0, 0.0, 0.0, 0.0
+    bb0, bb1, bb2, bb3, bb4, bb5 = out[0], out[1], out[2], out[3], out[4], out[5]
+    a = 0
+    H = 1
+    w = 1.0
+    for j in range(1, lev + 1):
+        _normals3(seed, key0 + np.uint64(H), b, rot, z)
+        sd = 0.5 * math.sqrt(w)
+        m0 = 0.5 * (ba0 + bb0) + sd * z[0]
+        m1 = 0.5 * (ba1 + bb1) + sd * z[1]
+        m2 = 0.5 * (ba2 + bb2) + sd * z[2]
+        m3 = 0.5 * (ba3 + bb3) + sd * z[3]
+        m4 = 0.5 * (ba4 + bb4) + sd * z[4]
+        m5 = 0.5 * (ba5 + bb5) + sd * z[5]
+        if j == lev:
+            out[0] = m0
+            out[1] = m1
+            out[2] = m2
+            out[3] = m3
+            out[4] = m4
+            out[5] = m5
+            return
+        kj = k >> (lev - j)
+        if kj == 2 * a:
+            bb0, bb1, bb2, bb3, bb4, bb5 = m0, m1, m2, m3, m4, m5
+            a = 2 * a
+            H = 2 * H
+        else:
+            ba0, ba1, ba2, ba3, ba4, ba5 = m0, m1, m2, m3, m4, m5
+            a = 2 * a + 1
+            H = 2 * H + 1
+        w *= 0.5
+
+
+@njit(cache=True)
+def stages_for(h, rho, eta):
+    """SK-ROCK stage count: the smallest s >= 2 with (2 - 4 eta/3) s^2 >= h rho."""
+    s = int(math.ceil(math.sqrt(h * rho / (2.0 - 4.0 * eta / 3.0))))
+    return s if s >= 2 else 2
+
+
+def _sk_step_py(pos, quat, t, h, gamma, gamma_r, noisy, s, eta,
                 site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_rest0, sp_rest1, sp_tol, sp_inp, sp_bound,
                 end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v, wca_eps, wca_s, wca_rc,
                 ex0, ex_list, head, nxt, cell, nl0, nl, pos_nl, nlstate, uval, ws, arm, fsp, ratio, dmin, dpart, F, T, mon,
                 K0, K1, K2, Qn, qn):
-    """One SK-ROCK step of size h with s stages from (pos, quat); F, T must hold the
-    forces at (pos, quat, t).  Orientations enter the stages as rotation vectors theta
-    (q = exp(theta) q_n) in the chart of the step's start orientation, with
-    theta' = J_l(theta)^-1 omega.  Leaves the new state in (pos, quat)."""
+    """One SK-ROCK step of size h with s stages from (pos, quat) and the noise increment
+    Qn (N, 6: translation, rotation vector); F, T must hold the forces at (pos, quat, t).
+    Orientations enter the stages as rotation vectors theta (q = exp(theta) q_n) in the
+    chart of the step's start orientation, with theta' = J_l(theta)^-1 omega.  Leaves the
+    new state in (pos, quat) and its chart coordinates (r, theta) in K1."""
     N = pos.shape[0]
-    amp = math.sqrt(2.0 * kT * h / gamma)
-    amp_r = math.sqrt(2.0 * kT * h / gamma_r) if rot_noise else 0.0
     for b in prange(N):
         for c in range(3):
             K0[b, c] = pos[b, c]
@@ -629,25 +695,11 @@ def _sk_step_py(pos, quat, t, h, kT, gamma, gamma_r, rot_noise, seed, key, s, et
     mu1 = w1 / w0
     nu1 = s * w1 / 2.0
     ka1 = s * w1 / w0
-    # noise increment Q; first evaluation point X_n + nu1 Q
+    # first evaluation point X_n + nu1 Q
     for b in prange(N):
-        xi0, xi1 = gauss2(seed, key, 2 * b)
-        xi2, xi3 = gauss2(seed, key, 2 * b + 1)
-        Qn[b, 0] = amp * xi0
-        Qn[b, 1] = amp * xi1
-        Qn[b, 2] = amp * xi2
-        if rot_noise:
-            e0, e1 = gauss2(seed, key, 2 * N + 2 * b)
-            Qn[b, 3] = amp_r * xi3
-            Qn[b, 4] = amp_r * e0
-            Qn[b, 5] = amp_r * e1
-        else:
-            Qn[b, 3] = 0.0
-            Qn[b, 4] = 0.0
-            Qn[b, 5] = 0.0
         for c in range(6):
             K2[b, c] = K0[b, c] + nu1 * Qn[b, c]
-    if amp > 0.0 or amp_r > 0.0:
+    if noisy:
         _stage_f(K2, qn, pos, quat)
         _eval(pos, quat, t, site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_rest0, sp_rest1, sp_tol,
               sp_inp, sp_bound, end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v,
@@ -690,125 +742,173 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
                site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_rest0, sp_rest1, sp_tol, sp_inp, sp_bound,
                end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v, wca_eps, wca_s, wca_rc, wca_min,
                ex0, ex_list, head, nxt, cell, nl0, nl, pos_nl, nlstate, max_disp, max_rot,
-               probe_i, probe_j, rec_every, rec, frame_every, fpos, fquat,
+               probe_i, probe_j, rec_every, rec_phase, rec, frame_every, frame_phase, fpos, fquat,
                uval, ws, arm, fsp, ratio, dmin, dpart, F, T, disp, mon, status,
                eta, rho_safety, rho_every, rho_iters, pv, pw, sp_tmp, fixed_s, stages_out,
-               K0, K1, K2, Qn, qn, xs, qs, accept, rot_acc, disp_acc, arm_max):
+               K0, K1, K2, Qn, qn, xs, qs, accept, rot_acc, disp_acc, arm_max,
+               Bc, Bn, zb, ppos, pquat, post, lev_min):
     """SK-ROCK (Abdulle, Almuslimani & Vilmart 2018) with damping ``eta``, ``nsteps``
     macro steps of size dt.  The number of stages s is the smallest with
     (2 - 4 eta/3) s^2 >= h rho, rho = power-iteration estimate (times ``rho_safety``,
     refreshed every ``rho_every`` steps) plus the WCA curvature bound.
 
-    Transients (a muscle switching, a large rotation) are resolved by adaptive substeps:
-    a substep whose end state has a bond beyond ``accept`` of its stretch bound, centres
-    inside ``wca_min``, a body moved more than max_disp/max_rot, or (accuracy) a body
-    drifted (displacement less noise) more than ``disp_acc`` or turned by more than
-    ``rot_acc`` or ``disp_acc/arm_max`` rad, is redone with half the step (fresh
-    counter-based noise); after an easy substep the step doubles again, up to dt.  A
-    substep rejected at dt/2^20 is a genuine instability (status set).  stages_out:
-    [0] force evaluations, [1] last s, [2] last rho, [3] rejected substeps, [4] the
-    last accepted substep (carried over between calls)."""
+    Adaptive substeps on a dyadic grid: a substep covers [k, k+1] dt/2^l and its noise is
+    the increment of one Brownian path per macro step built by Levy's construction
+    (:func:`brownian_at`), so a rejected substep is refined into halves of the *same*
+    noise (a Brownian bridge), never redrawn: step-size control does not condition the
+    noise.  A substep is redone at level l+1 when its end state has a bond beyond
+    ``accept`` of its stretch bound, centres inside ``wca_min``, a body whose drift
+    (displacement less its noise increment) exceeds max_disp/max_rot, or (accuracy) a
+    drift beyond ``disp_acc`` (+ 3 |noise| for bodies whose noise a bond absorbs) or a
+    rotational drift beyond ``rot_acc`` or that over ``arm_max``.  After an easy substep
+    the level drops again where the grid allows; never below ``lev_min`` (a level set from
+    the rotational noise variance).  A substep rejected at level LMAX is a genuine
+    instability (status set).  With ``post`` the recorded states are post-processed:
+    X + Q'/(2s), Q' a fresh noise increment of the current substep size (exact stationary
+    variance of linear modes for eta = 0).  stages_out: [0] force evaluations, [1] last s,
+    [2] last rho, [3] rejected substeps, [4] the last accepted substep (kept between calls)."""
     N = pos.shape[0]
     nrec = 0
     nfr = 0
     rho_b = 0.0
+    full = 1 << LMAX
+    amp_dt = math.sqrt(2.0 * kT * dt / gamma)
+    amp_dt_r = math.sqrt(2.0 * kT * dt / gamma_r) if rot_noise else 0.0
+    noisy = amp_dt > 0.0 or amp_dt_r > 0.0
     h_last = stages_out[4]
-    h_min = dt / 1048576.0
+    lev = lev_min
+    if h_last > 0.0:
+        lev = int(round(math.log2(dt / h_last)))
+        lev = min(max(lev, lev_min), LMAX)
     _eval(pos, quat, t_start, site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_rest0, sp_rest1, sp_tol,
           sp_inp, sp_bound, end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v,
           wca_eps, wca_s, wca_rc, ex0, ex_list, head, nxt, cell, nl0, nl, pos_nl, nlstate,
           uval, ws, arm, fsp, ratio, dmin, dpart, F, T, mon)
     stages_out[0] += 1
+    if nlstate[2] > 0.0:
+        status[0] = OVERFLOW
+        status[1] = step0
+        return 0
     for n in range(nsteps):
         t = t_start + n * dt
         step = step0 + n
-        # F, T, ws, mon hold the state at (pos, quat, t)
-        nrec, nfr = _record(n, t, rec_every, rec, nrec, probe_i, probe_j, ws, frame_every, fpos, fquat, nfr,
-                            pos, quat)
-        if _failed(mon, wca_min, status, step):
-            return n
+        # F, T, ws, arm, mon hold the state at (pos, quat, t)
         if fixed_s <= 0 and (n % rho_every == 0 or rho_b == 0.0):
             it = rho_iters if rho_b == 0.0 else max(3, rho_iters // 8)
             rho_b = _spectral(site_body, arm, sp_i, sp_j, sp_k, end0, end_sp, end_sign, sp_tmp,
                               1.0 / gamma, 1.0 / gamma_r, pv, pw, it) * rho_safety
         rho = rho_b + 2.0 * mon[5] / gamma
         stages_out[2] = rho
-        # adaptive substeps within the macro step [t, t + dt]
-        tt = 0.0
-        h = min(dt, 2.0 * h_last) if h_last > 0.0 else dt
-        counter = 0
-        while tt < dt * (1.0 - 1e-12):
-            if h > dt - tt:
-                h = dt - tt
-            if fixed_s > 0:
-                s = fixed_s
+        # the macro step starts at twice the last accepted substep
+        lev = max(lev - 1, lev_min)
+        if _due(n, rec_every, rec_phase) or _due(n, frame_every, frame_phase):
+            if post and noisy:
+                h0 = dt / (1 << lev)
+                s0 = fixed_s if fixed_s > 0 else stages_for(h0, rho, eta)
+                c = math.sqrt(h0 / dt) / (2.0 * s0)
+                pkey = np.uint64(step) * np.uint64(2147483648) + np.uint64(2147483647)
+                for b in prange(N):
+                    z = np.empty(6)
+                    _normals3(seed, pkey, b, rot_noise, z)
+                    for cc in range(3):
+                        ppos[b, cc] = pos[b, cc] + c * amp_dt * z[cc]
+                    q0, q1, q2, q3 = quat_exp_mul(c * amp_dt_r * z[3], c * amp_dt_r * z[4], c * amp_dt_r * z[5],
+                                                  quat[b, 0], quat[b, 1], quat[b, 2], quat[b, 3])
+                    pquat[b, 0] = q0
+                    pquat[b, 1] = q1
+                    pquat[b, 2] = q2
+                    pquat[b, 3] = q3
+                nrec, nfr = _record(n, t, rec_every, rec_phase, rec, nrec, probe_i, probe_j, site_body, site_local,
+                                    frame_every, frame_phase, fpos, fquat, nfr, ppos, pquat)
             else:
-                s = int(math.ceil(math.sqrt(h * rho / (2.0 - 4.0 * eta / 3.0))))
-                if s < 2:
-                    s = 2
+                nrec, nfr = _record(n, t, rec_every, rec_phase, rec, nrec, probe_i, probe_j, site_body, site_local,
+                                    frame_every, frame_phase, fpos, fquat, nfr, pos, quat)
+        if _failed(mon, wca_min, status, step):
+            return n
+        # adaptive substeps on the dyadic grid of [t, t + dt]; u in units of dt / 2^LMAX
+        u = 0
+        for b in range(N):
+            for c in range(6):
+                Bc[b, c] = 0.0
+        while u < full:
+            h = dt / (1 << lev)
+            rho = rho_b + 2.0 * mon[5] / gamma          # WCA curvature at the substep start
+            s = fixed_s if fixed_s > 0 else stages_for(h, rho, eta)
             stages_out[1] = s
-            # substep start (F, T, mon are fresh for it)
             for b in prange(N):
                 for c in range(3):
                     xs[b, c] = pos[b, c]
                 for c in range(4):
                     qs[b, c] = quat[b, c]
-            key = np.uint64(step) * np.uint64(1048576) + np.uint64(counter)
-            counter += 1
-            _sk_step(pos, quat, t + tt, h, kT, gamma, gamma_r, rot_noise, seed, key, s, eta,
+            if noisy:
+                kend = (u >> (LMAX - lev)) + 1
+                for b in prange(N):
+                    brownian_at(seed, step, kend, lev, b, rot_noise, Bn[b], zb[b])
+                    for c in range(3):
+                        Qn[b, c] = amp_dt * (Bn[b, c] - Bc[b, c])
+                        Qn[b, 3 + c] = amp_dt_r * (Bn[b, 3 + c] - Bc[b, 3 + c])
+            else:
+                for b in range(N):
+                    for c in range(6):
+                        Qn[b, c] = 0.0
+            _sk_step(pos, quat, t + u * (dt / full), h, gamma, gamma_r, noisy, s, eta,
                      site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_rest0, sp_rest1, sp_tol, sp_inp,
                      sp_bound, end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v, wca_eps, wca_s, wca_rc,
-                     ex0, ex_list, head, nxt, cell, nl0, nl, pos_nl, nlstate, uval, ws, arm, fsp, ratio, dmin, dpart, F, T, mon,
-                     K0, K1, K2, Qn, qn)
-            _eval(pos, quat, t + tt + h, site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_rest0, sp_rest1,
-                  sp_tol, sp_inp, sp_bound, end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v,
-                  wca_eps, wca_s, wca_rc, ex0, ex_list, head, nxt, cell, nl0, nl, pos_nl, nlstate,
+                     ex0, ex_list, head, nxt, cell, nl0, nl, pos_nl, nlstate, uval, ws, arm, fsp, ratio, dmin, dpart,
+                     F, T, mon, K0, K1, K2, Qn, qn)
+            _eval(pos, quat, t + (u + (full >> lev)) * (dt / full), site_body, site_local, bsite0, sp_i, sp_j,
+                  sp_k, sp_rest0, sp_rest1, sp_tol, sp_inp, sp_bound, end0, end_sp, end_sign, dkind, dpar,
+                  tab_t, tab_v, wca_eps, wca_s, wca_rc, ex0, ex_list, head, nxt, cell, nl0, nl, pos_nl, nlstate,
                   uval, ws, arm, fsp, ratio, dmin, dpart, F, T, mon)
             stages_out[0] += s + 1
-            # drift (displacement less the noise increment), displacement and rotation of the substep
+            if nlstate[2] > 0.0:
+                status[0] = OVERFLOW
+                status[1] = step
+                return n
+            # drift = displacement less the noise increment, in translation and rotation
             dmax = 0.0
             amax = 0.0
             worst = 0.0
             wb = -1
             for b in range(N):
-                dx = pos[b, 0] - xs[b, 0]
-                dy = pos[b, 1] - xs[b, 1]
-                dz = pos[b, 2] - xs[b, 2]
-                d2 = dx * dx + dy * dy + dz * dz
-                ex = dx - Qn[b, 0]
-                ey = dy - Qn[b, 1]
-                ez = dz - Qn[b, 2]
+                ex = pos[b, 0] - xs[b, 0] - Qn[b, 0]
+                ey = pos[b, 1] - xs[b, 1] - Qn[b, 1]
+                ez = pos[b, 2] - xs[b, 2] - Qn[b, 2]
                 v = ex * ex + ey * ey + ez * ez
                 if not (v <= dmax):
                     dmax = v
-                dq = abs(quat[b, 0] * qs[b, 0] + quat[b, 1] * qs[b, 1] + quat[b, 2] * qs[b, 2]
-                         + quat[b, 3] * qs[b, 3])
-                ang = 2.0 * math.acos(min(1.0, dq))
-                if not (ang <= amax):
-                    amax = ang
-                w = max(math.sqrt(d2) / max_disp, ang / max_rot)
+                rx = K1[b, 3] - Qn[b, 3]
+                ry = K1[b, 4] - Qn[b, 4]
+                rz = K1[b, 5] - Qn[b, 5]
+                a2 = rx * rx + ry * ry + rz * rz
+                if not (a2 <= amax):
+                    amax = a2
+                w = max(v / (max_disp * max_disp), a2 / (max_rot * max_rot))
                 if not (w <= worst):
                     worst = w
                     wb = b
             dmax = math.sqrt(dmax)
-            # accept when bonds stay inside their bounds, no WCA core is entered, and the substep
-            # drifted < disp_acc and turned < rot_acc (rotations count by the arc of the farthest
-            # site, arm_max).  For bodies held by stiff bonds the noise is absorbed, so
-            # "displacement less noise" is of the noise's size: allow 3 |Q| on top.
-            dlim = disp_acc + 3.0 * math.sqrt(3.0) * math.sqrt(2.0 * kT * h / gamma)
+            amax = math.sqrt(amax)
+            # accept when bonds stay inside their bounds, no WCA core is entered, no drift explodes
+            # and the substep drifted < disp_acc and turned (less its noise) < rot_acc (rotations
+            # count by the arc of the farthest site, arm_max).  For bodies held by stiff bonds the
+            # noise is absorbed, so their drift is of the noise's size: allow 3 |Q| on top.
+            dlim = disp_acc + 3.0 * math.sqrt(3.0) * amp_dt * math.sqrt(1.0 / (1 << lev))
             alim = min(rot_acc, dlim / arm_max) if arm_max > 0.0 else rot_acc
             ok = (mon[0] <= accept) and (mon[2] >= wca_min) and (worst <= 1.0)
             accurate = (dmax <= dlim) and (amax <= alim)
-            if ok and (accurate or h <= h_min):
-                tt += h
-                h_last = h
+            if ok and (accurate or lev >= LMAX):
+                u += full >> lev
+                for b in range(N):
+                    for c in range(6):
+                        Bc[b, c] = Bn[b, c]
                 stages_out[4] = h
-                if dmax < 0.5 * dlim and amax < 0.5 * alim:
-                    h = 2.0 * h
+                if dmax < 0.5 * dlim and amax < 0.5 * alim and lev > lev_min and ((u >> (LMAX - lev)) & 1) == 0:
+                    lev -= 1
                 continue
-            # reject: back to the substep start with half the step
+            # reject: back to the substep start, refine into halves of the same Brownian increment
             stages_out[3] += 1
-            if h <= h_min:
+            if lev >= LMAX:
                 if not (mon[0] <= 1.0):
                     status[0] = STRETCH if mon[0] == mon[0] else NONFINITE
                     status[2] = int(mon[1])
@@ -826,12 +926,16 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
                     pos[b, c] = xs[b, c]
                 for c in range(4):
                     quat[b, c] = qs[b, c]
-            _eval(pos, quat, t + tt, site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_rest0, sp_rest1,
-                  sp_tol, sp_inp, sp_bound, end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v,
+            _eval(pos, quat, t + u * (dt / full), site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_rest0,
+                  sp_rest1, sp_tol, sp_inp, sp_bound, end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v,
                   wca_eps, wca_s, wca_rc, ex0, ex_list, head, nxt, cell, nl0, nl, pos_nl, nlstate,
                   uval, ws, arm, fsp, ratio, dmin, dpart, F, T, mon)
             stages_out[0] += 1
-            h = 0.5 * h
+            if nlstate[2] > 0.0:
+                status[0] = OVERFLOW
+                status[1] = step
+                return n
+            lev += 1
     return nsteps
 
 
