@@ -71,3 +71,11 @@ def test_smallest_singular_value_in_every_state():
 
 def test_design_signs_cover_every_indicator():
     assert set(DESIGN_SIGN) == set(INDICATORS)
+
+
+def test_check_gate_branches_option_errors(capsys):
+    from mlc.cli import main
+    assert main(["check-gate", "NAND", "--branches", "--dynamic"]) == 2
+    assert "--branches" in capsys.readouterr().err
+    assert main(["check-gate", "NAND", "--branches", "--kT", "0"]) == 2
+    assert "kT > 0" in capsys.readouterr().err
