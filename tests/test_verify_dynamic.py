@@ -13,7 +13,7 @@ from mlc.gates.library import gate_scene
 from mlc.scene.model import Body, Box, Muscle, Probe, Scene
 from mlc.sim.drive import Drive
 from mlc.sim.integrator import SimOptions, Simulation
-from mlc.verify.dynamic import check_scene_dynamic_multi, relaxation_time
+from mlc.verify.dynamic import check_scene_dynamic_multi, probe_thermal_sd, relaxation_time
 
 
 def _points(n: int, k: float, gamma: float = 1.0) -> Scene:
@@ -60,6 +60,32 @@ def test_relaxation_time_is_the_decay_time_of_the_dynamics():
     fitted = -1.0 / np.polyfit(t[late], np.log(dev[late]), 1)[0]
     assert fitted == pytest.approx(tau, rel=0.05)
     assert dev[-1] < 1e-3
+
+
+@pytest.mark.parametrize("rot_noise", [True, False])
+def test_probe_thermal_spread_against_the_integrator(rot_noise):
+    """The harmonic estimate kT g^T H^+ g of a probe's thermal spread is the Boltzmann one:
+    the Euler-Maruyama reference with rotational noise (full equipartition) measures it
+    within sampling error over 400 relaxation times; the default model (translational noise
+    only, as in the paper) fluctuates less, so the estimate is an upper bound there."""
+    from mlc.gates.connector import half_unit_scene
+
+    sc = half_unit_scene("expand")
+    pred = probe_thermal_sd(sc, 1e-5)["out"]
+    tau = relaxation_time(sc)
+    sim = Simulation(sc, {}, SimOptions(scheme="euler", kT=1e-5, seed=1, rot_noise=rot_noise))
+    x = sim.run(400 * tau, record_interval=tau / 4, quiet=True).probes["out"][40:]
+    if rot_noise:
+        assert x.std() == pytest.approx(pred, rel=0.15)
+    else:
+        assert 0.3 * pred < x.std() < 0.9 * pred
+
+
+def test_a_zero_mode_probe_has_no_finite_spread():
+    sc = chain_scene(1, "expand")
+    sc.muscles = []                     # nothing holds the signal: the probe reads a zero mode
+    assert probe_thermal_sd(sc, 1e-5)["out"] == float("inf")
+    assert probe_thermal_sd(chain_scene(1, "expand"), 1e-5)["out"] < 0.05
 
 
 def test_two_input_gate_every_row_and_seed():

@@ -8,11 +8,18 @@ dynamics runs (:class:`mlc.sim.integrator.Simulation`, stiff scheme by default) 
 
 1. **plateau**: the last third of the run (at least ``MIN_WINDOWS`` windows of
    ``window`` t0), cut into three equal blocks, has block means of every probe that
-   agree within ``tol = 2e-3 + 3 sqrt(kT/k0)`` sigma (a drift test: block means, not
-   single windows, so that thermal noise does not keep a long run from passing);
+   agree within :func:`plateau_tol`: ``2e-3 + 3 sqrt(kT/k0)`` sigma plus three standard
+   deviations of the difference of two block means, from the probe's harmonic thermal
+   spread ``sd`` (:func:`probe_thermal_sd`, at the row's static equilibrium) and its
+   correlation time (at most ``tau``).  Block means, not single windows, and a
+   tolerance that knows the probe's own noise: the far end of a 20-unit contracting
+   chain fluctuates by sd = 0.08 sigma with a correlation time of ~40 t0, so a fixed
+   0.01-sigma test never passes however long the run;
 2. **time scale**: when the row's inputs differ from the starting row, the run has
    lasted at least ``tau_factor`` times the mechanism's slowest relaxation time
-   ``tau`` (:func:`relaxation_time`).
+   ``tau`` (:func:`relaxation_time`, the larger of its values at the starting pose and
+   at the row's static equilibrium: a NAND's output lever relaxes with 0.13 t0 in row
+   01 but 0.086 t0 about the rest pose).
 
 The plateau alone is not enough.  A signal crosses a long connector chain by
 diffusion (``tau`` grows as the square of the length: 0.03, 0.8, 3.0, 12 t0 for
@@ -91,6 +98,46 @@ def relaxation_time(scene, pos=None, quat=None, gamma_r: float | None = None,
     return 1.0 / lam / t_unit
 
 
+def probe_thermal_sd(scene, kT: float, pos=None, quat=None) -> dict:
+    """Equilibrium thermal standard deviation (sigma) of every probe of ``scene`` about the
+    pose ``pos``/``quat`` (default: the scene's own), in the harmonic approximation: the
+    poses fluctuate with covariance ``kT H^+`` (``H = J^T J``, the bond and muscle
+    stiffness, k0/sigma^2, zero modes left out), so a probe with gradient ``g`` (per body
+    translation and rotation vector) has variance ``kT g^T H^+ g``.  A probe that a zero
+    mode moves (``g`` not orthogonal to the null space) has no finite variance: inf."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import splu
+
+    from mlc.verify.static import _Problem
+
+    A = scene.arrays()
+    prob = _Problem(scene, A.pos if pos is None else pos, A.quat if quat is None else quat, pin_first=False)
+    out = {p.name: 0.0 for p in scene.probes}
+    if prob.m == 0 or prob.n == 0 or kT <= 0 or not scene.probes:
+        return out
+    J = prob.jacobian()
+    H = (J.T @ J).tocsc()
+    eps = 1e-10 * max(float(H.diagonal().max()), 1e-300)
+    lu = splu((H + sp.identity(prob.n, format="csc") * eps).tocsc())
+    p, rs = prob.sites()
+    for k, pr in enumerate(scene.probes):
+        i, j = A.probe_i[k], A.probe_j[k]
+        d = p[i] - p[j]
+        n = d / max(float(np.linalg.norm(d)), 1e-300)
+        g = np.zeros(prob.n)
+        for site, sign in ((i, 1.0), (j, -1.0)):
+            b = A.site_body[site]
+            g[6 * b:6 * b + 3] += sign * n
+            g[6 * b + 3:6 * b + 6] += sign * np.cross(rs[site], n)
+        y = lu.solve(g)
+        # a component of g along a zero mode shows up as a 1/eps blow-up: no finite variance
+        # (g . y = sum c^2/(lambda + eps); eps |y|^2 is about eps/lambda of it for the stiff
+        # modes, and about all of it for a zero mode)
+        gy = float(g @ y)
+        out[pr.name] = float(np.sqrt(kT * gy)) if eps * float(y @ y) < 0.1 * gy else float("inf")
+    return out
+
+
 def _diag(v):
     import scipy.sparse as sp
 
@@ -145,19 +192,33 @@ def _check_rows(scene, rows) -> list[str]:
     return out
 
 
+def plateau_tol(kT: float, k0: float = 1.0, sd: float = 0.0, tau: float = 0.0, block: float = 1.0) -> float:
+    """How far (sigma) two block means of a relaxed probe may differ: ``2e-3 + 3 sqrt(kT/k0)``
+    plus three standard deviations of the difference of two block means of length
+    ``block`` t0 of a probe with thermal standard deviation ``sd`` (sigma) and correlation
+    time at most ``tau`` t0: ``3 sqrt(2) sd sqrt(min(1, 2 tau / block))``."""
+    base = 2e-3 + 3.0 * math.sqrt(max(kT, 0.0) / k0)
+    if not sd:
+        return base
+    if not math.isfinite(sd):
+        return math.inf
+    return base + 3.0 * math.sqrt(2.0) * sd * math.sqrt(min(1.0, 2.0 * tau / max(block, 1e-300)))
+
+
 def relax_all(sim: Simulation, probes: list[str], kT: float, t_min: float = 0.0, window: float = WINDOW,
-              max_time: float = MAX_TIME, tol: float | None = None):
-    """Run ``sim`` until every probe in ``probes`` has relaxed (the three block means of
-    the last third of the run, at least ``MIN_WINDOWS`` windows, agree within ``tol``;
-    and time >= ``t_min`` t0).
-    Returns (means: dict probe -> plateau mean in sigma, time t0, relaxed)."""
-    tol = 2e-3 + 3.0 * math.sqrt(max(kT, 0.0) / sim.k0) if tol is None else tol
+              max_time: float = MAX_TIME, sd: dict | None = None, tau: float = 0.0):
+    """Run ``sim`` until every probe in ``probes`` has relaxed: time >= ``t_min`` t0, and the
+    three block means of the last third of the run (at least ``MIN_WINDOWS`` windows of
+    ``window`` t0) agree within :func:`plateau_tol` (``sd``: probe -> thermal standard
+    deviation in sigma, ``tau``: slowest relaxation time in t0).  Returns (means: probe ->
+    plateau mean in sigma, time t0, relaxed)."""
+    sd = sd or {}
     ends, means = [], {p: [] for p in probes}
     t = 0.0
     start = sim.t / sim.t_unit
     while True:
         res = sim.run(window, record_interval=window / 10, quiet=True)
-        if res.interrupted:
+        if getattr(res, "interrupted", False):      # Ctrl-C inside the run
             raise KeyboardInterrupt
         t = res.time - start
         ends.append(t)
@@ -170,8 +231,9 @@ def relax_all(sim: Simulation, probes: list[str], kT: float, t_min: float = 0.0,
         while first > 0 and ends[first - 1] - window >= cut - 1e-12:
             first -= 1
         if first >= 0 and t >= t_min - 1e-12:
-            flat = all(np.ptp([np.mean(b) for b in np.array_split(means[p][first:], MIN_WINDOWS)]) < tol
-                       for p in probes)
+            block = (len(ends) - first) * window / MIN_WINDOWS
+            flat = all(np.ptp([np.mean(b) for b in np.array_split(means[p][first:], MIN_WINDOWS)])
+                       < plateau_tol(kT, sim.k0, sd.get(p, 0.0), tau, block) for p in probes)
             if flat:
                 return {p: float(np.mean(means[p][first:])) for p in probes}, t, True
         if t >= max_time - 1e-12:
@@ -197,10 +259,13 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
 
     ``progress``: None (a bar on a terminal for long runs), False (silent), True (a
     bar) or a callable ``f(done, total)`` called after each (row, seed) run.  ``tau``
-    (t0): the slowest relaxation time, if already known (default :func:`relaxation_time`).
+    (t0): the slowest relaxation time, if already known, used for every row (default
+    :func:`relaxation_time` at the starting pose and at each row's static equilibrium,
+    the larger of the two).
     ``max_time`` (t0): give up on a run after this long (default the larger of 20 t0 and
-    12 tau).  ``window`` (t0): averaging window (default the larger of 0.05 t0 and tau/20)."""
+    12 tau of the row).  ``window`` (t0): averaging window (default the larger of 0.05 t0 and tau/20)."""
     from mlc.io.progress import Progress
+    from mlc.verify.static import equilibrium
 
     if scene.truth_table is None:
         raise MlcError(f"scene {scene.name} has no truth table to verify against", scene.source or scene.name,
@@ -213,8 +278,10 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
     seed_list = _seed_list(seeds)
     states = _check_rows(scene, rows)
     opt0 = SimOptions(scheme=scheme)
+    tau_given = tau is not None
     tau = relaxation_time(scene, gamma_r=opt0.gamma_r) if tau is None else float(tau)
-    max_time = max(MAX_TIME, MAX_TAUS * tau) if max_time is None else float(max_time)
+    max_time_given = max_time is not None
+    max_time = float(max_time) if max_time_given else None
     window = max(WINDOW, tau / 20.0) if window is None else float(window)
     rest = "0" * len(scene.inputs)
     names = [p.name for p in scene.probes]
@@ -227,12 +294,21 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
         for state in states:
             want = scene.truth_table.get(state)
             drives = {inp: Drive.constant(int(bit)) for inp, bit in zip(scene.inputs, state)}
-            t_min = tau_factor * tau if state != rest else 0.0
+            # the row's static equilibrium: the probes' thermal spread and the relaxation time
+            # there (the slowest of start and end pose sets the time floor)
+            try:
+                eq = equilibrium(scene, state)
+                sd = probe_thermal_sd(scene, kT, eq.pos, eq.quat)
+                tau_row = tau if tau_given else max(tau, relaxation_time(scene, eq.pos, eq.quat, opt0.gamma_r))
+            except (MlcError, ValueError, RuntimeError, np.linalg.LinAlgError):
+                sd, tau_row = probe_thermal_sd(scene, kT), tau
+            t_min = tau_factor * tau_row if state != rest else 0.0
             per = []
             for seed in seed_list:
                 opt = SimOptions(scheme=scheme, kT=kT, seed=seed, dt=dt if dt is not None else DT.get(scheme))
                 sim = Simulation(scene, drives, opt)
-                means, t_rel, relaxed = relax_all(sim, names, kT, t_min, window, max_time)
+                t_max = max_time if max_time_given else max(MAX_TIME, MAX_TAUS * tau_row)
+                means, t_rel, relaxed = relax_all(sim, names, kT, t_min, window, t_max, sd, tau_row)
                 per.append((means, t_rel, relaxed))
                 done += 1
                 bar.update(done)
@@ -251,8 +327,9 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
                             "margin": None if margins is None else min(margins), "ok": bool(ok),
                             "relaxed": relaxed,
                             "relax_time": max(t for _, t, _ in per) if relaxed else None,
-                            "per_seed": vals, "seeds": seed_list, "tau": tau, "scheme": scheme, "kT": kT})
+                            "per_seed": vals, "seeds": seed_list, "tau": tau_row, "thermal_sd": sd[pr.name],
+                            "scheme": scheme, "kT": kT})
     return out
 
 
-__all__ = ["check_scene_dynamic_multi", "relax_all", "relaxation_time"]
+__all__ = ["check_scene_dynamic_multi", "plateau_tol", "probe_thermal_sd", "relax_all", "relaxation_time"]
