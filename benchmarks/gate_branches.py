@@ -87,7 +87,7 @@ def main() -> int:
         path = RESULTS / "gate_branches.json"
         out = json.loads(path.read_text())
         out["brownian"] = [r for r in out["brownian"] if r["T"] < 50] + \
-            bd_study(1e-3, 8, 50.0, ["NAND"], ["contract"], frames=20)
+            bd_study(1e-3, 8, 50.0, ["NAND"], ["contract", "expand"], frames=20)
         path.write_text(json.dumps(out, indent=1) + "\n")
         return 0
     t0 = time.time()
@@ -118,7 +118,7 @@ def main() -> int:
     for kT, seeds in ((1e-5, 2), (1e-4, 2), (1e-3, 4)):
         bd += bd_study(kT, seeds, 10.0, names, ["contract", "expand"])
     # the lowest barrier found: long runs
-    bd += bd_study(1e-3, 4 if quick else 8, 50.0, ["NAND"], ["contract"], frames=20)
+    bd += bd_study(1e-3, 4 if quick else 8, 50.0, ["NAND"], ["contract", "expand"], frames=20)
     out["brownian"] = bd
     out["wall_seconds"] = time.time() - t0
     RESULTS.mkdir(parents=True, exist_ok=True)
