@@ -8,10 +8,18 @@ mode count, and for chains of 1, 5, 10, 20 units (straight and bent) and the 3-w
 the static error and the Brownian-dynamics reading at kT = 1e-5 (one seed), relaxation
 time and thermal spread.  Units: sigma, t0, degrees.
 """
-import math, json, os, sys, time
+import json
+import math
+import os
+import sys
+import time
+
 import numpy as np
+
 sys.path.insert(0, os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-from mlc.gates.connector import *
+import mlc.gates.connector as C  # noqa: E402
+from mlc.gates.connector import (branch_scene, chain_scene, connector_geometry, full_unit_scene,  # noqa: E402
+                                 half_unit_scene, max_bend)
 from mlc.verify.overlap import clearance, static_poses, sweep_clearance
 from mlc.verify.dynamic import check_scene_dynamic_multi, relaxation_time
 from mlc.verify.static import _Problem, equilibrium
@@ -72,7 +80,6 @@ for sig in ("expand", "contract"):
                         "smallest_nonzero_sv_over_max": float(sv[len(sv) - z - 1] / sv[0])}
     d["floppy"] = nulls
     print(sig, json.dumps({k: v for k, v in d.items() if k != "dynamic"}, indent=1), flush=True)
-import mlc.gates.connector as C
 out["default_gap"] = C.DEFAULT_GAP
 path = os.path.join(os.path.dirname(os.path.abspath(__file__)), "results", "connector.json")
 with open(path, "w") as f:
