@@ -195,7 +195,7 @@ class Simulation:
         self.disp = np.zeros(N)
         self.mon = np.zeros(6)
         self.status = np.zeros(4, np.int64)
-        self.stages_out = np.zeros(5)
+        self.stages_out = np.zeros(6)
         self.pv = np.random.default_rng(12345).standard_normal((N, 6))
         self.pw = np.zeros((N, 6))
         self.sp_tmp = np.zeros((B, 3))

@@ -766,11 +766,12 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
     instability (status set).  With ``post`` the recorded states are post-processed:
     X + Q'/(2s), Q' a fresh noise increment of the current substep size (exact stationary
     variance of linear modes for eta = 0).  stages_out: [0] force evaluations, [1] last s,
-    [2] last rho, [3] rejected substeps, [4] the last accepted substep (kept between calls)."""
+    [2] last rho, [3] rejected substeps, [4] the substep size to go on with, [5] the spectral
+    estimate (both kept between calls, so the trajectory does not depend on the chunking)."""
     N = pos.shape[0]
     nrec = 0
     nfr = 0
-    rho_b = 0.0
+    rho_b = stages_out[5]          # kept between calls: refreshes depend on the global step only
     full = 1 << LMAX
     amp_dt = math.sqrt(2.0 * kT * dt / gamma)
     amp_dt_r = math.sqrt(2.0 * kT * dt / gamma_r) if rot_noise else 0.0
@@ -793,10 +794,11 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
         t = t_start + n * dt
         step = step0 + n
         # F, T, ws, arm, mon hold the state at (pos, quat, t)
-        if fixed_s <= 0 and (n % rho_every == 0 or rho_b == 0.0):
+        if fixed_s <= 0 and (step % rho_every == 0 or rho_b == 0.0):
             it = rho_iters if rho_b == 0.0 else max(3, rho_iters // 8)
             rho_b = _spectral(site_body, arm, sp_i, sp_j, sp_k, end0, end_sp, end_sign, sp_tmp,
                               1.0 / gamma, 1.0 / gamma_r, pv, pw, it) * rho_safety
+            stages_out[5] = rho_b
         rho = rho_b + 2.0 * mon[5] / gamma
         stages_out[2] = rho
         # the macro step starts at twice the last accepted substep
@@ -902,9 +904,9 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
                 for b in range(N):
                     for c in range(6):
                         Bc[b, c] = Bn[b, c]
-                stages_out[4] = h
                 if dmax < 0.5 * dlim and amax < 0.5 * alim and lev > lev_min and ((u >> (LMAX - lev)) & 1) == 0:
                     lev -= 1
+                stages_out[4] = dt / (1 << lev)         # the level to go on with (kept between calls)
                 continue
             # reject: back to the substep start, refine into halves of the same Brownian increment
             stages_out[3] += 1
