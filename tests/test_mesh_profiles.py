@@ -23,7 +23,7 @@ def test_published_defaults():
     assert (PROFILES["mjp"].sigma_mm, PROFILES["mjp"].clearance) == (5.0, 0.2)    # the paper's print
     assert abs(PROFILES["sla"].clearance - 0.3) < 1e-9
     assert abs(PROFILES["fdm"].clearance - 0.4) < 1e-9 and PROFILES["fdm"].slab_thickness >= 1.2
-    assert PROFILES["fdm"].orient == "axes_flat"
+    assert PROFILES["fdm"].orient == "auto"
 
 
 def test_every_value_overridable():

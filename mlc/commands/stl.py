@@ -38,7 +38,8 @@ def register(sub):
     g.add_argument("--min-feature", type=float, help="minimum feature (knuckle length, holes)")
     g.add_argument("--pin-diameter", type=float, help="hinge pin diameter")
     g.add_argument("--segments", dest="circular_segments", type=int, help="polygon segments per circle")
-    g.add_argument("--orient", choices=("as_is", "axes_flat"), help="print orientation")
+    g.add_argument("--orient", choices=("as_is", "axes_flat", "auto"),
+                   help="print orientation (auto: least support, then most bed contact)")
     g.add_argument("--pin", choices=("pin", "cone"), help="hinge pins: a straight pin or 45 degree cone pins")
     p.set_defaults(func=run)
 
@@ -84,7 +85,7 @@ def run(args) -> int:
         for o in report.outputs:
             print(f"wrote {o}")
     if not report.ok:
-        failed = [c.name for c in report.checks if not c.ok]
+        failed = [c.name for c in report.checks if not c.ok and c.blocking]
         if args.force:
             sys.stderr.write(f"mlc: warning: printability checks failed ({', '.join(failed)}); written anyway "
                              f"(--force)\n")

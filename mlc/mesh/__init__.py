@@ -33,7 +33,7 @@ def export_scene(scene, profile="mjp", *, stl=None, threemf=None, parts_dir=None
             report.outputs = write_outputs(asm, stl=stl, threemf=threemf, parts_dir=parts_dir,
                                            meshes=part_meshes(asm))
     elif not force:
-        failed = [c.name for c in report.checks if not c.ok]
+        failed = [c.name for c in report.checks if not c.ok and c.blocking]
         err = MlcError(f"printability checks failed: {', '.join(failed)}; nothing written", scene.source or scene.name,
                        "see the report, change the profile, or force the export")
         err.report = report

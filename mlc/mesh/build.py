@@ -336,6 +336,12 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         for ln in lines:
             p, dd = ln[0], ln[1]
             if abs(abs(np.dot(d, dd)) - 1) < 1e-6 and np.linalg.norm(np.cross(ends[0] - p, dd)) < _TOL:
+                # one line, but one hinge only where the spans meet: the hinges of stacked
+                # layers (connector half units) lie on one line at different places along it
+                mine = sorted(float(np.dot(e - p, dd)) for e in ends)
+                theirs = [float(np.dot(e - p, dd)) for e in ln[4]]
+                if mine[0] > max(theirs) + _TOL or mine[1] < min(theirs) - _TOL:
+                    continue
                 ln[2].append(jname)
                 for bn in sorted(pair):
                     if bn not in ln[3]:
@@ -1116,6 +1122,8 @@ def _orientation(asm: Assembly) -> np.ndarray:
         best = min(cands, key=lambda z: (round(sum(abs(float(np.dot(z, d))) for d in dirs), 6)))
         from mlc.geometry.rotation import rotation_between
         Rm = rotation_between(best, [0, 0, 1.0])
+    if asm.profile.orient == "auto" and asm.parts:
+        Rm = _best_rotation(asm)
     lo = np.full(3, np.inf)
     hi = np.full(3, -np.inf)
     for p in asm.parts:
@@ -1128,6 +1136,53 @@ def _orientation(asm: Assembly) -> np.ndarray:
         return np.eye(4)
     shift = np.array([-(lo[0] + hi[0]) / 2, -(lo[1] + hi[1]) / 2, -lo[2]])
     return _h(Rm, shift)
+
+
+def _best_rotation(asm: Assembly) -> np.ndarray:
+    """``orient: auto``: of the candidate "up" directions -- the world axes, the normals of every
+    slab (laid flat) and the hinge-axes-flat direction, both signs -- the one whose print needs
+    the least support (none resting on a part first), then has the most bed contact
+    (:func:`mlc.mesh.printability.bed_stats` on a coarse grid)."""
+    from mlc.geometry.rotation import rotation_between
+    from mlc.mesh.checks import BED_CONTACT_MIN, OVERHANG_DEG, SUPPORT_MAX
+    from mlc.mesh.printability import bed_stats
+
+    cands = [np.array(v, float) for v in np.eye(3)]
+    for b in asm.scene.bodies:
+        Rb = quat_to_matrix(b.orientation)
+        for bx in b.boxes:
+            R = Rb @ quat_to_matrix(bx.orientation)
+            cands.append(R[:, int(np.argmin(bx.size))])
+    uniq = []
+    for c in cands:
+        for sg in (1.0, -1.0):
+            v = sg * c / np.linalg.norm(c)
+            if all(np.dot(v, u) < 1 - 1e-6 for u in uniq):
+                uniq.append(v)
+    ext = max(float(np.max(np.asarray(p.solid.bounding_box())[3:] - np.asarray(p.solid.bounding_box())[:3]))
+              for p in asm.parts if not p.solid.is_empty())
+    h = max(ext / 60, 0.05)
+    best = None
+    for up in uniq:
+        R = rotation_between(up, [0, 0, 1.0])
+        solids = []
+        zmin = np.inf
+        for p in asm.parts:
+            if p.solid.is_empty():
+                continue
+            sp = transform_solid(p.solid, _h(R, np.zeros(3)))
+            zmin = min(zmin, float(np.asarray(sp.bounding_box())[2]))
+            solids.append((p.name, sp))
+        solids = [(n, x.translate([0, 0, -zmin])) for n, x in solids]
+        st = bed_stats(solids, OVERHANG_DEG, h, first_layer=min(0.2, asm.profile.min_wall / 2))
+        bad = (st.support_inside_mm3 > 1e-6) + (st.support_fraction > SUPPORT_MAX) + \
+              (st.contact_fraction < BED_CONTACT_MIN)
+        key = (bad, round(st.support_fraction - st.contact_fraction, 6))
+        if best is None or key < best[0]:
+            best = (key, R, up)
+    asm.notes.append(f"orientation: up is the model's ({best[2][0]:.3g}, {best[2][1]:.3g}, {best[2][2]:.3g}), "
+                     f"the best bed of {len(uniq)} candidates (least support, then most bed contact)")
+    return best[1]
 
 
 def _h(R, t) -> np.ndarray:

@@ -19,14 +19,15 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mlc.mesh.build import Assembly, Part, build_assembly, transform_solid, _orientation
-from mlc.mesh.checks import GAP_EPS, VOL_EPS, Check, Report, _bbox, _pairs, check_assembly, print_size
+from mlc.mesh.checks import (GAP_EPS, VOL_EPS, Check, Report, _bbox, _pairs, bed_checks, check_assembly,
+                             print_size)
 from mlc.mesh.profiles import Profile
 from mlc.scene.model import Scene
 
 #: input states of one mechanism beyond which only a sample of states is posed
 MAX_STATES = 64
 #: poses checked on the way from rest to each state (besides the states themselves)
-PATH_STEPS = 1
+PATH_STEPS = 6
 
 
 @dataclass
@@ -288,6 +289,16 @@ def _merge_reports(scene, profile, mechs, built, full, owner) -> Report:
         st.ok = st.ok and not fails
     st.detail += (f"; {len(close)} pairs of mechanisms sweep through shared space (checked in every state "
                   f"combination)" if close else "; mechanisms never share space")
+    # measured walls: per distinct mechanism (copies are translated, their walls the same)
+    walls = [(k, reps[k].check("wall_thickness")) for k in reps if "wall_thickness" in
+             {c.name for c in reps[k].checks}]
+    vals = [ch.value for _, ch in walls if ch.value is not None]
+    checks.append(Check("wall_thickness", all(ch.ok for _, ch in walls), min(vals) if vals else None,
+                        profile.min_wall, "; ".join(f"{mechs[k].scene.name}: {ch.detail}" for k, ch in walls)[:2000],
+                        [f"{mechs[k].scene.name}: {f}" for k, ch in walls for f in ch.failures],
+                        all(ch.blocking for _, ch in walls)))
+    # the bed: the whole assembly as printed
+    checks += bed_checks(full)
     rep = Report(scene.name, profile.to_dict(),
                  [{"name": p.name, "kind": p.kind, "volume_mm3": round(float(p.solid.volume()), 4), "pieces": 1}
                   for p in full.parts], checks, list(full.notes))

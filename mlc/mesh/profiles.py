@@ -16,7 +16,8 @@ min_feature       minimum feature: knuckle length, lug hole diameter
 pin_diameter      hinge pin diameter (>= min_feature)
 circular_segments polygon segments of every cylinder (never manifold3d's default)
 pin               "pin" (a straight pin through the knuckles) or "cone" (45 degree cone pins)
-orient            "axes_flat" (rotate the assembly so hinge axes lie flat on the bed) or "as_is"
+orient            "auto" (the up direction, of the world axes and slab normals, with the least
+                  support and most bed contact), "axes_flat" (hinge axes flat on the bed) or "as_is"
 
 A profile is a built-in name or a YAML/JSON file validated against
 ``mlc/schemas/profile.schema.json``; command-line overrides replace single values.
@@ -70,7 +71,7 @@ class Profile:
 
 
 PIN_KINDS = ("pin", "cone")
-ORIENTS = ("as_is", "axes_flat")
+ORIENTS = ("as_is", "axes_flat", "auto")
 
 #: the paper printed 0.1 mm slabs at sigma = 5 mm (0.02 sigma); the simulations use 0.01 sigma.
 PAPER_SLAB_MM = 0.1
@@ -88,9 +89,9 @@ PROFILES: dict[str, Profile] = {
                     "holes/features >= 0.5 mm; supports required"),
     "fdm": Profile(
         "fdm", sigma_mm=20.0, clearance=0.4, knuckle_gap=0.4, slab_thickness=1.2, min_wall=1.2,
-        min_feature=2.0, pin_diameter=3.0, circular_segments=32, pin="pin", orient="axes_flat",
+        min_feature=2.0, pin_diameter=3.0, circular_segments=32, pin="pin", orient="auto",
         description="filament FDM, 0.4 mm nozzle: moving-part clearance ~0.4 mm, walls >= 1.2 mm, "
-                    "holes/features >= 2 mm, pins >= 3 mm; hinge axes flat on the bed"),
+                    "holes/features >= 2 mm, pins >= 3 mm; oriented for the least support"),
 }
 
 FIELD_NAMES = tuple(f.name for f in fields(Profile))
