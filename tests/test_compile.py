@@ -33,7 +33,7 @@ def agrees(spec, text, parser):
 @pytest.mark.parametrize("example", EXAMPLES)
 def test_every_example_compiles(example, tmp_path, capsys):
     src = ROOT / "examples" / example
-    d = run_json(capsys, str(src), "-o", str(tmp_path / "out"), "-O1")
+    d = run_json(capsys, str(src), "-o", str(tmp_path / "out"), "-O1", "--no-circuit")
     assert d["equivalent"] is True and d["gates"] >= 0 and d["depth"] >= 0
     spec = load(str(src))
     nl = Netlist.loads((tmp_path / "out" / "netlist.json").read_text(), "netlist.json")
@@ -45,18 +45,23 @@ def test_every_example_compiles(example, tmp_path, capsys):
 
 def test_tetris_done_when(tmp_path, capsys):
     """The issue's acceptance command."""
-    d = run_json(capsys, str(ROOT / "examples" / "tetris.tt"), "-o", str(tmp_path / "out"))
+    d = run_json(capsys, str(ROOT / "examples" / "tetris.tt"), "-o", str(tmp_path / "out"), "--verify")
     assert d["equivalent"] is True
     assert d["gates"] == 3 and d["depth"] == 1          # !y&b, y&b, y&!b; u3_up is the muscle y itself
     assert d["const_outputs"] == {"u1_up": 0, "u1_dn": 0, "u2_dn": 0}
     assert d["input_outputs"] == {"u3_up": "y"}
-    assert sorted(Path(f).name for f in d["files"]) == ["netlist.aag", "netlist.blif", "netlist.dot", "netlist.json"]
+    assert sorted(Path(f).name for f in d["files"]) == ["circuit.png", "circuit.yaml", "netlist.aag", "netlist.aig",
+                                                        "netlist.blif", "netlist.dot", "netlist.json", "verify.json"]
+    assert d["verification"]["ok"] is True and d["verification"]["rows"] == 4
+    assert (tmp_path / "out" / "circuit.png").read_bytes().startswith(b"\x89PNG")
+    # the scene loads and verifies again through the CLI
+    assert main(["verify", str(tmp_path / "out" / "circuit.yaml"), "--rows", "01", "11"]) == 0
 
 
 def test_expression_signal_draw_and_text_summary(tmp_path, capsys):
     png = tmp_path / "pics" / "fa.png"
     rc = main(["compile", "-e", "s = a ^ b ^ c; co = maj(a, b, c); n = !a", "-o", str(tmp_path / "o"),
-               "--signal", "contract", "--draw", str(png)])
+               "--signal", "contract", "--draw", str(png), "--no-circuit"])
     out, err = capsys.readouterr()
     assert rc == 0, err
     assert "equivalence proven" in out and "gates: " in out and "depth" in out
@@ -67,14 +72,14 @@ def test_expression_signal_draw_and_text_summary(tmp_path, capsys):
 
 
 def test_full_adder_is_seven_gates(tmp_path, capsys):
-    d = run_json(capsys, str(ROOT / "examples" / "full_adder.tt"), "-o", str(tmp_path), "-O2")
+    d = run_json(capsys, str(ROOT / "examples" / "full_adder.tt"), "-o", str(tmp_path), "-O2", "--no-circuit")
     assert d["gates"] == 7
 
 
 def test_strict_flag(tmp_path, capsys):
     f = tmp_path / "p.tt"
     f.write_text(".inputs a b\n.outputs f\n11 | 1\n")
-    assert main(["compile", str(f), "-o", str(tmp_path / "o1")]) == 0
+    assert main(["compile", str(f), "-o", str(tmp_path / "o1"), "--no-circuit"]) == 0
     capsys.readouterr()
     assert main(["compile", str(f), "--strict", "-o", str(tmp_path / "o2")]) == 2
     assert "p.tt:1:1:" in capsys.readouterr().err
@@ -163,7 +168,7 @@ def _yosys_roundtrip(read_cmd: str, path: Path, tmp: Path):
 @pytest.mark.skipif(shutil.which("yosys") is None, reason="yosys is not installed")
 @pytest.mark.parametrize("example", ["bcd7seg.pla", "compare2.aag"])
 def test_yosys_reads_the_blif_and_aiger_exports(example, tmp_path, capsys):
-    run_json(capsys, str(ROOT / "examples" / example), "-o", str(tmp_path / "o"), "-O1")
+    run_json(capsys, str(ROOT / "examples" / example), "-o", str(tmp_path / "o"), "-O1", "--no-circuit")
     spec = load(str(ROOT / "examples" / example))
     on, dc = truth_tables(spec)
     for cmd, name in (("read_blif", "netlist.blif"), ("read_aiger", "netlist.aag")):

@@ -1,19 +1,19 @@
-"""``mlc compile``: Boolean logic in, a proven-equivalent netlist of mechanical gates out.
+"""``mlc compile``: Boolean logic in, a proven-equivalent netlist of mechanical gates and the
+whole circuit as one mechanism out.  The stages are those of :mod:`mlc.pipeline`::
 
-Pipeline (each step one call; the back end adds scene and mesh steps after ``map``)::
-
-    spec    = load(INPUT or -e EXPR)                  mlc.front.load
-    aig     = synthesize(spec, -O)                    mlc.logic.synth (proves aig == spec)
-    netlist = map_aig(aig, --signal)                  mlc.netlist.mapper
-    proof   = check_equivalent(netlist.to_aig(), spec)   the mapped gates, proven again
-    files   = render(netlist, ...)                    everything in memory first
-    write(OUTDIR, files)                              atomically, only after all of the above
+    spec    = load(INPUT or -e EXPR)                  mlc.front
+    c       = compile_spec(spec, -O, --signal)        mlc.logic + mlc.netlist (netlist proven == spec)
+    circuit = build_circuit(c.netlist, spec)          mlc.circuit (one scene, posed in the all-zero row)
+    report  = verify(circuit.scene)                   mlc.verify (--verify; --dynamic for Brownian dynamics)
+    meshes  = mlc stl OUT/circuit.yaml                mlc.mesh (--stl / --3mf)
+    files   = render(...)                             everything in memory (staged) first
+    commit                                            all outputs moved into place, or none
 """
 from __future__ import annotations
 
 import json
+import sys
 import time
-from dataclasses import dataclass, field
 from pathlib import Path
 
 from mlc.errors import MlcError
@@ -31,42 +31,37 @@ def register(sub):
     p.add_argument("--signal", choices=("expand", "contract"), default="expand",
                    help="muscle convention of the inputs and every wire (default expand)")
     p.add_argument("--strict", action="store_true", help=".tt: unlisted input combinations are an error")
-    p.add_argument("--draw", metavar="PNG", help="also draw the circuit to this PNG file")
+    p.add_argument("--draw", metavar="PNG", help="also draw the gate schematic to this PNG file")
+    p.add_argument("--no-circuit", action="store_true",
+                   help="stop at the netlist (no circuit scene OUTDIR/circuit.yaml and picture OUTDIR/circuit.png)")
+    p.add_argument("--verify", action="store_true",
+                   help="verify the circuit on every row of its truth table (static; with --dynamic by Brownian dynamics)")
+    p.add_argument("--dynamic", action="store_true", help="with --verify: Brownian dynamics from rest, until relaxed")
+    p.add_argument("--kT", type=float, default=1e-5, help="thermal energy for --dynamic (k0 sigma^2, default 1e-5)")
+    p.add_argument("--seeds", type=int, default=3, help="seeds per row for --dynamic (default 3)")
+    p.add_argument("--scheme", choices=("stiff", "euler"), default="stiff", help="integrator for --dynamic")
+    p.add_argument("--stl", metavar="STL", help="printable mesh of the whole circuit (through mlc stl)")
+    p.add_argument("--3mf", dest="threemf", metavar="3MF", help="3MF of the circuit with named parts (through mlc stl)")
+    p.add_argument("--profile", default="mjp", help="printer profile for --stl/--3mf (mjp, sla, fdm or a file)")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(func=run)
 
 
-@dataclass
-class Compiled:
-    spec: object
-    aig: object
-    netlist: object
-    synth_stats: dict = field(default_factory=dict)
-    proof: dict = field(default_factory=dict)
-    seconds: float = 0.0
+def compile_spec(spec, level: int = 2, signal: str = "expand"):
+    """Synthesize, map and prove (:func:`mlc.pipeline.compile_spec`)."""
+    from mlc.pipeline import compile_spec as _compile
+    return _compile(spec, level, signal)
 
 
-def compile_spec(spec, level: int = 2, signal: str = "expand") -> Compiled:
-    """Synthesize, map and prove; raises InternalError if anything is not equivalent."""
-    from mlc.netlist.mapper import map_aig
-    from mlc.logic.equiv import check_equivalent
-    from mlc.logic.synth import synthesize
-
-    t0 = time.perf_counter()
-    stats: dict = {}
-    aig = synthesize(spec, level, stats)
-    netlist = map_aig(aig, signal, spec.source)
-    proof = check_equivalent(netlist.to_aig(), spec)
-    return Compiled(spec, aig, netlist, stats, proof, time.perf_counter() - t0)
-
-
-def render(c: Compiled, draw: bool = False) -> dict[str, bytes]:
+def render(c, draw: bool = False) -> dict[str, bytes]:
     """All output files, by name, in memory."""
+    from mlc.logic.aigio import aag_to_aig
     nl = c.netlist
     files = {
         "netlist.json": nl.dumps().encode(),
         "netlist.blif": nl.to_blif().encode(),
         "netlist.aag": nl.to_aiger().encode(),
+        "netlist.aig": aag_to_aig(nl.to_aiger(), "netlist.aag"),
         "netlist.dot": nl.to_dot().encode(),
     }
     if draw:
@@ -74,32 +69,7 @@ def render(c: Compiled, draw: bool = False) -> dict[str, bytes]:
     return files
 
 
-def write(outdir: str, files: dict[str, bytes], draw_path: str | None = None) -> list[str]:
-    from mlc.io.atomic import write_bytes
-
-    out = Path(outdir)
-    if out.exists() and not out.is_dir():
-        raise MlcError("exists and is not a directory", "-o", "choose another output directory")
-    try:
-        out.mkdir(parents=True, exist_ok=True)
-    except OSError as e:
-        raise MlcError(f"cannot create output directory {out}: {e.strerror}", "-o") from None
-    written = []
-    for name, data in files.items():
-        if name == "<draw>":
-            continue
-        write_bytes(out / name, data)
-        written.append(str(out / name))
-    if draw_path is not None:
-        parent = Path(draw_path).parent
-        if str(parent) and not parent.exists():
-            parent.mkdir(parents=True, exist_ok=True)
-        write_bytes(draw_path, files["<draw>"])
-        written.append(str(draw_path))
-    return written
-
-
-def summary(c: Compiled, written: list[str], level: int) -> dict:
+def summary(c, written: list[str], level: int) -> dict:
     nl, s = c.netlist, c.netlist.stats
     return {
         "source": c.spec.source,
@@ -119,6 +89,9 @@ def summary(c: Compiled, written: list[str], level: int) -> dict:
         "input_outputs": {o.name: ("!" if o.half_unit else "") + o.src[1] for o in nl.outputs if o.kind == "input"},
         "files": written,
         "seconds": round(c.seconds, 3),
+        "circuit": None if c.circuit is None else {
+            "bodies": len(c.circuit.scene.bodies), "chains": c.circuit.chains, "half_units": c.circuit.half_units,
+            "seconds": {k: round(v, 3) for k, v in c.circuit.seconds.items()}},
     }
 
 
@@ -135,17 +108,102 @@ def format_summary(d: dict) -> str:
     if d["input_outputs"]:
         lines.append("outputs wired to an input: " + ", ".join(f"{k} = {v}" for k, v in d["input_outputs"].items()))
     lines.append(f"equivalence proven ({d['equivalence_method']}); compiled in {d['seconds']} s")
+    if d.get("circuit"):
+        ci = d["circuit"]
+        lines.append(f"circuit: {ci['bodies']} bodies, {ci['chains']} connector chains, {ci['half_units']} half units "
+                     f"(placed and routed in {sum(ci['seconds'].values()):.1f} s)")
+    if d.get("verification"):
+        v = d["verification"]
+        lines.append(f"verification ({v['mode']}): {'all ' + str(v['rows']) + ' rows correct' if v['ok'] else 'FAILED'}"
+                     f" in {v['seconds']:.1f} s")
     lines.append("wrote " + ", ".join(d["files"]))
     return "\n".join(lines)
 
 
 def run(args) -> int:
+    from mlc.errors import MlcError
     from mlc.front.load import load
+    from mlc.io.outputs import Outputs
+    from mlc.io.progress import Progress
+
+    want_circuit = not args.no_circuit
+    if not want_circuit and (args.verify or args.stl or args.threemf):
+        raise MlcError("--verify, --stl and --3mf need the circuit", "--no-circuit", "drop --no-circuit")
+    if args.dynamic and not args.verify:
+        raise MlcError("--dynamic only applies to --verify", "--dynamic", "add --verify")
+    if args.seeds < 1:
+        raise MlcError(f"need at least one seed, got {args.seeds}", "--seeds")
+    if not (args.kT >= 0 and args.kT < float("inf")):
+        raise MlcError(f"kT must be finite and >= 0, got {args.kT}", "--kT")
+    outs = Outputs(inputs=[args.input] if args.input else [])
+    outdir = outs.directory(args.outdir, "-o")
+    draw = outs.file(args.draw, "--draw", suffixes=(".png",), parents=True)
+    stl = outs.file(args.stl, "--stl", suffixes=(".stl",), parents=True)
+    threemf = outs.file(args.threemf, "--3mf", suffixes=(".3mf",), parents=True)
+    outs.check()                                    # every output location, before the work
 
     spec = load(args.input, args.expr, strict=args.strict)
     c = compile_spec(spec, args.level, args.signal)
     files = render(c, draw=bool(args.draw))
-    written = write(args.outdir, files, args.draw)
+    report = None
+    if want_circuit:
+        from mlc.pipeline import build
+        from mlc.scene.io import dump_scene
+        with Progress("placing and routing", total=1) as bar:
+            build(c, progress=lambda done, total: (setattr(bar, "total", total), bar.update(done)))
+        scene = c.circuit.scene
+        files["circuit.yaml"] = dump_scene(scene).encode()
+        from mlc.circuit.draw import render_circuit
+        files["circuit.png"] = render_circuit(scene)
+        if args.verify:
+            from mlc.commands.verify import verify_scene_file
+            report = verify_scene_file(scene, args.dynamic, args.kT, args.seeds, args.scheme)
+    with outs:
+        for name, data in files.items():
+            if name == "<draw>":
+                draw.write_bytes(data)
+            else:
+                outdir.write_bytes(name, data)
+        if report is not None:
+            outdir.write_text("verify.json", json.dumps(report.as_dict(), indent=1))
+        if stl is not None or threemf is not None:
+            _mesh(outdir.file("circuit.yaml"), stl, threemf, args.profile)
+        if report is not None and not report.ok:
+            from mlc.verify.circuit import format_report
+            sys.stdout.write(format_report(report) + "\n")
+            raise MlcError(f"the circuit failed {args.dynamic and 'dynamic' or 'static'} verification "
+                           f"(rows {', '.join(r['state'] for r in report.rows if not r['ok'])})",
+                           f"{spec.source}", "this is a bug in mlc's circuit back end: please report it")
+    written = outs.written
     d = summary(c, written, args.level)
-    print(json.dumps(d) if args.json else format_summary(d))
+    if report is not None:
+        d["verification"] = {"mode": report.mode, "ok": report.ok, "rows": len(report.rows),
+                             "seconds": report.seconds, **report.params}
+    if args.json:
+        print(json.dumps(d))
+    else:
+        print(format_summary(d))
+        if report is not None:
+            from mlc.verify.circuit import format_report
+            print(format_report(report))
     return 0
+
+
+def _mesh(scene_path, stl, threemf, profile: str) -> None:
+    """Printable meshes of the circuit through ``mlc stl`` (staged paths)."""
+    from mlc.cli import main as cli
+    argv = ["stl", str(scene_path), "--profile", profile]
+    if stl is not None:
+        argv += ["-o", str(stl.tmp)]
+    if threemf is not None:
+        argv += ["--3mf", str(threemf.tmp)]
+    import contextlib
+    import io
+    err = io.StringIO()
+    with contextlib.redirect_stderr(err):
+        rc = cli(argv)
+    if rc != 0:
+        from mlc.errors import MlcError
+        msg = err.getvalue().strip().splitlines()
+        raise MlcError(f"meshing the circuit failed: {msg[-1] if msg else 'exit ' + str(rc)}", "--stl",
+                       "see mlc stl OUTDIR/circuit.yaml for the printability report")

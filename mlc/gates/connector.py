@@ -56,7 +56,7 @@ _EX = np.array([1.0, 0.0, 0.0])
 _EY = np.array([0.0, 1.0, 0.0])
 _EZ = np.array([0.0, 0.0, 1.0])
 
-DEFAULT_GAP = 0.3          # sigma: gap between two layers at a junction (posts of gap/2 each)
+DEFAULT_GAP = 0.5          # sigma: gap between two layers at a junction (posts of gap/2 each)
 POST_WIDTH = 0.08          # sigma: cross-section of the posts that carry the joint sites
 
 

@@ -1,0 +1,123 @@
+"""Circuit back end: cost against circuit size, and dynamic verification per scheme.
+
+* Ripple-carry adders of growing width (1 to ``--max-width`` bits; 7 gates per full-adder
+  bit): netlist gates, scene bodies, build time (placement + routing + assembly), static
+  verification time of one row (the all-ones row: every muscle moves), the smallest slab
+  clearance and whether every probe read right.  Goals (issue 9): build of 200 gates
+  under 2 s, static verification of one row of a 200-gate circuit under 10 s, build cost
+  no worse than linear in bodies.
+* The full adder verified by Brownian dynamics on one row with each scheme: wall time.
+
+    python benchmarks/circuit_scaling.py [--max-width 30] [--skip-dynamic]
+
+Writes benchmarks/results/circuit_scaling.json and .png.  Times are wall seconds on this
+machine in one run; compare ratios, not absolute numbers across machines.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import time
+from pathlib import Path
+
+import numpy as np
+
+from mlc.circuit.build import build_circuit
+from mlc.logic.library import ripple_adder
+from mlc.pipeline import compile_spec
+from mlc.verify.circuit import verify_dynamic, verify_static
+
+OUT = Path(__file__).resolve().parent / "results"
+
+
+def adder_point(w: int) -> dict:
+    spec = ripple_adder(w)
+    c = compile_spec(spec, 2, "expand")
+    t0 = time.perf_counter()
+    circ = build_circuit(c.netlist, spec)
+    t_build = time.perf_counter() - t0
+    sc = circ.scene
+    row = "1" * len(sc.inputs)
+    rep = verify_static(sc, rows=[row])
+    return {"width": w, "gates": len(c.netlist.gates), "bodies": len(sc.bodies), "chains": circ.chains,
+            "half_units": circ.half_units, "build_s": t_build, "build_parts_s": circ.seconds,
+            "verify_row_s": rep.rows[0]["seconds"], "row": row, "ok": rep.ok,
+            "clearance": rep.rows[0].get("clearance"), "joint_stretch": rep.rows[0]["joint_stretch"]}
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--max-width", type=int, default=30)
+    ap.add_argument("--widths", type=int, nargs="*")
+    ap.add_argument("--skip-dynamic", action="store_true")
+    ap.add_argument("--budget", type=float, default=1800.0, help="stop growing after this many seconds")
+    args = ap.parse_args()
+    widths = args.widths or [w for w in (1, 2, 3, 4, 6, 8, 12, 16, 20, 25, 30) if w <= args.max_width]
+    points = []
+    t_all = time.perf_counter()
+    for w in widths:
+        p = adder_point(w)
+        points.append(p)
+        print(json.dumps({k: (round(v, 3) if isinstance(v, float) else v) for k, v in p.items()
+                          if k != "build_parts_s"}), flush=True)
+        if time.perf_counter() - t_all > args.budget:
+            print(f"budget of {args.budget} s reached; stopping at width {w}")
+            break
+    dyn = []
+    if not args.skip_dynamic:
+        from mlc.front.load import load
+        spec = load(str(Path(__file__).resolve().parents[1] / "examples" / "full_adder.tt"), None)
+        c = compile_spec(spec)
+        sc = build_circuit(c.netlist, spec).scene
+        for scheme in ("stiff", "euler"):
+            t0 = time.perf_counter()
+            try:
+                rep = verify_dynamic(sc, rows=["111"], kT=1e-5, seeds=1, scheme=scheme, progress=False)
+                dyn.append({"scheme": scheme, "row": "111", "seconds": time.perf_counter() - t0, "ok": rep.ok,
+                            "bodies": len(sc.bodies)})
+            except Exception as e:  # an unstable or too-slow scheme is a result, not a crash
+                dyn.append({"scheme": scheme, "row": "111", "seconds": time.perf_counter() - t0, "ok": False,
+                            "error": str(e)})
+            print(json.dumps(dyn[-1]), flush=True)
+    g = np.array([p["gates"] for p in points], float)
+    b = np.array([p["bodies"] for p in points], float)
+    tb = np.array([p["build_s"] for p in points])
+    tv = np.array([p["verify_row_s"] for p in points])
+    fit = {}
+    if len(points) >= 3:
+        fit["build_exponent_in_bodies"] = float(np.polyfit(np.log(b), np.log(tb), 1)[0])
+        fit["verify_exponent_in_bodies"] = float(np.polyfit(np.log(b), np.log(tv), 1)[0])
+    biggest = points[-1]
+    goals = {"build_200_gates_under_2s": None, "verify_row_200_gates_under_10s": None}
+    if biggest["gates"] >= 200:
+        goals = {"build_200_gates_under_2s": biggest["build_s"] < 2.0,
+                 "verify_row_200_gates_under_10s": biggest["verify_row_s"] < 10.0}
+    res = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
+                       "load": os.getloadavg()[0] if hasattr(os, "getloadavg") else None},
+           "adders": points, "dynamic_full_adder": dyn, "fit": fit, "goals": goals}
+    OUT.mkdir(exist_ok=True)
+    (OUT / "circuit_scaling.json").write_text(json.dumps(res, indent=1))
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
+    ax[0].loglog(g, b, "o-")
+    ax[0].set_xlabel("gates")
+    ax[0].set_ylabel("bodies in the scene")
+    ax[0].set_title("ripple-carry adders")
+    ax[1].loglog(b, tb, "o-", label="build (place + route + assemble)")
+    ax[1].loglog(b, tv, "s-", label="static verification, one row")
+    ax[1].axhline(2.0, color="C0", ls=":", lw=0.8)
+    ax[1].axhline(10.0, color="C1", ls=":", lw=0.8)
+    ax[1].set_xlabel("bodies")
+    ax[1].set_ylabel("wall time (s)")
+    ax[1].legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(OUT / "circuit_scaling.png", dpi=110)
+    print(json.dumps({"fit": fit, "goals": goals}))
+
+
+if __name__ == "__main__":
+    main()

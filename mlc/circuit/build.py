@@ -1,0 +1,393 @@
+"""A gate netlist becomes one circuit scene: placement, routing and assembly.
+
+Rules (docs/circuits.md):
+
+* **Signals.**  Every wire carries the netlist's physical signal (``netlist.signal``);
+  a gate computes on the physical states of its input wires (its levers absorb the
+  inversions).  The scene is built posed in the all-zero input row: each gate is posed
+  in its own input state of that row (solved once per gate type and state).
+* **Placement.**  Gates stand upright (core plane horizontal, output lever up) in
+  levels along +z: logic level ``d`` at ``z = d * level_pitch``; a level's gates are
+  spread along x, ordered by the mean x of their drivers.  Circuit inputs that need a
+  source (fan-out, or an output) sit at level 0.
+* **Inputs.**  One muscle per circuit input.  An input that feeds exactly one gate
+  input drives that input lever directly (the library gate's own muscle); otherwise
+  the muscle spans the input diagonal of a *source* half unit at level 0, whose output
+  pair (carrying the inverted signal) is the tap of the wire.
+* **Taps and fan-out.**  A wire's tap is a gate's output pair (or a source's).  One
+  consumer: a chain hangs on the tap.  Several: a branch: one half unit (a page) per
+  consumer hangs on the tap, turned about the tap's axis, and each page's chain goes on.
+* **Chains** are routed by inverse kinematics (:mod:`mlc.circuit.route`) from the tap
+  (or page) to the consumer's input lever, arriving from below, with the parity the
+  signal needs: every half unit is a NOT, so a path has an even count of them, or an
+  odd one where the netlist marks a half unit (an inverted output).
+* **Outputs** are probes across a pair carrying the output's wire: a gate's output pair,
+  a page or a stub half unit where an inversion is needed.  A constant output is a
+  probe across two sites of one rigid slab, fixed at the state's length.
+
+Units: sigma, k0.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import lru_cache
+
+import numpy as np
+
+from mlc.errors import MlcError
+from mlc.gates.connector import (ConnectorGeometry, Pair, Parts, branch_angles, chain_parts, connector_geometry,
+                                 half_unit_parts, join, max_bend, rotate)
+from mlc.gates.parts import slab_body
+from mlc.scene.model import Body, Bond, Muscle, Probe, Scene
+
+MAX_GATES = 2000            # larger netlists are refused (the scene would not fit a verification)
+MAX_INPUTS = 14             # the scene's truth table lists every row
+LEVEL_PITCH = 12.0          # sigma between logic levels (z)
+GATE_PITCH = 12.0           # sigma between gates of one level (x)
+TERMINAL_POST = 0.5         # sigma: the last half unit's layer stays this far below a lever's plane
+LAYER_PITCH = 2.5           # sigma between the horizontal layers of the routes into one level
+RISER_Y = -5.0              # sigma: plane (y) of the routes' vertical runs, in front of the gates
+RUN_Y = -8.5                # sigma: plane (y) of their horizontal runs
+RISER_PITCH = 3.5           # sigma between the risers of the routes from one tap (x)
+# Gates are turned by +90 degrees about z (gate x -> world y): every output pair's axis is
+# then along world x, so branch pages (turned about that axis) fan out towards -y, where
+# the routes run, and a gate's input levers reach along +-y.
+_ROT = np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]])
+_ROT_Q = np.array([np.cos(np.pi / 4), 0.0, 0.0, np.sin(np.pi / 4)])
+
+
+@dataclass
+class CircuitOptions:
+    gap: float = 0.5                 # connector junction gap (sigma)
+    level_pitch: float = LEVEL_PITCH
+    gate_pitch: float = GATE_PITCH
+
+
+@dataclass
+class Circuit:
+    """The built scene plus what the builder knows about it."""
+
+    scene: Scene
+    gate_frames: dict = field(default_factory=dict)      # gate id -> world translation
+    chains: int = 0
+    half_units: int = 0
+    seconds: dict = field(default_factory=dict)
+
+
+@lru_cache(maxsize=None)
+def _posed_gate(gtype: str, signal: str, state: str):
+    """(scene, pos, quat) of a library gate in input state ``state`` ("ab")."""
+    from mlc.gates.library import gate_scene
+    from mlc.verify.static import equilibrium
+    sc = gate_scene(gtype, signal)
+    if state == "00":
+        A = sc.arrays()
+        return sc, A.pos.copy(), A.quat.copy()
+    eq = equilibrium(sc, state)
+    return sc, eq.pos, eq.quat
+
+
+def _wire_values(netlist, bits: dict) -> dict:
+    """Physical state of every wire for input values ``bits`` (name -> 0/1)."""
+    from mlc.gates.library import get_gate
+    val = {("input", w.name): int(bits[w.name]) for w in netlist.inputs}
+    for g in netlist.gates:
+        gd = get_gate(g.type)
+        val[("gate", g.id)] = gd.evaluate(val[g.a.src], val[g.b.src])
+    return val
+
+
+def _truth_table(spec, netlist) -> dict[str, str]:
+    """Expected outputs of every row, from the specification (the user's intent)."""
+    from mlc.logic.equiv import spec_tables
+    n = len(netlist.inputs)
+    names = [w.name for w in netlist.inputs]
+    if spec is not None:
+        on, dc = spec_tables(spec)
+        pos = {x: i for i, x in enumerate(spec.inputs)}
+        oidx = {x: i for i, x in enumerate(spec.outputs)}
+        table = {}
+        for r in range(2 ** n):
+            key = format(r, f"0{n}b")
+            m = sum(int(key[i]) << pos[x] for i, x in enumerate(names))
+            out = []
+            for o in netlist.outputs:
+                k = oidx[o.name]
+                out.append("-" if (dc[k] >> m) & 1 else str((on[k] >> m) & 1))
+            table[key] = "".join(out)
+        return table
+    table = {}
+    for r in range(2 ** n):
+        key = format(r, f"0{n}b")
+        v = _wire_values(netlist, dict(zip(names, map(int, key))))
+        table[key] = "".join(str(o.value) if o.kind == "const" else str(v[o.src] ^ int(o.half_unit))
+                             for o in netlist.outputs)
+    return table
+
+
+def _gate_bodies(gid: str, sc: Scene, pos, quat, offset) -> tuple[list[Body], list[Bond]]:
+    """The gate's bodies and bonds, renamed ``{gid}_{name}`` and moved by ``offset``."""
+    from mlc.geometry.rotation import matrix_to_quat, quat_to_matrix
+    bodies = [Body(f"{gid}_{b.name}", _ROT @ np.asarray(p, float) + offset,
+                   matrix_to_quat(_ROT @ quat_to_matrix(q)), b.boxes, dict(b.sites))
+              for b, p, q in zip(sc.bodies, pos, quat)]
+    bonds = []
+    for b in sc.bonds:
+        ba, sa = b.a.split(".", 1)
+        bb, sb = b.b.split(".", 1)
+        bonds.append(Bond(f"{gid}_{b.name}", f"{gid}_{ba}.{sa}", f"{gid}_{bb}.{sb}", b.k, b.rest, b.tolerance,
+                          b.kind, f"{gid}_{b.joint}" if b.joint else None))
+    return bodies, bonds
+
+
+def _world(bodies_by_name, ref: str) -> np.ndarray:
+    body, site = ref.split(".", 1)
+    return bodies_by_name[body].world(site)
+
+
+def _pair(bodies_by_name, lo: str, hi: str) -> Pair:
+    p, q = _world(bodies_by_name, lo), _world(bodies_by_name, hi)
+    L = float(np.linalg.norm(q - p))
+    return Pair(lo, hi, 0.5 * (p + q), (q - p) / L, L)
+
+
+def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, progress=None) -> Circuit:
+    """One scene of the whole circuit, posed in the all-zero input row (see module doc)."""
+    import time
+
+    from mlc.circuit.route import solve_route
+
+    opt = options or CircuitOptions()
+    t_start = time.perf_counter()
+    if len(netlist.gates) > MAX_GATES:
+        raise MlcError(f"netlist has {len(netlist.gates)} gates; the circuit back end builds at most {MAX_GATES}",
+                       netlist.source, "split the design, or compile without the circuit (netlist only)")
+    if len(netlist.inputs) > MAX_INPUTS:
+        raise MlcError(f"netlist has {len(netlist.inputs)} inputs; a circuit scene lists every row of its truth "
+                       f"table and holds at most {MAX_INPUTS}", netlist.source, "split the design")
+    signal = netlist.signal
+    geo = connector_geometry(signal, gap=opt.gap)
+    names = [w.name for w in netlist.inputs]
+    zero = _wire_values(netlist, {x: 0 for x in names})
+
+    # ---- consumers of every wire ---------------------------------------------------
+    consumers: dict[tuple, list] = {}
+    for g in netlist.gates:
+        for pin, p in (("a", g.a), ("b", g.b)):
+            consumers.setdefault(p.src, []).append(("pin", g.id, pin))
+    for o in netlist.outputs:
+        if o.kind != "const":
+            consumers.setdefault(o.src, []).append(("out", o.name, int(o.half_unit)))
+
+    # ---- placement -----------------------------------------------------------------
+    levels: dict[int, list] = {}
+    for g in netlist.gates:
+        levels.setdefault(g.depth, []).append(g)
+    xpos: dict[tuple, float] = {}
+    sources = [w for w in netlist.inputs
+               if not (len(consumers.get(("input", w.name), [])) == 1
+                       and consumers[("input", w.name)][0][0] == "pin")]
+    for i, w in enumerate(sources):
+        xpos[("input", w.name)] = (i - 0.5 * (len(sources) - 1)) * opt.gate_pitch
+    for w in netlist.inputs:
+        xpos.setdefault(("input", w.name), 0.0)
+    # routes arriving at each level: each gets its own horizontal layer in the gap below it
+    arriving: dict[int, int] = {}
+    for g in netlist.gates:
+        for p in (g.a, g.b):
+            if not (p.src[0] == "input" and len(consumers.get(p.src, [])) == 1):
+                arriving[g.depth] = arriving.get(g.depth, 0) + 1
+    zlevel = {0: 0.0}
+    for d in range(1, max(levels, default=0) + 1):
+        zlevel[d] = zlevel[d - 1] + opt.level_pitch + LAYER_PITCH * arriving.get(d, 0)
+    origin: dict[str, np.ndarray] = {}
+    for d in sorted(levels):
+        gs = levels[d]
+        gs.sort(key=lambda g: (0.5 * (xpos.get(g.a.src, 0.0) + xpos.get(g.b.src, 0.0)), g.id))
+        for i, g in enumerate(gs):
+            x = (i - 0.5 * (len(gs) - 1) + 0.5 * (d % 2)) * opt.gate_pitch
+            xpos[("gate", g.id)] = x
+            origin[g.id] = np.array([x, 0.0, zlevel[d]])
+    layer_next = {d: 0 for d in zlevel}
+
+    bodies: list[Body] = []
+    bonds: list[Bond] = []
+    muscles: list[Muscle] = []
+    probes: list[Probe] = []
+    by_name: dict[str, Body] = {}
+
+    def add(parts: Parts):
+        bodies.extend(parts.bodies)
+        bonds.extend(parts.bonds)
+        muscles.extend(parts.muscles)
+        for b in parts.bodies:
+            by_name[b.name] = b
+
+    # ---- gates ---------------------------------------------------------------------
+    direct_input: dict[tuple, str] = {}      # (gate id, pin) -> circuit input driving the lever directly
+    for w in netlist.inputs:
+        cons = consumers.get(("input", w.name), [])
+        if len(cons) == 1 and cons[0][0] == "pin":
+            direct_input[(cons[0][1], cons[0][2])] = w.name
+    for g in netlist.gates:
+        state = f"{zero[g.a.src]}{zero[g.b.src]}"
+        sc, pos, quat = _posed_gate(g.type, signal, state)
+        bs, bd = _gate_bodies(g.id, sc, pos, quat, origin[g.id])
+        add(Parts(bs, bd, []))
+        for m in sc.muscles:                     # muscle_a / muscle_b: kept where an input drives the lever
+            key = (g.id, m.input)
+            if key in direct_input:
+                ba, sa = m.a.split(".", 1)
+                bb, sb = m.b.split(".", 1)
+                muscles.append(Muscle(f"muscle_{direct_input[key]}", direct_input[key], f"{g.id}_{ba}.{sa}",
+                                      f"{g.id}_{bb}.{sb}", m.rest, m.actuated, m.k))
+
+    # ---- sources of inputs that fan out (or reach an output) --------------------------
+    taps: dict[tuple, tuple[Pair, int]] = {}     # wire -> (tap pair, its polarity: 1 = carries NOT wire)
+    for w in sources:
+        src = ("input", w.name)
+        c = np.array([xpos[src], 0.0, 0.0])
+        parts, pin, pout = half_unit_parts(f"src_{w.name}", c, np.array([0.0, 1.0, 0]), np.array([0, 0, 1.0]),
+                                           zero[src], geo)
+        parts.muscles.append(Muscle(f"muscle_{w.name}", w.name, pin.lo, pin.hi, geo.L0, geo.L1, geo.k))
+        add(parts)
+        taps[src] = (pout, 1)
+        if not consumers.get(src):
+            taps[src] = (pin, 0)
+    for g in netlist.gates:
+        taps[("gate", g.id)] = (_pair(by_name, f"{g.id}_out_lo.out", f"{g.id}_out_hi.out"), 0)
+
+    # ---- wires: branches, chains, output probes ----------------------------------------
+    t_route = time.perf_counter()
+    n_chains = n_half = 0
+    wires = [w for w in taps if consumers.get(w)]
+    for wi, wire in enumerate(wires):
+        if progress:
+            progress(wi, len(wires))
+        tap, pol = taps[wire]
+        cons = consumers[wire]
+        wname = wire[1]
+        state_at_tap = zero[wire] ^ pol
+        up = np.array([0.0, 0.0, 1.0])
+        t_up = up - float(up @ tap.axis) * tap.axis
+        t_up /= np.linalg.norm(t_up)
+        # turning about the tap's axis by +ang must lean towards -y (the routing planes)
+        sgn = 1.0 if rotate(t_up, tap.axis, 0.1)[1] < 0 else -1.0
+        # where each consumer is (for the page order)
+        def cx(c):
+            if c[0] == "pin":
+                return xpos[("gate", c[1])]
+            return xpos[wire]
+        cons = sorted(cons, key=cx)
+        if len(cons) == 1:
+            starts = [(tap, pol, True, rotate(t_up, tap.axis, sgn * math.radians(45.0)), None)]
+        else:
+            starts = []
+            angs = branch_angles(len(cons))
+            spread = abs(angs[1] - angs[0])
+            post = max(geo.branch_post, geo.reach / math.tan(0.5 * spread) + 0.25)
+            for k, (c, ang) in enumerate(zip(cons, angs)):
+                t = rotate(t_up, tap.axis, sgn * ang)
+                parts, pin, pout = half_unit_parts(f"w_{wname}_p{k}", tap.centre, tap.axis, t, state_at_tap, geo,
+                                                   in_post=post)
+                parts.bonds += join(f"w_{wname}_p{k}_j", tap, pin, geo.k)
+                add(parts)
+                n_half += 1
+                starts.append((pout, pol ^ 1, True, t, None))
+        for k, (c, (start, spol, free, t0, _)) in enumerate(zip(cons, starts)):
+            sstate = zero[wire] ^ spol
+            tag = f"w_{wname}_{k}"
+            if c[0] == "out":
+                need = c[2]                                   # 1: the output is inverted
+                extra = spol ^ need
+                end = start
+                if extra:
+                    parts, pin, pout = half_unit_parts(f"{tag}_stub", start.centre, start.axis, t0, sstate, geo)
+                    parts.bonds += join(f"{tag}_stub_j", start, pin, geo.k)
+                    add(parts)
+                    n_half += 1
+                    end = pout
+                probes.append(Probe(c[1], c[1], end.lo, end.hi, geo.L0, geo.L1))
+                continue
+            gid, pin_name = c[1], c[2]
+            target = _pair(by_name, f"{gid}_{pin_name}_lo.in", f"{gid}_{pin_name}_hi.in")
+            ext = TERMINAL_POST - 0.5 * geo.gap
+            app = np.array([0.0, 0.0, 1.0])
+            d_sink = next(g.depth for g in netlist.gates if g.id == gid)
+            k_layer = layer_next[d_sink]
+            layer_next[d_sink] += 1
+            z_run = zlevel[d_sink - 1] + 0.5 * opt.level_pitch + LAYER_PITCH * k_layer
+            x_rise = tap.centre[0] + RISER_PITCH * (k - 0.5 * (len(starts) - 1))
+            xp, yp, zp = target.centre
+            wps = [(x_rise, RISER_Y, start.centre[2] + 3.0), (x_rise, RISER_Y, z_run - 1.5),
+                   (x_rise, RUN_Y, z_run), (xp, RUN_Y, z_run), (xp, yp - 2.0, zp - 4.0)]
+            route = solve_route(start.centre, start.axis, target.centre, target.axis, geo, spol, waypoints=wps,
+                                tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
+                                start_bend_max=math.radians(50.0) if len(starts) == 1 else 0.75 * max_bend(geo))
+            if route is None:        # the lanes are a preference: route straight if they cannot be kept
+                route = solve_route(start.centre, start.axis, target.centre, target.axis, geo, spol,
+                                    tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
+                                    start_bend_max=math.radians(50.0) if len(starts) == 1 else 0.75 * max_bend(geo))
+            if route is None:
+                raise MlcError(f"cannot route wire {wname} to {gid}.{pin_name}: no connector chain reaches it",
+                               netlist.source, "this is a placement limit of mlc; please report the netlist")
+            parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, sstate, geo)
+            # the last half unit's output post is longer so its layer clears the lever plane:
+            last = len(route.bends) - 1
+            for b in list(parts.bodies):
+                if b.name.startswith(f"{tag}_{last}_"):
+                    parts.bodies.remove(b)
+            parts.bonds = [bd for bd in parts.bonds if not bd.name.startswith(f"{tag}_{last}_")]
+            cs_in = pairs[-2]
+            t_last = (pairs[-1].centre - cs_in.centre) / np.linalg.norm(pairs[-1].centre - cs_in.centre)
+            lp, lin, lout = half_unit_parts(f"{tag}_{last}", cs_in.centre, cs_in.axis, t_last,
+                                            sstate ^ (last % 2), geo, out_post=0.5 * geo.gap + ext)
+            parts.add(lp)
+            parts.bonds += join(f"{tag}_j0", start, pairs[0], geo.k)
+            add(parts)
+            n_chains += 1
+            n_half += len(route.bends)
+            same = float(lout.axis @ target.axis) > 0
+            ends = (lout.lo, lout.hi) if same else (lout.hi, lout.lo)
+            bonds.append(Bond(f"{tag}_end_lo", ends[0], target.lo, geo.k, 0.0, 0.0, "universal", f"{tag}_end_lo"))
+            bonds.append(Bond(f"{tag}_end_hi", ends[1], target.hi, geo.k, 0.0, 0.0, "universal", f"{tag}_end_hi"))
+    t_done = time.perf_counter()
+
+    # ---- constant outputs ------------------------------------------------------------
+    for i, o in enumerate(netlist.outputs):
+        if o.kind == "const":
+            L = geo.length(o.value)
+            c = np.array([(i + 1) * opt.gate_pitch, -opt.gate_pitch, 0.0])
+            p, q = c - [0.5 * L, 0, 0], c + [0.5 * L, 0, 0]
+            body = slab_body(f"const_{o.name}", [(p, q)], {"lo": p, "hi": q}, np.array([0, 0, 1.0]),
+                             geo.width, geo.thickness)
+            add(Parts([body], [], []))
+            probes.append(Probe(o.name, o.name, f"const_{o.name}.lo", f"const_{o.name}.hi", geo.L0, geo.L1))
+
+    # order probes as the outputs
+    order = {o.name: i for i, o in enumerate(netlist.outputs)}
+    probes.sort(key=lambda p: order[p.output])
+    table = _truth_table(spec, netlist)
+    scene = Scene(name=f"circuit_{_stem(netlist.source)}", bodies=bodies, bonds=bonds, muscles=muscles,
+                  probes=probes, inputs=names, outputs=[o.name for o in netlist.outputs], truth_table=table,
+                  meta={"element": "circuit", "signal": signal, "source": netlist.source,
+                        "gates": {g.id: {"type": g.type, "origin": [float(v) for v in origin[g.id]],
+                                         "depth": g.depth} for g in netlist.gates},
+                        "connector": {"gap": geo.gap, "side": round(geo.side, 6), "chains": n_chains,
+                                      "half_units": n_half}})
+    scene.check()
+    t_end = time.perf_counter()
+    return Circuit(scene, origin, n_chains, n_half,
+                   {"place": t_route - t_start, "route": t_done - t_route, "assemble": t_end - t_done})
+
+
+def _stem(source: str) -> str:
+    import os
+    import re
+    s = os.path.splitext(os.path.basename(source or "circuit"))[0]
+    s = re.sub(r"[^A-Za-z0-9_]", "_", s) or "circuit"
+    return s if re.match(r"[A-Za-z_]", s) else f"c_{s}"
+
+
+__all__ = ["Circuit", "CircuitOptions", "build_circuit"]

@@ -1,0 +1,255 @@
+"""Routing: a connector chain from one signal pair to another, by inverse kinematics.
+
+A chain of ``n`` half units is fixed by its start pair (centre ``c0``, axis ``u0``), its
+first tangent and the bend at every junction (:func:`mlc.gates.connector.chain_frames`:
+junction ``i`` turns the next tangent about the junction's pair axis).  Routing finds
+bends such that the last pair lands on the target pair:
+
+* centre ``c_n = P`` (3 equations) and axis ``u_n = +-a`` (2 equations), solved to 1e-10
+  sigma: the joints close exactly when the scene is built;
+* the last tangent points along ``approach`` (the side the target is open to), softly;
+* the chain passes near ``waypoints`` (fractions of its length), softly;
+* every bend within ``+-bend_max`` (bounds), so neighbouring layers never touch;
+* smallest bends otherwise (a weak term).
+
+``n`` has the parity the signal needs (every half unit is a NOT) and grows from the
+straight-line estimate until the equations close.  Units: sigma, radians.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from numba import njit
+from scipy.optimize import least_squares
+
+from mlc.gates.connector import ConnectorGeometry, chain_frames, max_bend, rotate
+
+BEND_FRACTION = 0.75         # routing bends at most this fraction of the geometric largest bend
+EXACT = 1e-7                 # sigma: the last pair must land this close
+
+
+@dataclass
+class Route:
+    """A solved chain: start pair, first tangent (before bends[0]), bends (rad)."""
+
+    centre: np.ndarray
+    axis: np.ndarray
+    tangent: np.ndarray
+    bends: list
+    error: float                 # distance of the last pair from the target (sigma)
+    approach_error: float        # |t_last - approach| (0 = straight on)
+
+    @property
+    def n(self) -> int:
+        return len(self.bends)
+
+
+def _perp_basis(a):
+    a = a / np.linalg.norm(a)
+    h = np.array([1.0, 0, 0]) if abs(a[0]) < 0.9 else np.array([0, 1.0, 0])
+    e1 = np.cross(a, h)
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(a, e1)
+
+
+def _project_perp(v, u):
+    v = np.asarray(v, float) - float(np.dot(v, u)) * u
+    n = np.linalg.norm(v)
+    return v / n if n > 1e-9 else None
+
+
+def _bezier(p0, d0, p3, d3, k=64):
+    """Points of the cubic Bezier from p0 (leaving along d0) to p3 (arriving along d3)."""
+    L = float(np.linalg.norm(p3 - p0))
+    p1, p2 = p0 + 0.4 * L * d0, p3 - 0.4 * L * d3
+    s = np.linspace(0.0, 1.0, k)[:, None]
+    return (1 - s) ** 3 * p0 + 3 * (1 - s) ** 2 * s * p1 + 3 * (1 - s) * s ** 2 * p2 + s ** 3 * p3
+
+
+def _steer(c0, u0, t0, guide, pitch, bmax, free_start, max_half):
+    """Bends that make a chain follow the polyline ``guide`` (pure pursuit, one pitch of
+    look-ahead); stops when the chain is within a pitch of the guide's end."""
+    end = guide[-1]
+    bends, c, u, t = [], np.array(c0, float), np.array(u0, float), np.array(t0, float)
+    seg = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(guide, axis=0), axis=1))])
+    for i in range(max_half):
+        # closest guide point, then look ahead by 2 pitches
+        j = int(np.argmin(np.linalg.norm(guide - c, axis=1)))
+        s_goal = seg[j] + 2.0 * pitch
+        k = int(np.searchsorted(seg, s_goal))
+        goal = guide[min(k, len(guide) - 1)]
+        d = goal - c
+        dp = d - float(d @ u) * u
+        lim = float(free_start) if i == 0 else bmax
+        if np.linalg.norm(dp) > 1e-9 and lim > 0:
+            dp /= np.linalg.norm(dp)
+            ang = math.atan2(float(np.cross(t, dp) @ u), float(t @ dp))
+            b = max(-lim, min(lim, ang))
+        else:
+            b = 0.0
+        t = _rot(t, u, b)
+        bends.append(b)
+        c = c + pitch * t
+        u = np.cross(t, u)
+        if float(np.linalg.norm(end - c)) < 0.75 * pitch and seg[j] > seg[-1] - 3 * pitch:
+            break
+    return bends
+
+
+def solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int, *,
+                tangent=None, free_start: bool = True, approach=None, waypoints=(),
+                min_half: int = 2, max_half: int = 400, bend_max: float | None = None,
+                last_pitch: float | None = None, start_bend_max: float = math.radians(50.0)) -> Route | None:
+    """A chain from pair (c0, u0) to pair (target_c, +-target_a) with ``n % 2 == parity``
+    half units; None when no chain closes.
+
+    ``tangent``: the first tangent (perpendicular to u0); with ``free_start`` the first
+    bend may turn it about u0 (a chain hung on a floppy pair) by up to ``start_bend_max``,
+    otherwise it is fixed.
+    ``approach``: unit vector the last tangent should follow.  ``waypoints``: points the
+    chain should pass (in order).  The bends are first found by steering along a smooth
+    guide curve through the waypoints, then refined by inverse kinematics."""
+    c0, u0 = np.asarray(c0, float), np.asarray(u0, float) / np.linalg.norm(u0)
+    P, a = np.asarray(target_c, float), np.asarray(target_a, float) / np.linalg.norm(target_a)
+    e1, e2 = _perp_basis(a)
+    bmax = BEND_FRACTION * max_bend(geo) if bend_max is None else bend_max
+    if tangent is None:
+        tangent = _project_perp(P - c0, u0)
+        if tangent is None:
+            tangent = _perp_basis(u0)[0]
+    t0 = _project_perp(tangent, u0)
+    app = None if approach is None else np.asarray(approach, float) / np.linalg.norm(approach)
+    # guide: start along t0, through the waypoints, into the target along the approach
+    knots = [c0] + [np.asarray(w, float) for w in waypoints] + [P]
+    dirs = [t0]
+    def unit_or(d, fallback):
+        n = float(np.linalg.norm(d))
+        return d / n if n > 1e-9 else fallback
+
+    for i in range(1, len(knots) - 1):
+        dirs.append(unit_or(knots[i + 1] - knots[i - 1], dirs[-1]))
+    dirs.append(app if app is not None else unit_or(P - knots[-2], dirs[-1]))
+    guide = np.concatenate([_bezier(knots[i], dirs[i], knots[i + 1], dirs[i + 1])[:-1]
+                            for i in range(len(knots) - 1)] + [P[None]])
+    guess = _steer(c0, u0, t0, guide, geo.pitch, bmax, free_start and start_bend_max, max_half)
+    best = None
+    for extra in (0, 2, 4, 8, 12, 16, 24):
+        n = max(min_half, len(guess) + extra)
+        if n % 2 != parity:
+            n += 1
+        x0 = np.nan_to_num(np.array((guess + [0.0] * n)[:n]))
+        pitches = np.full(n, geo.pitch)
+        if last_pitch is not None:
+            pitches[-1] = last_pitch
+        cs_g, _, _ = _fk(c0, u0, t0, x0, pitches)
+        wps = [(max(1, min(n - 1, int(np.argmin(np.linalg.norm(cs_g - np.asarray(w, float), axis=1))))),
+                np.asarray(w, float)) for w in waypoints]
+        try:
+            r = _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start and start_bend_max, wps)
+        except ValueError:          # a degenerate start (non-finite residuals): try the next length
+            continue
+        if r.error < EXACT and r.approach_error < 0.5:
+            return r
+        if best is None or r.error < best.error:
+            best = r
+    return None
+
+
+def _rot(v, k, th):
+    c, s = math.cos(th), math.sin(th)
+    return v * c + np.cross(k, v) * s + k * float(k @ v) * (1.0 - c)
+
+
+@njit(cache=True)
+def _fk_kernel(c0, u0, t0, b, pitch, cs, us, ts):
+    """Chain frames (see chain_frames) into cs (n+1,3), us (n+1,3), ts (n,3): arrays only."""
+    n = b.shape[0]
+    for j in range(3):
+        cs[0, j] = c0[j]
+        us[0, j] = u0[j]
+    t = np.empty(3)
+    t[:] = t0
+    k = np.empty(3)
+    for i in range(n):
+        # t <- R(k, b[i]) t with k = us[i]
+        for j in range(3):
+            k[j] = us[i, j]
+        th = b[i]
+        c, s = math.cos(th), math.sin(th)
+        kx = k[1] * t[2] - k[2] * t[1]
+        ky = k[2] * t[0] - k[0] * t[2]
+        kz = k[0] * t[1] - k[1] * t[0]
+        kd = k[0] * t[0] + k[1] * t[1] + k[2] * t[2]
+        t0x = t[0] * c + kx * s + k[0] * kd * (1.0 - c)
+        t0y = t[1] * c + ky * s + k[1] * kd * (1.0 - c)
+        t0z = t[2] * c + kz * s + k[2] * kd * (1.0 - c)
+        t[0], t[1], t[2] = t0x, t0y, t0z
+        ts[i, 0], ts[i, 1], ts[i, 2] = t[0], t[1], t[2]
+        for j in range(3):
+            cs[i + 1, j] = cs[i, j] + pitch[i] * t[j]
+        us[i + 1, 0] = t[1] * us[i, 2] - t[2] * us[i, 1]
+        us[i + 1, 1] = t[2] * us[i, 0] - t[0] * us[i, 2]
+        us[i + 1, 2] = t[0] * us[i, 1] - t[1] * us[i, 0]
+
+
+def _fk(c0, u0, t0, b, pitch):
+    """Frames of the chain (see chain_frames; ``pitch`` a number or one per half unit):
+    arrays cs (n+1,3), us (n+1,3), ts (n,3)."""
+    b = np.ascontiguousarray(b, dtype=np.float64)
+    n = len(b)
+    pitch = np.ascontiguousarray(np.broadcast_to(np.asarray(pitch, float), (n,)))
+    cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
+    _fk_kernel(np.asarray(c0, float), np.asarray(u0, float), np.asarray(t0, float), b, pitch, cs, us, ts)
+    return cs, us, ts
+
+
+def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=()) -> Route:
+    lo = np.full(n, -bmax)
+    hi = np.full(n, bmax)
+    lim0 = float(free_start) if free_start else 1e-12      # free_start: the first bend's bound (rad)
+    lo[0], hi[0] = -lim0, lim0
+
+    def resid(b, w_soft):
+        cs, us, ts = _fk(c0, u0, t0, b, pitches)
+        out = [10.0 * (cs[-1] - P), [10.0 * float(us[-1] @ e1), 10.0 * float(us[-1] @ e2)]]
+        if app is not None:
+            out.append(w_soft * 2.0 * (ts[-1] - app))
+        for k, p in wps:
+            out.append(w_soft * 0.3 * (cs[k] - p))
+        out.append(w_soft * 0.05 * np.asarray(b[1:]))
+        return np.concatenate([np.ravel(x) for x in out])
+
+    def jac(b, w_soft):
+        # bend i turns everything downstream of junction i rigidly about (c_i, u_i)
+        cs, us, ts = _fk(c0, u0, t0, b, pitches)
+        U, C = us[:n], cs[:n]                                   # axis and point of each bend
+        rows = [10.0 * np.cross(U, cs[-1] - C).T,               # d c_n
+                10.0 * (np.cross(U, us[-1]) @ e1)[None, :],     # d (u_n . e1)
+                10.0 * (np.cross(U, us[-1]) @ e2)[None, :]]
+        if app is not None:
+            rows.append(w_soft * 2.0 * np.cross(U, ts[-1]).T)   # d t_{n-1}: every bend i <= n-1
+        idx = np.arange(n)
+        for k, _ in wps:
+            d = np.cross(U, cs[k] - C).T
+            d[:, idx >= k] = 0.0
+            rows.append(w_soft * 0.3 * d)
+        sm = np.zeros((n - 1, n))
+        sm[np.arange(n - 1), np.arange(1, n)] = w_soft * 0.05
+        rows.append(sm)
+        return np.vstack(rows)
+
+    x = np.clip(np.asarray(x0, float), lo + 1e-12, hi - 1e-12)
+    # two passes: soft terms on (shape the chain), then nearly off (close exactly)
+    for w_soft in (1.0, 1e-3):
+        res = least_squares(resid, x, jac=jac, bounds=(lo, hi), args=(w_soft,), method="trf", xtol=1e-15,
+                            ftol=1e-15, gtol=1e-15, max_nfev=300 if w_soft == 1.0 else 200)
+        x = res.x
+    cs, us, ts = _fk(c0, u0, t0, x, pitches)
+    err = float(max(np.linalg.norm(cs[-1] - P), abs(us[-1] @ e1), abs(us[-1] @ e2)))
+    aerr = 0.0 if app is None else float(np.linalg.norm(ts[-1] - app))
+    return Route(c0, u0, t0, [float(v) for v in x], err, aerr)
+
+
+__all__ = ["BEND_FRACTION", "Route", "solve_route"]

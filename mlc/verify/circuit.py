@@ -1,0 +1,186 @@
+"""Verification of a whole scene (a compiled circuit, a connector, a gate) on every row of
+its truth table, statically or by Brownian dynamics.
+
+* **static**: for each row, the equilibrium reached from the scene's rest pose by moving
+  the muscles (:func:`mlc.verify.static.equilibrium`), every probe read; a row passes
+  when every probe reads the expected bit with the length within ``tol_length`` of the
+  ideal, the largest joint stretch is within ``tol_stretch`` (no gate strained by its
+  wiring), and no two slabs of different bodies interpenetrate in that pose
+  (:func:`mlc.verify.overlap.clearance`; the smallest clearance is reported).  Clearance
+  is its own verdict (``clearance_ok``); it fails a row only with ``require_clearance``:
+  the router does not yet keep every pair of wires apart (docs/circuits.md), and a
+  crossing of two floppy chains does not change what the circuit computes;
+* **dynamic**: :func:`mlc.verify.dynamic.check_scene_dynamic_multi`: Brownian dynamics
+  from rest into each row over several seeds until every probe has relaxed (detected).
+
+The result is a :class:`Report`: one entry per (row, output) and a per-row summary.
+Units: sigma, k0, t0.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+from mlc.errors import MlcError
+from mlc.scene.model import Scene
+
+TOL_LENGTH = 0.05       # sigma: a read length must be this close to its ideal (static)
+TOL_STRETCH = 1e-3      # sigma: largest joint stretch allowed in a row's equilibrium
+
+
+@dataclass
+class Report:
+    scene: str
+    mode: str                          # "static" or "dynamic"
+    entries: list = field(default_factory=list)      # one dict per (row, output)
+    rows: list = field(default_factory=list)         # one dict per row: state, ok, clearance, stretch...
+    seconds: float = 0.0
+    params: dict = field(default_factory=dict)
+
+    @property
+    def ok(self) -> bool:
+        return all(r["ok"] for r in self.rows)
+
+    def failures(self) -> list[dict]:
+        return [e for e in self.entries if not e["ok"]]
+
+    def as_dict(self) -> dict:
+        return {"scene": self.scene, "mode": self.mode, "ok": self.ok, "seconds": round(self.seconds, 3),
+                "params": self.params, "rows": self.rows, "entries": self.entries}
+
+
+def select_rows(scene: Scene, rows=None) -> list[str]:
+    """The rows to verify: all (default) or the given bit strings, checked."""
+    if scene.truth_table is None:
+        raise MlcError(f"scene {scene.name} has no truth table to verify against", scene.source or scene.name,
+                       "add a truth_table mapping input bits to output bits")
+    if not scene.probes:
+        raise MlcError(f"scene {scene.name} has no probes to read", scene.source or scene.name,
+                       "add a probe for each output")
+    allrows = scene.states()
+    if rows is None:
+        return allrows
+    out = []
+    for r in rows:
+        r = str(r).strip()
+        if r not in allrows:
+            raise MlcError(f"row {r!r} is not {len(scene.inputs)} bits for inputs {', '.join(scene.inputs)}",
+                           "--rows", f"give bit strings such as {allrows[-1]}")
+        out.append(r)
+    return out
+
+
+def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_stretch: float = TOL_STRETCH,
+                  clearance: bool = True, progress=None, require_clearance: bool = False) -> Report:
+    from mlc.verify.overlap import clearance as clear
+    from mlc.verify.static import equilibrium
+
+    states = select_rows(scene, rows)
+    t0 = time.perf_counter()
+    rep = Report(scene.name, "static", params={"tol_length": tol_length, "tol_stretch": tol_stretch,
+                                               "require_clearance": require_clearance})
+    for i, state in enumerate(states):
+        t_row = time.perf_counter()
+        eq = equilibrium(scene, state)
+        want = scene.truth_table.get(state)
+        row_ok = eq.max_joint_stretch <= tol_stretch
+        for pr in scene.probes:
+            k = scene.outputs.index(pr.output)
+            bit = None if want is None or want[k] == "-" else int(want[k])
+            L = eq.probes[pr.name]
+            ideal = None if bit is None else (pr.actuated if bit else pr.rest)
+            ok = bit is None or (pr.bit(L) == bit and abs(L - ideal) <= tol_length)
+            row_ok &= ok
+            rep.entries.append({"state": state, "output": pr.output, "expected": bit, "measured": L,
+                                "bit": pr.bit(L), "margin": None if bit is None else float(pr.margin(L, bit)),
+                                "error": None if ideal is None else float(abs(L - ideal)), "ok": bool(ok)})
+        row = {"state": state, "joint_stretch": eq.max_joint_stretch, "seconds": 0.0}
+        if clearance:
+            c = clear(scene, eq.pos, eq.quat)
+            row["clearance"] = c.min_clearance
+            row["clearance_pair"] = list(c.pair)
+            row["overlaps"] = [list(o) for o in c.overlaps[:10]]
+            row["n_overlaps"] = len(c.overlaps)
+            row["clearance_ok"] = bool(c.ok())
+            if require_clearance:
+                row_ok &= c.ok()
+        row["ok"] = bool(row_ok)
+        row["seconds"] = time.perf_counter() - t_row
+        rep.rows.append(row)
+        if progress:
+            progress(i + 1, len(states))
+    rep.seconds = time.perf_counter() - t0
+    return rep
+
+
+def verify_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
+                   progress=None) -> Report:
+    from mlc.verify.dynamic import check_scene_dynamic_multi
+
+    states = select_rows(scene, rows)
+    if int(seeds) < 1:
+        raise MlcError(f"need at least one seed, got {seeds}", "--seeds")
+    t0 = time.perf_counter()
+    entries = check_scene_dynamic_multi(scene, kT=kT, seeds=int(seeds), scheme=scheme, rows=states,
+                                        progress=progress)
+    rep = Report(scene.name, "dynamic", params={"kT": kT, "seeds": int(seeds), "scheme": scheme})
+    for e in entries:
+        rep.entries.append({"state": e["state"], "output": e["output"], "expected": e["expected"],
+                            "measured": e["measured"], "bit": e.get("bit"), "margin": e["margin"],
+                            "relax_time": e.get("relax_time"), "per_seed": e.get("per_seed"), "ok": bool(e["ok"])})
+    for s in states:
+        es = [e for e in rep.entries if e["state"] == s]
+        rts = [e["relax_time"] for e in es]
+        rep.rows.append({"state": s, "ok": all(e["ok"] for e in es),
+                         "relax_time": None if any(r is None for r in rts) else max(rts, default=0.0)})
+    rep.seconds = time.perf_counter() - t0
+    return rep
+
+
+def format_report(rep: Report) -> str:
+    """A table of rows by outputs: the read length (sigma) and margin, then a verdict."""
+    outs = list(dict.fromkeys(e["output"] for e in rep.entries))
+    by = {(e["state"], e["output"]): e for e in rep.entries}
+    head = f"{'row':>8} | " + " | ".join(f"{o:>14}" for o in outs)
+    extra = " | clearance   stretch" if rep.mode == "static" else " | relax (t0)"
+    lines = [f"{rep.scene}: {rep.mode} verification, {len(rep.rows)} rows x {len(outs)} outputs "
+             f"(cells: length sigma / margin; * = wrong)", head + extra, "-" * (len(head) + len(extra))]
+    for row in rep.rows:
+        cells = []
+        for o in outs:
+            e = by.get((row["state"], o))
+            if e is None:
+                cells.append(f"{'':>14}")
+                continue
+            m = "   dc" if e["margin"] is None else f"{e['margin']:+.3f}"
+            cells.append(f"{e['measured']:.3f}/{m}{'*' if not e['ok'] else ' '}".rjust(14))
+        if rep.mode == "static":
+            tail = f" | {row.get('clearance', float('nan')):+.4f}   {row['joint_stretch']:.1e}"
+        else:
+            rt = row.get("relax_time")
+            tail = f" | {'not relaxed' if rt is None else f'{rt:.2f}'}"
+        lines.append(f"{row['state']:>8} | " + " | ".join(cells) + tail + ("" if row["ok"] else "   WRONG"))
+    bad = rep.failures()
+    bad_rows = [r for r in rep.rows if not r["ok"]]
+    if not bad_rows:
+        lines.append(f"all {len(rep.rows)} rows correct ({rep.seconds:.1f} s)")
+    else:
+        for e in bad[:10]:
+            want = "don't care" if e["expected"] is None else e["expected"]
+            lines.append(f"WRONG: row {e['state']}, output {e['output']}: expected {want}, read "
+                         f"{e['measured']:.4f} sigma (bit {e['bit']})")
+        for r in bad_rows:
+            if rep.mode == "static" and r["joint_stretch"] > rep.params.get("tol_stretch", TOL_STRETCH):
+                lines.append(f"WRONG: row {r['state']}: joint stretch {r['joint_stretch']:.2e} sigma "
+                             f"(bound {rep.params.get('tol_stretch', TOL_STRETCH)})")
+    for r in rep.rows:
+        if rep.mode == "static" and r.get("overlaps"):
+            a, b, d = r["overlaps"][0]
+            word = "WRONG" if rep.params.get("require_clearance") else "WARNING"
+            lines.append(f"{word}: row {r['state']}: slabs {a} and {b} interpenetrate by {d:.4f} sigma "
+                         f"({r.get('n_overlaps', len(r['overlaps']))} pairs); smallest clearance "
+                         f"{r['clearance']:+.4f} sigma")
+    return "\n".join(lines)
+
+
+__all__ = ["Report", "format_report", "select_rows", "verify_dynamic", "verify_static"]
