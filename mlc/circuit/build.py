@@ -45,10 +45,11 @@ MAX_GATES = 2000            # larger netlists are refused (the scene would not f
 MAX_INPUTS = 14             # the scene's truth table lists every row
 LEVEL_PITCH = 12.0          # sigma between logic levels (z)
 GATE_PITCH = 12.0           # sigma between gates of one level (x)
-TERMINAL_POST = 0.5         # sigma: the last half unit's layer stays this far below a lever's plane
+TERMINAL_POST = 0.6         # sigma: the last half unit's layer stays this far below a lever's plane
 LAYER_PITCH = 2.5           # sigma between the horizontal layers of the routes into one level
 RISER_Y = -5.0              # sigma: plane (y) of the routes' vertical runs, in front of the gates
 RUN_Y = -8.5                # sigma: plane (y) of their horizontal runs
+PIN_SPREAD = 2.5            # sigma: a gate's two input chains arrive this far apart in x
 RISER_PITCH = 3.5           # sigma between the risers of the routes from one tap (x)
 # Gates are turned by +90 degrees about z (gate x -> world y): every output pair's axis is
 # then along world x, so branch pages (turned about that axis) fan out towards -y, where
@@ -320,8 +321,11 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
             z_run = zlevel[d_sink - 1] + 0.5 * opt.level_pitch + LAYER_PITCH * k_layer
             x_rise = tap.centre[0] + RISER_PITCH * (k - 0.5 * (len(starts) - 1))
             xp, yp, zp = target.centre
+            # the two inputs of a gate sit at one x (they differ in y): come in from either side
+            side = -1.0 if pin_name == "a" else 1.0
+            x_in = xp + side * PIN_SPREAD
             wps = [(x_rise, RISER_Y, start.centre[2] + 3.0), (x_rise, RISER_Y, z_run - 1.5),
-                   (x_rise, RUN_Y, z_run), (xp, RUN_Y, z_run), (xp, yp - 2.0, zp - 4.0)]
+                   (x_rise, RUN_Y, z_run), (x_in, RUN_Y, z_run), (x_in, yp - 2.0, zp - 4.0)]
             route = solve_route(start.centre, start.axis, target.centre, target.axis, geo, spol, waypoints=wps,
                                 tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
                                 start_bend_max=math.radians(50.0) if len(starts) == 1 else 0.75 * max_bend(geo))
