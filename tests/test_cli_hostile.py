@@ -390,12 +390,13 @@ def test_core_extreme_parameters(din, h, capsys):
 
 def _mlc(args, **kw):
     code = f"import sys; from mlc.cli import main; sys.exit(main({args!r}))"
-    return subprocess.run([sys.executable, "-c", code], capture_output=False, stderr=subprocess.PIPE,
+    # -P: not the checkout on sys.path, the installed package (as CI's plain `pytest` does)
+    return subprocess.run([sys.executable, "-P", "-c", code], capture_output=False, stderr=subprocess.PIPE,
                           text=True, timeout=120, **kw)
 
 
 def test_stdout_closed_and_full():
-    r = subprocess.run(["sh", "-c", f"'{sys.executable}' -c 'import sys; from mlc.cli import main; "
+    r = subprocess.run(["sh", "-c", f"'{sys.executable}' -P -c 'import sys; from mlc.cli import main; "
                                     f"sys.exit(main([\"info\"]))' >&-"], stderr=subprocess.PIPE, text=True,
                        timeout=120)
     assert r.returncode == 2 and r.stderr == "mlc: error: standard output is closed " \
