@@ -64,8 +64,8 @@ def select_rows(scene: Scene, rows=None) -> list[str]:
     for r in rows:
         r = str(r).strip()
         if r not in allrows:
-            raise MlcError(f"row {r!r} is not {len(scene.inputs)} bits for inputs {', '.join(scene.inputs)}",
-                           "--rows", f"give bit strings such as {allrows[-1]}")
+            raise MlcError(f"row {r!r} is not an input state of scene {scene.name} (inputs {scene.inputs})",
+                           "--rows", f"give {len(scene.inputs)}-bit strings like {allrows[-1]!r}")
         out.append(r)
     return out
 

@@ -178,20 +178,6 @@ def _seed_list(seeds) -> list[int]:
     return out
 
 
-def _check_rows(scene, rows) -> list[str]:
-    states = scene.states()
-    if rows is None:
-        return states
-    out = []
-    for r in rows:
-        r = str(r)
-        if r not in states:
-            raise MlcError(f"row {r!r} is not an input state of scene {scene.name} (inputs {scene.inputs})",
-                           "--rows", f"give {len(scene.inputs)}-bit strings like {states[-1]!r}")
-        out.append(r)
-    return out
-
-
 def plateau_tol(kT: float, k0: float = 1.0, sd: float = 0.0, tau: float = 0.0, block: float = 1.0) -> float:
     """How far (sigma) two block means of a relaxed probe may differ: ``2e-3 + 3 sqrt(kT/k0)``
     plus three standard deviations of the difference of two block means of length
@@ -267,16 +253,12 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
     from mlc.io.progress import Progress
     from mlc.verify.static import equilibrium
 
-    if scene.truth_table is None:
-        raise MlcError(f"scene {scene.name} has no truth table to verify against", scene.source or scene.name,
-                       "add a truth_table mapping input bits to output bits")
-    if not scene.probes:
-        raise MlcError(f"scene {scene.name} has no probes to read", scene.source or scene.name,
-                       "add a probe for each output")
+    from mlc.verify.circuit import select_rows
+
+    states = select_rows(scene, rows)          # truth table, probes and the rows, checked
     if not (math.isfinite(kT) and kT >= 0):
         raise MlcError(f"kT must be finite and >= 0, got {kT}", "--kT")
     seed_list = _seed_list(seeds)
-    states = _check_rows(scene, rows)
     opt0 = SimOptions(scheme=scheme)
     tau_given = tau is not None
     tau = relaxation_time(scene, gamma_r=opt0.gamma_r) if tau is None else float(tau)
