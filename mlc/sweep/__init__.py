@@ -1,0 +1,1 @@
+"""Parameter sweeps of Brownian-dynamics runs on Dask (``mlc sweep``; docs/reproduction.md)."""
