@@ -129,12 +129,34 @@ def test_non_utf8_scene_gives_line_and_column(scene_text, tmp_path, capsys):
 
 
 def test_draw_refuses_a_scene_too_large_to_draw(scene_text, tmp_path, capsys):
+    """A body 1e300 sigma away: refused by the scene format's coordinate bound (1e6 sigma), at file:line."""
     import re
     src = tmp_path / "far.yaml"
     src.write_text(re.sub(r"position: \[[^\]]*\]", "position: [1e300, 0, 0]", scene_text, count=1))
     before = listing(tmp_path)
     code, _, err = run(capsys, "draw", src, "-o", tmp_path / "x.png")
-    assert_clean_failure(code, err, before, tmp_path, str(src), "spans 1e+300 sigma")
+    assert_clean_failure(code, err, before, tmp_path, f"{src}:", "must be <= 1e+06, got 1e+300")
+
+
+@pytest.mark.parametrize("old,new,words", [
+    # every number of a scene has a sane range, and the error says what the value means
+    (r"position: \[[^,]*,", "position: [1e300,", ["position[0]", "must be <= 1e+06", "coordinate in sigma"]),
+    ("  k: 1.0", "  k: 1e308", ["k: must be <= 1e+06", "stiffness in k0/sigma^2"]),
+    ("  actuated: 1.5", "  actuated: 1e308", ["actuated: must be <= 1000", "length in sigma"]),
+    ("  rest: 1.0", "  rest: 5e3", ["rest: must be <= 1000"]),
+    ("  tolerance: 0.0", "  tolerance: 1e9", ["tolerance: must be <= 1000", "flat-bottom"]),
+    (r"size: \[[^,]*,", "size: [2e4,", ["size[0]: must be <= 10000", "edge length in sigma"]),
+    ("  k: 1.0", "  k: '1.5'", ["expected number, got str", "without quotes, e.g. 1.5"]),
+])
+def test_scene_numbers_have_ranges_with_a_hint(old, new, words, scene_text, tmp_path, capsys):
+    import re
+    src = tmp_path / "s.yaml"
+    text = re.sub(old if old.startswith(("position", "size")) else re.escape(old), new, scene_text, count=1)
+    assert text != scene_text
+    src.write_text(text)
+    before = listing(tmp_path)
+    code, _, err = run(capsys, "simulate", src, "--time", "1", "--out", tmp_path / "t.gsd")
+    assert_clean_failure(code, err, before, tmp_path, f"{src}:", *words)
 
 
 def test_yaml_1_2_floats_without_a_dot_are_numbers(scene_text):

@@ -27,9 +27,12 @@ def run(args) -> int:
         with outs:                       # every output checked before the ~30 s of work
             if plot:
                 solve_core(args.din, args.h)          # the marker must exist: fail before the work
-            # about 30 s on the reference machine (29 accessible-range scans of 150 core solves)
-            with Progress("mlc core: computing the Fig. 1B design space", expect=30.0):
-                space = design_space()
+            # about 30 s on the reference machine (29 accessible-range scans of 151 core solves)
+            with Progress("mlc core: computing the Fig. 1B design space", total=1) as bar:
+                def step(done, total):
+                    bar.total = total
+                    bar.update(done)
+                space = design_space(progress=step)
             if data:
                 data.write_text(json.dumps({
                     "units": "sigma", "curves": {str(h): pts for h, pts in space["curves"].items()},

@@ -35,13 +35,16 @@ def register(sub):
 
 def run_gate(args) -> int:
     from mlc.gates.library import gate_scene
-    from mlc.scene.io import dump_scene, write_scene
-    scene = gate_scene(args.name, args.signal)
-    if args.output:
-        write_scene(scene, args.output)
-        print(f"wrote {args.output}")
-    else:
-        sys.stdout.write(dump_scene(scene))
+    from mlc.io.outputs import Outputs
+    from mlc.scene.io import dump_scene
+    if args.output is None:
+        sys.stdout.write(dump_scene(gate_scene(args.name, args.signal)))
+        return 0
+    outs = Outputs()
+    out = outs.file(args.output, "-o", suffixes=(".yaml", ".yml"))
+    with outs:              # the location is checked before the scene is built
+        out.write_text(dump_scene(gate_scene(args.name, args.signal)))
+    print(f"wrote {args.output}")
     return 0
 
 

@@ -61,8 +61,6 @@ def parse_sets(items, scene) -> dict:
 
 
 def run(args) -> int:
-    from pathlib import Path
-
     from mlc.scene.io import load_scene
     from mlc.sim.integrator import SimOptions, Simulation
     from mlc.sim.output import write_gsd, write_probes_csv, write_probes_npz
@@ -85,18 +83,27 @@ def run(args) -> int:
         raise MlcError(f"--threads must be >= 1, got {args.threads}", "--threads")
     if args.fluct and args.scheme != "stiff":
         raise MlcError("--fluct is a mode of the stiff scheme", "--fluct", "drop --scheme euler")
+    from mlc.io.outputs import Outputs
+    outs = Outputs(inputs=[args.scene])
+    gsd = outs.file(args.out, "--out", suffixes=(".gsd",))
+    csv = outs.file(args.probes, "--probes", suffixes=(".csv",))
+    npz = None
+    if csv is not None and not (csv.path.exists() and not csv.path.is_file()):   # no .npz beside /dev/stdout
+        npz = outs.file(csv.path.with_suffix(".npz"), "--probes (its .npz)", suffixes=(".npz",))
     opt = SimOptions(dt=args.dt, scheme=args.scheme, kT=args.kT, seed=args.seed, rot_noise=args.rot_noise,
                      threads=args.threads, disp_acc=args.drift_tol, fluct=args.fluct)
-    sim = Simulation(scene, drives, opt)
-    res = sim.run(args.time, record_interval=args.record, frames=args.frames if args.out else 0,
-                  quiet=args.quiet or args.json)
-    if args.out:
-        write_gsd(args.out, scene, res.frame_times, res.frame_pos, res.frame_quat)
-    if args.probes:
-        write_probes_csv(args.probes, res.times, res.probes)
-        write_probes_npz(str(Path(args.probes).with_suffix(".npz")), res.times, res.probes,
-                         {"scene": scene.name, "scheme": res.scheme, "dt": res.dt, "kT": args.kT,
-                          "seed": args.seed})
+    with outs:          # every output location checked before the run; all written, or none
+        sim = Simulation(scene, drives, opt)
+        res = sim.run(args.time, record_interval=args.record, frames=args.frames if args.out else 0,
+                      quiet=args.quiet or args.json)
+        if gsd:
+            write_gsd(gsd.tmp, scene, res.frame_times, res.frame_pos, res.frame_quat)
+        if csv:
+            write_probes_csv(csv.tmp, res.times, res.probes)
+        if npz:
+            write_probes_npz(str(npz.tmp), res.times, res.probes,
+                             {"scene": scene.name, "scheme": res.scheme, "dt": res.dt, "kT": args.kT,
+                              "seed": args.seed})
     bias = sim.variance_bias()
     summary = {"scene": scene.name, "scheme": res.scheme, "fluct": bool(args.fluct), "dt": res.dt,
                "steps": res.steps, "time": res.time, "wall": round(res.wall, 4), "force_evals": res.force_evals,

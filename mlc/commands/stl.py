@@ -60,7 +60,10 @@ def load_target(target: str, signal: str):
 
 def run(args) -> int:
     from mlc.errors import MlcError
-    from mlc.mesh import export_scene
+    from mlc.io.outputs import Outputs
+    from mlc.io.progress import Progress
+    from mlc.mesh.export import declare_outputs, part_meshes, write_staged
+    from mlc.mesh.pipeline import export_assembly
     from mlc.mesh.profiles import load_profile
 
     overrides = {k: getattr(args, k) for k in ("sigma_mm", "clearance", "knuckle_gap", "slab_thickness",
@@ -68,28 +71,47 @@ def run(args) -> int:
                                               "orient", "pin")}
     prof = load_profile(args.profile, overrides)
     scene = load_target(args.target, args.signal)
-    try:
-        report = export_scene(scene, prof, stl=args.output, threemf=args.threemf, parts_dir=args.parts,
-                        force=args.force, solve=not args.no_states)
-    except MlcError as e:
-        if not hasattr(e, "report"):
-            raise
-        report = e.report      # the checks failed: print the report, then fail below
-    if args.report:
-        from mlc.io.atomic import write_text
-        write_text(args.report, json.dumps(report.to_dict(), indent=2) + "\n")
+    check_resources(scene, prof, {k: "--" + ("segments" if k == "circular_segments" else k.replace("_", "-"))
+                                  for k, v in overrides.items() if v is not None})
+    inputs = [p for p in (args.target, args.profile) if p and Path(p).exists()]
+    outs = Outputs(inputs=inputs)
+    files = declare_outputs(outs, args.output, args.threemf, args.parts)
+    rep_out = outs.file(args.report, "--report", suffixes=(".json",))
+    with outs:              # every output location checked before the meshes are built; all or none
+        # a library gate takes about 5 s; a circuit of many gates minutes (quiet when not a terminal)
+        with Progress(f"mlc stl: building and checking the parts of {scene.name}"):
+            asm, report = export_assembly(scene, prof, solve=not args.no_states)
+        report.outputs = []
+        if report.ok or args.force:
+            if any(f is not None for f in files):
+                report.outputs = write_staged(part_meshes(asm), scene.name, *files)
+            if rep_out is not None:
+                rep_out.write_text(json.dumps(report.to_dict(), indent=2) + "\n")
+                report.outputs.append(str(rep_out.path))
+        _print_report(report, args)
+        if not report.ok and not args.force:
+            failed = [c.name for c in report.checks if not c.ok and c.blocking]
+            raise MlcError(f"printability checks failed: {', '.join(failed)}; nothing written", args.target,
+                           "see the report above, change the profile, or use --force")
+    if not args.json:
+        for o in outs.written:
+            print(f"wrote {o}")
+    if not report.ok:
+        failed = [c.name for c in report.checks if not c.ok and c.blocking]
+        sys.stderr.write(f"mlc: warning: printability checks failed ({', '.join(failed)}); written anyway "
+                         f"(--force)\n")
+    return 0
+
+
+def _print_report(report, args) -> None:
     if args.json:
         print(json.dumps(report.to_dict(), indent=2))
     else:
         print(report.text())
-        for o in report.outputs:
-            print(f"wrote {o}")
-    if not report.ok:
-        failed = [c.name for c in report.checks if not c.ok and c.blocking]
-        if args.force:
-            sys.stderr.write(f"mlc: warning: printability checks failed ({', '.join(failed)}); written anyway "
-                             f"(--force)\n")
-            return 0
-        raise MlcError(f"printability checks failed: {', '.join(failed)}; nothing written", args.target,
-                       "see the report above, change the profile, or use --force")
-    return 0
+
+
+def check_resources(scene, prof, options=None) -> None:
+    """Refuse, before any work, a profile that does not fit the scene or would need too much memory
+    (:func:`mlc.mesh.profiles.check_against_scene`); ``options``: field -> the option that set it."""
+    from mlc.mesh.profiles import check_against_scene
+    check_against_scene(prof, scene, "--profile", options)

@@ -112,9 +112,13 @@ def _roots(din: float, h: float) -> list[float]:
     return roots
 
 
+_RANGE_GRID = 121      # din samples of an accessible-range scan
+_EDGE_STEPS = 30       # bisection steps refining its upper edge
+
+
 def accessible_din_range(h: float) -> tuple[float, float] | None:
     """The (min, max) of din/sigma for which a core of height h has a physical solution."""
-    grid = np.linspace(1e-3, 3.0, 121)
+    grid = np.linspace(1e-3, 3.0, _RANGE_GRID)
     ok = [d for d in grid if _physical(d, h)]
     if not ok:
         return None
@@ -163,33 +167,52 @@ def _solve(din: float, h: float) -> CoreSolution | None:
     return max(sols, key=lambda s: s.dout)
 
 
-def design_space(hs=(1.25, 1.5, 2.0, 2.5, 3.0), n: int = 60) -> dict:
+def design_space(hs=(1.25, 1.5, 2.0, 2.5, 3.0), n: int = 60, progress=None) -> dict:
     """Fig. 1B as data: dout(din) for each h, and the accessible boundary.
 
-    The boundary is, for each h, the largest accessible din (and its dout)."""
+    The boundary is, for each h, the largest accessible din (and its dout).  ``progress``,
+    if given, is called as ``progress(done, total)`` in units of core solves (an accessible-range
+    scan counts as its 151 solves), so a caller can show a bar with an ETA."""
     curves = {}
     boundary = []
     hgrid = np.linspace(1.1, 4.0, 24)
+    per_range = _RANGE_GRID + _EDGE_STEPS
+    total = len(hs) * (per_range + n) + len(hgrid) * per_range
+    done = 0
+
+    def tick(k):
+        nonlocal done
+        done += k
+        if progress is not None:
+            progress(done, total)
+
     for h in hs:
         rng = accessible_din_range(h)
+        tick(per_range)
         pts = []
         if rng:
-            for din in np.linspace(rng[0], rng[1], n):
+            for i, din in enumerate(np.linspace(rng[0], rng[1], n)):
                 s = _solve(din, h)
                 if s is not None:
                     pts.append((float(din), float(s.dout)))
+                if i % 10 == 9:
+                    tick(10)
+            tick(n % 10)
+        else:
+            tick(n)
         curves[float(h)] = pts
     for h in hgrid:
         rng = accessible_din_range(h)
         if rng:
             hi = rng[1]
             boundary.append((float(h), hi, float(_solve(hi, h).dout)))
+        tick(per_range)
     return {"curves": curves, "boundary": boundary}
 
 
 def _refine_edge(h: float, lo: float) -> float:
     hi = lo + 0.025
-    for _ in range(30):
+    for _ in range(_EDGE_STEPS):
         mid = 0.5 * (lo + hi)
         if _physical(mid, h):
             lo = mid

@@ -46,8 +46,8 @@ def _path_str(path) -> str:
 
 
 class _Fail(Exception):
-    def __init__(self, msg, loc, path):
-        self.msg, self.loc, self.path = msg, loc, path
+    def __init__(self, msg, loc, path, fix=None):
+        self.msg, self.loc, self.path, self.fix = msg, loc, path, fix
 
 
 def validate(data, schema: dict, filename: str = "<input>") -> None:
@@ -56,7 +56,7 @@ def validate(data, schema: dict, filename: str = "<input>") -> None:
     try:
         _check(data, schema, root, [], getattr(data, "loc", None) or Loc(filename))
     except _Fail as f:
-        raise MlcError(f"{_path_str(f.path)}: {f.msg}", f.loc) from None
+        raise MlcError(f"{_path_str(f.path)}: {f.msg}", f.loc, f.fix) from None
 
 
 def _check(v, s, root, path, loc):
@@ -68,18 +68,19 @@ def _check(v, s, root, path, loc):
     if "type" in s:
         types = s["type"] if isinstance(s["type"], list) else [s["type"]]
         if not any(_TYPES[t](v) for t in types):
-            raise _Fail(f"expected {' or '.join(types)}, got {_describe(v)}", loc, path)
+            raise _Fail(f"expected {' or '.join(types)}, got {_describe(v)}", loc, path, _type_fix(v, types, s))
     if isinstance(v, (int, float)) and not isinstance(v, bool):
+        hint = s.get("description")
         if not math.isfinite(v):
-            raise _Fail(f"expected a finite number, got {v}", loc, path)
+            raise _Fail(f"expected a finite number, got {v}", loc, path, hint)
         if "minimum" in s and v < s["minimum"]:
-            raise _Fail(f"must be >= {s['minimum']}, got {v}", loc, path)
+            raise _Fail(f"must be >= {s['minimum']:g}, got {v:g}", loc, path, hint)
         if "maximum" in s and v > s["maximum"]:
-            raise _Fail(f"must be <= {s['maximum']}, got {v}", loc, path)
+            raise _Fail(f"must be <= {s['maximum']:g}, got {v:g}", loc, path, hint)
         if "exclusiveMinimum" in s and v <= s["exclusiveMinimum"]:
-            raise _Fail(f"must be > {s['exclusiveMinimum']}, got {v}", loc, path)
+            raise _Fail(f"must be > {s['exclusiveMinimum']:g}, got {v:g}", loc, path, hint)
         if "exclusiveMaximum" in s and v >= s["exclusiveMaximum"]:
-            raise _Fail(f"must be < {s['exclusiveMaximum']}, got {v}", loc, path)
+            raise _Fail(f"must be < {s['exclusiveMaximum']:g}, got {v:g}", loc, path, hint)
     if "enum" in s and v not in s["enum"]:
         raise _Fail(f"must be one of {', '.join(map(repr, s['enum']))}, got {v!r}", loc, path)
     if "const" in s and v != s["const"]:
@@ -134,6 +135,17 @@ def _check(v, s, root, path, loc):
                     first = first or f
             else:
                 raise first
+
+
+def _type_fix(v, types, s) -> str | None:
+    """A hint for a value of the wrong type: a quoted number, or what the value means."""
+    if isinstance(v, str) and ("number" in types or "integer" in types):
+        try:
+            float(v)
+        except ValueError:
+            return s.get("description")
+        return f"write the number without quotes, e.g. {float(v)!r}"
+    return s.get("description")
 
 
 def _describe(v) -> str:

@@ -3,8 +3,8 @@
 Meshes go out through trimesh (STL).  3MF is written here with the standard library
 (zip + XML, unit millimetre): one object, the assembly, whose named parts are volumes
 (PrusaSlicer's ``Slic3r_PE_model.config``), so slicers keep the parts in place; it needs no
-XML package beyond Python's; :func:`read_3mf` reads it back.  Every file is
-written atomically (``mlc.io.atomic``): a failed export leaves no partial file.
+XML package beyond Python's; :func:`read_3mf` reads it back.  The files of one export are
+written all or none (``mlc.io.outputs``): a failed export leaves no file behind.
 """
 from __future__ import annotations
 
@@ -18,7 +18,7 @@ import numpy as np
 import trimesh
 
 from mlc.errors import MlcError
-from mlc.io.atomic import atomic_path, write_bytes
+from mlc.io.atomic import write_bytes
 
 _NS_3MF = "http://schemas.microsoft.com/3dmanufacturing/core/2015/02"
 
@@ -167,34 +167,49 @@ def safe_name(name: str) -> str:
     return re.sub(r"[^A-Za-z0-9_.-]", "_", name)
 
 
-def write_outputs(asm, stl=None, threemf=None, parts_dir=None, meshes=None) -> list[str]:
-    """Write the requested files atomically; return the paths written.
+def declare_outputs(outs, stl=None, threemf=None, parts_dir=None, options=("-o", "--3mf", "--parts")):
+    """Declare the mesh files in an :class:`mlc.io.outputs.Outputs` (checked before any work):
+    returns ``(stl, threemf, parts)``, each None when not asked for."""
+    return (outs.file(stl, options[0], suffixes=(".stl",)),
+            outs.file(threemf, options[1], suffixes=(".3mf",)),
+            outs.directory(parts_dir, options[2]))
 
-    Every file is first built in memory, then all are renamed into place: an error while
-    building any of them leaves none behind."""
-    meshes = meshes if meshes is not None else part_meshes(asm)
-    blobs: list[tuple[Path, bytes]] = []
-    if stl:
-        blobs.append((Path(stl), stl_bytes(meshes)))
-    if threemf:
-        blobs.append((Path(threemf), threemf_bytes(meshes, asm.scene.name)))
-    if parts_dir:
-        d = Path(parts_dir)
-        if d.exists() and not d.is_dir():
-            raise MlcError("--parts must be a directory", str(d))
-        d.mkdir(parents=True, exist_ok=True)
+
+def write_staged(meshes, title: str, stl=None, threemf=None, parts=None) -> list[str]:
+    """Write the meshes to outputs declared by :func:`declare_outputs` (staged: they reach their
+    places when the ``Outputs`` block ends); return the final paths."""
+    final = []
+    if stl is not None:
+        stl.write_bytes(stl_bytes(meshes))
+        final.append(str(stl.path))
+    if threemf is not None:
+        threemf.write_bytes(threemf_bytes(meshes, title))
+        final.append(str(threemf.path))
+    if parts is not None:
+        if not meshes:
+            raise MlcError("nothing to export: the assembly has no parts")
         for name, m in meshes:
-            blobs.append((d / f"{safe_name(name)}.stl", m.export(file_type="stl")))
-    written = []
-    # write every file to its temporary first; rename only when all are written
-    from contextlib import ExitStack
-    with ExitStack() as stack:
-        for path, data in blobs:
-            tmp = stack.enter_context(atomic_path(path))
-            tmp.write_bytes(data)
-            written.append(str(path))
-    return written
+            fname = f"{safe_name(name)}.stl"
+            parts.write_bytes(fname, m.export(file_type="stl"))
+            final.append(str(parts.path / fname))
+    return final
+
+
+def write_outputs(asm, stl=None, threemf=None, parts_dir=None, meshes=None) -> list[str]:
+    """Write the requested files, all or none (:mod:`mlc.io.outputs`); return the paths written.
+
+    Every location is checked first (a file where the parts directory should go, a read-only
+    directory, a wrong suffix are :class:`~mlc.errors.MlcError`); the files are staged and moved
+    into place only when all are written."""
+    from mlc.io.outputs import Outputs
+
+    outs = Outputs()
+    decl = declare_outputs(outs, stl, threemf, parts_dir)
+    with outs:
+        meshes = meshes if meshes is not None else part_meshes(asm)
+        final = write_staged(meshes, asm.scene.name, *decl)
+    return final
 
 
 __all__ = ["to_trimesh", "part_meshes", "stl_bytes", "threemf_bytes", "read_3mf", "read_parts",
-           "write_outputs", "write_bytes"]
+           "declare_outputs", "write_staged", "write_outputs", "write_bytes"]

@@ -133,10 +133,7 @@ def profile_from_file(path) -> Profile:
     from mlc.io.schema import load_schema, validate
 
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as e:
-        raise MlcError(f"cannot read profile: {e.strerror}", str(path)) from None
+    text = yamlsrc.read_text(path, "profile")
     if path.suffix.lower() == ".json":
         try:
             data = json.loads(text)
@@ -167,3 +164,121 @@ def _plain(v):
     if isinstance(v, str):
         return str(v)
     return v
+
+
+#: largest sigma accepted (mm): a gate is about 3.6 sigma across, so 1000 mm makes a 3.6 m gate
+MAX_SIGMA_MM = 1000.0
+#: most polygon segments per circle (a 3 mm pin at 256 segments is within 0.0001 mm of a circle)
+MAX_SEGMENTS = 256
+#: memory an export may plan to use (bytes); beyond it `mlc stl` refuses with the estimate
+MEMORY_BUDGET = 2 * 2 ** 30
+
+
+def _widths(scene) -> tuple[float, float]:
+    """(narrowest slab width, largest extent of the scene), both in sigma.  A slab box's width is
+    its middle edge length (thickness < width <= length)."""
+    import numpy as np
+    widths, lo, hi = [], [], []
+    for b in scene.bodies:
+        for x in b.boxes:
+            w = sorted(float(v) for v in x.size)
+            widths.append(w[1])
+            c = np.asarray(b.position, float) + np.asarray(x.center, float)
+            r = 0.5 * float(np.linalg.norm(x.size))
+            lo.append(c - r)
+            hi.append(c + r)
+    if not widths:
+        return 0.0, 0.0
+    ext = np.max(hi, axis=0) - np.min(lo, axis=0)
+    return min(widths), ext
+
+
+def estimate_memory(prof: Profile, scene) -> dict:
+    """Rough peak memory (bytes) of an export of ``scene`` at ``prof``, from the sizes in mm.
+
+    Counted: the sample points on every slab's mid-plane (spacing as in mlc.mesh.build,
+    about 100 bytes a point with the copies made while trimming), the support-column grid of
+    the bed check (mlc.mesh.checks: spacing ``max(0.05, min(min_wall, size/150))`` mm, about
+    300 bytes a column) and a fixed 300 MB for the meshes and the voxel wall check (its grid is
+    capped at 6e6 cells).  Calibrated on NAND (mjp: ~0.2 GB measured; sigma 20 mm: 0.5 GB)."""
+    import numpy as np
+    s = prof.sigma_mm
+    t = prof.slab_thickness
+    c = prof.clearance
+    h = float(np.clip(max(min(t, c) if c > 0 else t, 0.015 * s), 0.05, 0.5))
+    n = 0.0
+    for b in scene.bodies:
+        for x in b.boxes:
+            w = sorted(float(v) * s for v in x.size)
+            n += (w[1] / h + 2) * (w[2] / h + 2)
+    _, ext = _widths(scene)
+    size = np.sort(np.asarray(ext, float) * s)
+    hb = max(0.05, min(prof.min_wall, float(size[-1]) / 150))
+    cols = (size[-1] / hb + 2) * (size[-2] / hb + 2)
+    total = 100.0 * n + 300.0 * cols + 300e6
+    return {"bytes": total, "samples": n, "sample_step_mm": h, "columns": cols, "column_step_mm": hb}
+
+
+def check_against_scene(prof: Profile, scene, where: str = "--profile", options: dict | None = None) -> None:
+    """Check the profile's sizes against the scene's geometry before any mesh is built.
+
+    ``options`` maps a field to the command-line option that set it (``{"clearance":
+    "--clearance"}``): an error names that option, else ``where``.  Refused (:class:`MlcError`
+    naming the value, and the smallest ``sigma_mm`` at which the rest of the profile fits):
+
+    * ``sigma_mm`` above :data:`MAX_SIGMA_MM`, ``circular_segments`` above :data:`MAX_SEGMENTS`;
+    * a minimum feature or pin wider than the narrowest slab (its width in mm is ``sigma_mm``
+      times its width in sigma), or a slab thickness, wall, clearance or knuckle gap of more than
+      half of it: the parts would not fit between each other (a 2 mm slab on the 2.5 mm slabs of
+      NAND at sigma 5 mm ran for more than 30 s; 1.2 mm took 6 s);
+    * hinges wider across (pin + 2 clearance + 2 walls) than the narrowest slab: the knuckles of
+      neighbouring hinges would overlap, and the trimming that follows runs for minutes (NAND at
+      sigma 4 mm: more than 30 s and 0.8 GB; at 5 mm, 2.2 mm hinges on 2.5 mm slabs: 4 s);
+    * an estimated peak memory (:func:`estimate_memory`) above :data:`MEMORY_BUDGET`.
+    """
+    options = options or {}
+
+    def opt(f):
+        return options.get(f, where)
+
+    s = prof.sigma_mm
+    if s > MAX_SIGMA_MM:
+        raise MlcError(f"sigma_mm {s:g} mm is larger than {MAX_SIGMA_MM:g} mm (a gate would be "
+                       f"{3.6 * s / 1000:.3g} m across)", opt("sigma_mm"),
+                       "printers build parts up to about 1 m; use a smaller sigma_mm")
+    if prof.circular_segments > MAX_SEGMENTS:
+        raise MlcError(f"circular_segments {prof.circular_segments} is more than {MAX_SEGMENTS}",
+                       opt("circular_segments"),
+                       f"{MAX_SEGMENTS} segments already keep a 10 mm circle within 0.001 mm; use 32 to {MAX_SEGMENTS}")
+    w_sigma, _ = _widths(scene)
+    if w_sigma <= 0:
+        return
+    W = w_sigma * s
+    at = f"the narrowest slab of {scene.name} is {W:.3g} mm wide ({w_sigma:.3g} sigma at sigma_mm {s:g})"
+    pin = max(prof.pin_diameter, prof.min_feature)
+    hinge = pin + 2 * prof.clearance + 2 * prof.min_wall
+    limits = [(f, part, getattr(prof, f), f"{f} {getattr(prof, f):g} mm is {what}")
+              for f, part, what in (("min_feature", 1.0, "wider than the slabs"),
+                                    ("pin_diameter", 1.0, "wider than the slabs"),
+                                    ("slab_thickness", 0.5, "more than half the slab width"),
+                                    ("min_wall", 0.5, "more than half the slab width"),
+                                    ("clearance", 0.5, "more than half the slab width"),
+                                    ("knuckle_gap", 0.5, "more than half the slab width"))]
+    limits.append(("hinge", 1.0, hinge, f"hinges {hinge:.3g} mm across (pin {pin:g} + 2 x clearance "
+                   f"{prof.clearance:g} + 2 x min_wall {prof.min_wall:g}) are wider than the slabs they join"))
+    s_min = max(v / (part * w_sigma) for _f, part, v, _m in limits)
+    for f, part, v, msg in limits:
+        if v > part * W * (1 + 1e-9):
+            if f == "hinge" or (f not in options and "sigma_mm" in options):
+                fix = f"use sigma_mm >= {s_min:.3g}" + (", or a smaller pin, clearance or min_wall" if f == "hinge" else "")
+                f = f if f in options else "sigma_mm"
+            else:
+                fix = f"use {f} <= {part * W:.3g} mm, or sigma_mm >= {s_min:.3g}"
+            raise MlcError(f"{msg}: {at}", opt(f), fix)
+    est = estimate_memory(prof, scene)
+    if est["bytes"] > MEMORY_BUDGET:
+        raise MlcError(f"this export would need about {est['bytes'] / 2 ** 30:.3g} GiB of memory "
+                       f"({est['samples']:.3g} slab samples {est['sample_step_mm']:.2g} mm apart, "
+                       f"{est['columns']:.3g} support columns {est['column_step_mm']:.2g} mm apart); "
+                       f"the limit is {MEMORY_BUDGET / 2 ** 30:.3g} GiB", opt("sigma_mm"),
+                       "use a smaller sigma_mm")

@@ -30,12 +30,9 @@ def parse_scene(text: str, filename: str = "<scene>") -> Scene:
 
 
 def load_scene(path) -> Scene:
-    try:
-        with open(path, encoding="utf-8") as f:
-            text = f.read()
-    except OSError as e:
-        raise MlcError(f"cannot read scene: {e.strerror}", str(path)) from None
-    return parse_scene(text, str(path))
+    """Read and check a scene file; a missing, unreadable, non-UTF-8, oversized or hostile file
+    (alias bomb, deep nesting, huge integers) is one :class:`MlcError` at ``file[:line:col]``."""
+    return parse_scene(yamlsrc.read_text(path, "scene"), str(path))
 
 
 def scene_from_data(data, filename: str = "<scene>") -> Scene:
