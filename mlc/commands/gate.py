@@ -96,8 +96,18 @@ def run_check(args) -> int:
             raise MlcError(f"need at least one seed, got {args.seeds}", "--seeds")
         if not args.kT >= 0:
             raise MlcError(f"kT must be >= 0, got {args.kT}", "--kT")
+        from mlc.io.progress import Progress
+        from mlc.io.warmup import notice
         from mlc.sim.dynamic import check_gates_dynamic
-        rows = check_gates_dynamic(names, signals, kT=args.kT, seeds=args.seeds, quiet=args.json)
+        if not args.json:
+            notice("stiff")
+        # one gate and convention at a time, so the bar has an ETA; the rows are printed once, below
+        pairs = [(n, s) for n in names for s in signals]
+        rows = []
+        with Progress("mlc check-gate --dynamic", total=len(pairs)) as bar:
+            for k, (n, s) in enumerate(pairs):
+                rows += check_gates_dynamic([n], [s], kT=args.kT, seeds=args.seeds, quiet=True)
+                bar.update(k + 1)
         mode = "dynamic"
     else:
         from mlc.errors import MlcError
@@ -132,10 +142,13 @@ def run_check(args) -> int:
         print(json.dumps(out))
     else:
         cl = " clearance" if clear else ""
-        print(f"{'gate':8s} {'signal':8s} state exp  measured  margin    stretch{cl}   ok")
+        rx = "  relax (t0)" if mode == "dynamic" else ""
+        print(f"{'gate':8s} {'signal':8s} state exp  measured  margin    stretch{cl}{rx}   ok")
         for r in rows:
             st = r.get("joint_stretch")
             c = f"  {r['clearance']:+8.4f}" if "clearance" in r else ""
+            if mode == "dynamic":
+                c += f"  {'not relaxed' if r.get('relax_time') is None else format(r['relax_time'], '.2f'):>10s}"
             print(f"{r['gate']:8s} {r['signal']:8s} {r['state']:5s}  {r['expected']}  {r['measured']:8.5f}  "
                   f"{r['margin']:+.4f}  {'-' if st is None else format(st, '.1e'):>8s}{c}  {'ok' if r['ok'] else 'WRONG'}")
         bad = sum(not r["ok"] for r in rows)

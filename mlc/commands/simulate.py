@@ -94,6 +94,9 @@ def run(args) -> int:
                      threads=args.threads, disp_acc=args.drift_tol, fluct=args.fluct)
     with outs:          # every output location checked before the run; all written, or none
         sim = Simulation(scene, drives, opt)
+        if not (args.quiet or args.json):
+            from mlc.io.warmup import notice
+            notice(args.scheme, sim.parallel)
         res = sim.run(args.time, record_interval=args.record, frames=args.frames if args.out else 0,
                       quiet=args.quiet or args.json)
         if gsd:

@@ -213,6 +213,31 @@ def load(text, filename: str = "<input>"):
             loader.dispose()
 
 
+def load_json(text, filename: str = "<input>"):
+    """Parse JSON ``text`` with the same limits as YAML: one :class:`MlcError` for a syntax error
+    (``file:line:col``), nesting deeper than the interpreter can follow, or an integer too large."""
+    import json
+
+    if isinstance(text, (bytes, bytearray)):
+        text = decode(bytes(text), filename)
+
+    def parse_int(v: str) -> int:
+        digits = sum(c.isdigit() for c in v)
+        if digits > 400:
+            raise MlcError(f"integer with {digits} digits is too large", Loc(filename), "numbers must be below 1.8e308")
+        n = int(v)
+        if abs(n) >= _MAX_INT:
+            raise MlcError(f"integer {v[:20]}... is too large", Loc(filename), "numbers must be below 1.8e308")
+        return n
+
+    try:
+        return json.loads(text, parse_int=parse_int)
+    except json.JSONDecodeError as e:
+        raise MlcError(f"JSON syntax error: {e.msg}", Loc(filename, e.lineno, e.colno)) from None
+    except RecursionError:
+        raise MlcError("lists and mappings nested too deep", Loc(filename), "flatten the data") from None
+
+
 def load_file(path, what: str = "file") -> object:
     """Read and parse a YAML file; a missing, unreadable or non-UTF-8 file is an :class:`MlcError`."""
     return load(read_text(path, what), str(path))

@@ -24,7 +24,6 @@ A profile is a built-in name or a YAML/JSON file validated against
 """
 from __future__ import annotations
 
-import json
 from dataclasses import asdict, dataclass, fields, replace
 from pathlib import Path
 
@@ -135,10 +134,7 @@ def profile_from_file(path) -> Profile:
     path = Path(path)
     text = yamlsrc.read_text(path, "profile")
     if path.suffix.lower() == ".json":
-        try:
-            data = json.loads(text)
-        except json.JSONDecodeError as e:
-            raise MlcError(f"profile is not valid JSON: {e.msg}", f"{path}:{e.lineno}") from None
+        data = yamlsrc.load_json(text, str(path))
     else:
         data = yamlsrc.load(text, str(path))
     if not isinstance(data, dict):
