@@ -501,3 +501,205 @@ def test_progress_bar_and_timer():
     with Progress("quiet", total=2, delay=0.0, stream=s) as bar:
         bar.update(2)
     assert s.getvalue() == ""
+
+
+# ---------------------------------------------------------------------------------------
+# stl, simulate, gate -o: every output checked before the work, all or nothing
+# ---------------------------------------------------------------------------------------
+
+@pytest.fixture
+def hinge_scene(tmp_path):
+    from mlc.mesh import examples as ex
+    from mlc.scene.io import write_scene
+    p = tmp_path / "in" / "hinge.yaml"
+    p.parent.mkdir()
+    write_scene(ex.hinge_pair(), p)
+    return p
+
+
+STL_BAD_OUTPUTS = [
+    # each fails before any mesh is built (a second at most): argv, words
+    (["--parts", "/proc/mlc-parts"], ["--parts", "cannot write in /proc"]),
+    (["-o", "{d}/x.stl", "--3mf", "{d}/x.3mf", "--parts", "{d}/f.txt"], ["--parts", "exists and is not a directory"]),
+    (["-o", "{d}"], ["-o", "is a directory"]),
+    (["-o", "{d}/x.3mf"], ["-o", "must end in .stl"]),
+    (["--3mf", "{d}/x.stl"], ["--3mf", "must end in .3mf"]),
+    (["-o", "{d}/x.stl", "--report", "{d}/x.stl"], ["--report", "must end in .json"]),
+    (["--report", "{d}/no/r.json"], ["--report", "does not exist"]),
+    (["-o", "{d}/x.stl", "--3mf", "{d}/f.txt/x.3mf"], ["--3mf", "not a directory"]),
+]
+
+
+@pytest.mark.parametrize("k", range(len(STL_BAD_OUTPUTS)))
+def test_stl_outputs_checked_before_the_work(k, hinge_scene, tmp_path, capsys):
+    argv, words = STL_BAD_OUTPUTS[k]
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "f.txt").write_text("keep")
+    before = listing(out)
+    code, stdout, err = run(capsys, "stl", hinge_scene, *[a.format(d=out) for a in argv])
+    assert_clean_failure(code, err, before, out, *words)
+    assert stdout == ""                        # refused before the report was computed
+
+
+def test_stl_all_or_nothing(hinge_scene, tmp_path, capsys):
+    """A failing check writes nothing (not even --report); --force writes every file, once."""
+    out = tmp_path / "out"
+    out.mkdir()
+    argv = ["stl", hinge_scene, "--no-states", "-o", out / "x.stl", "--3mf", out / "x.3mf",
+            "--parts", out / "P", "--report", out / "r.json"]
+    code, stdout, err = run(capsys, *argv)
+    assert_clean_failure(code, err, {}, out, "printability checks failed: states", "nothing written")
+    assert "FAIL" in stdout                    # the report explains the failure
+    code, stdout, err = run(capsys, *argv, "--force")
+    assert code == 0 and "written anyway (--force)" in err, err
+    files = sorted(listing(out))
+    assert files == ["P/A.stl", "P/B.stl", "r.json", "x.3mf", "x.stl"], files
+    assert json.loads((out / "r.json").read_text())["outputs"] == [str(out / f) for f in
+                                                                   ("x.stl", "x.3mf", "P/A.stl", "P/B.stl")]
+    assert stdout.count("wrote ") == 5
+
+
+@pytest.mark.parametrize("argv,option,words", [
+    # issue 14's runaway parameters: each refused at once, naming the option, the geometry and a fix
+    (["--clearance", "1e9"], "--clearance", ["more than half the slab width", "use clearance <="]),
+    (["--sigma-mm", "1e6"], "--sigma-mm", ["larger than 1000 mm"]),
+    (["--slab-thickness", "100"], "--slab-thickness", ["more than half the slab width"]),
+    (["--sigma-mm", "1e-6"], "--sigma-mm", ["wider than the slabs", "use sigma_mm >= 4.4"]),
+    (["--sigma-mm", "4"], "--sigma-mm", ["hinges 2.2 mm across", "use sigma_mm >= 4.4"]),
+    (["--pin-diameter", "50"], "--pin-diameter", ["wider than the slabs"]),
+    (["--segments", "100000"], "--segments", ["more than 256"]),
+    (["--knuckle-gap", "2"], "--knuckle-gap", ["more than half"]),
+    (["--min-wall", "inf"], "--profile", ["min_wall must be a positive number"]),
+    (["--clearance", "nan"], "--profile", ["clearance must be a number >= 0"]),
+    (["--segments", "-5"], "--profile", ["circular_segments must be an integer >= 8"]),
+])
+def test_stl_parameters_against_the_geometry(argv, option, words, tmp_path, capsys):
+    before = listing(tmp_path)
+    code, stdout, err = run(capsys, "stl", "NAND", *argv, "-o", tmp_path / "x.stl")
+    assert_clean_failure(code, err, before, tmp_path, f"mlc: error: {option}: ", *words)
+
+
+def test_stl_memory_estimate_refuses_with_the_estimate(monkeypatch):
+    from mlc.gates.library import gate_scene
+    from mlc.mesh import profiles
+    sc = gate_scene("NAND", "expand")
+    small = profiles.estimate_memory(profiles.PROFILES["mjp"], sc)
+    big = profiles.estimate_memory(profiles.load_profile("mjp", {"sigma_mm": 1000}), sc)
+    assert small["bytes"] < 0.5 * 2 ** 30 < 2 ** 31 < big["bytes"]     # grows with the size in mm
+    with pytest.raises(MlcError, match=r"--sigma-mm: this export would need about [0-9.]+ GiB"):
+        profiles.check_against_scene(profiles.load_profile("mjp", {"sigma_mm": 1000}), sc,
+                                     options={"sigma_mm": "--sigma-mm"})
+    for name in profiles.PROFILES:                  # the built-in profiles fit the library gates
+        profiles.check_against_scene(profiles.PROFILES[name], sc)
+
+
+def test_simulate_outputs_checked_before_the_run(scene_text, tmp_path, capsys):
+    d = tmp_path
+    src = d / "s.yaml"
+    src.write_text(scene_text)
+    (d / "s.gsd").write_text(scene_text)
+    before = listing(d)
+    for argv, words in [
+        (["--out", d / "t.gsd", "--probes", d / "no" / "p.csv"], ["--probes", "does not exist"]),
+        (["--out", d / "t.gsd", "--probes", "/proc/p.csv"], ["--probes", "cannot write in /proc"]),
+        (["--out", d / "same.gsd", "--probes", d / "same.gsd"], ["--probes", "must end in .csv"]),
+        (["--out", d / "t.gsd", "--probes", d / "p.npz"], ["--probes", "must end in .csv"]),
+        (["--out", d / "s.yaml"], ["--out", "must end in .gsd"]),
+        (["--out", d], ["--out", "is a directory"]),
+        (["--out", d / "t.gsd", "--probes", d / "s.gsd" / "p.csv"], ["--probes", "not a directory"]),
+    ]:
+        code, _, err = run(capsys, "simulate", src, "--time", "1", *argv)
+        assert_clean_failure(code, err, before, d, *words)
+    # a scene file named like a trajectory cannot be overwritten by its own run
+    code, _, err = run(capsys, "simulate", d / "s.gsd", "--time", "1", "--out", d / "s.gsd")
+    assert_clean_failure(code, err, before, d, "--out", "is an input")
+
+
+def test_simulate_writes_all_outputs(scene_text, tmp_path, capsys):
+    src = tmp_path / "s.yaml"
+    src.write_text(scene_text)
+    code, out, err = run(capsys, "simulate", src, "--time", "0.2", "--out", tmp_path / "t.gsd",
+                         "--probes", tmp_path / "p.csv", "--quiet", "--frames", "3")
+    assert code == 0, err
+    assert sorted(listing(tmp_path)) == ["p.csv", "p.npz", "s.yaml", "t.gsd"]
+    assert (tmp_path / "p.csv").read_text().startswith("time_t0,out\n")
+
+
+def test_gate_output(tmp_path, capsys):
+    (tmp_path / "f.txt").write_text("keep")
+    before = listing(tmp_path)
+    for path, words in [("/proc/g.yaml", ["cannot write in /proc"]), (tmp_path, ["is a directory"]),
+                        (tmp_path / "g.txt", ["must end in .yaml or .yml"]),
+                        (tmp_path / "f.txt" / "g.yaml", ["not a directory"]), ("", ["empty output path"])]:
+        code, _, err = run(capsys, "gate", "NAND", "-o", path)
+        assert_clean_failure(code, err, before, tmp_path, "-o", *words)
+    code, out, _ = run(capsys, "gate", "NAND", "-o", tmp_path / "g.yaml")
+    assert code == 0 and out == f"wrote {tmp_path / 'g.yaml'}\n"
+    assert (tmp_path / "g.yaml").read_text().startswith("# mlc scene")
+
+
+# ---------------------------------------------------------------------------------------
+# profile files: the same limits as scene files
+# ---------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("name,data,words", [
+    ("big.json", b'{"base": "mjp", "clearance": ' + b"7" * 5000 + b"}", ["5000 digits"]),
+    ("deep.json", b"[" * 100000 + b"]" * 100000, ["nested too deep"]),
+    ("comma.json", b'{"clearance": 0.3,}', ["comma.json:1:19:", "JSON syntax error"]),
+    ("nan.json", b'{"clearance": NaN}', ["finite number"]),
+    ("latin1.yaml", b"base: mjp\nname: caf\xe9\n", ["latin1.yaml:2:10:", "0xe9", "UTF-8"]),
+    ("bomb.yaml", _bomb().replace("meta:", "description:").encode(), ["alias", "1,000,000"]),
+    ("huge.yaml", b"clearance: " + b"9" * 400 + b"\n", ["too large"]),
+    ("list.yaml", b"- 1\n", ["must be a mapping"]),
+])
+def test_hostile_profile_files(name, data, words, tmp_path, capsys):
+    src = tmp_path / name
+    src.write_bytes(data)
+    before = listing(tmp_path)
+    code, _, err = run(capsys, "stl", "NAND", "--profile", src, "-o", tmp_path / "x.stl")
+    assert_clean_failure(code, err, before, tmp_path, str(src), *words)
+
+
+def test_scene_file_that_is_a_directory_or_missing(tmp_path, capsys):
+    for path, words in [(tmp_path, ["is a directory"]), (tmp_path / "none.yaml", ["No such file"])]:
+        code, _, err = run(capsys, "simulate", path, "--time", "1")
+        assert_clean_failure(code, err, listing(tmp_path), tmp_path, "cannot read scene", *words)
+
+
+# ---------------------------------------------------------------------------------------
+# what a newcomer sees: progress with an ETA, one table, a word before kernels compile
+# ---------------------------------------------------------------------------------------
+
+def test_design_space_reports_progress(monkeypatch):
+    from mlc.geometry import core
+    calls = []
+    monkeypatch.setattr(core, "accessible_din_range", lambda h: (0.1, 0.5) if h < 3.5 else None)
+    monkeypatch.setattr(core, "_solve", lambda din, h: type("S", (), {"dout": 0.1})())
+    space = core.design_space(progress=lambda done, total: calls.append((done, total)))
+    done = [c[0] for c in calls]
+    assert done == sorted(done) and len(calls) > 29 and calls[-1][0] == calls[-1][1] == calls[0][1]
+    assert len(space["curves"]) == 5 and space["boundary"]
+
+
+def test_check_gate_dynamic_prints_each_row_once(capsys):
+    code, out, err = run(capsys, "check-gate", "NAND", "--signal", "expand", "--dynamic", "--seeds", "1")
+    assert code == 0 and err == "", err
+    lines = out.splitlines()
+    assert len(lines) == 6 and "relax (t0)" in lines[0] and lines[-1].startswith("dynamic check: 4 of 4")
+
+
+def test_kernel_compile_notice_once(monkeypatch):
+    import io
+    from mlc.io import warmup
+    assert warmup.kernels_cached("stiff") in (True, False, None)
+    monkeypatch.setattr(warmup, "_said", False)
+    monkeypatch.setattr(warmup, "kernels_cached", lambda scheme="stiff", parallel=False: False)
+    s = io.StringIO()
+    assert warmup.notice(stream=s, show=True) and not warmup.notice(stream=s, show=True)
+    assert s.getvalue().count("\n") == 1 and "compiling the simulation kernels" in s.getvalue()
+    s = io.StringIO()
+    monkeypatch.setattr(warmup, "_said", False)
+    assert not warmup.notice(stream=s) and s.getvalue() == ""          # not a terminal: silent
+    monkeypatch.setattr(warmup, "kernels_cached", lambda scheme="stiff", parallel=False: True)
+    assert not warmup.notice(stream=s, show=True)                       # cached: nothing to say
