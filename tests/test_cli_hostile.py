@@ -703,3 +703,71 @@ def test_kernel_compile_notice_once(monkeypatch):
     assert not warmup.notice(stream=s) and s.getvalue() == ""          # not a terminal: silent
     monkeypatch.setattr(warmup, "kernels_cached", lambda scheme="stiff", parallel=False: True)
     assert not warmup.notice(stream=s, show=True)                       # cached: nothing to say
+
+
+# ---------------------------------------------------------------------------------------
+# found by the hostile sweep: runaway parameters, leftovers of abandoned or killed runs
+# ---------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("argv,words", [
+    (["simulate", "{scene}", "--time", "1e308"], ["--time", "inf steps"]),
+    (["simulate", "{scene}", "--time", "1", "--drift-tol", "inf"], ["--drift-tol", "positive number of sigma"]),
+    (["simulate", "{scene}", "--time", "1", "--threads", "100000"], ["--threads", "cores of this machine"]),
+    (["check-gate", "NAND", "--grid", "100000"], ["--grid", "2e+10 poses", "days"]),
+    (["check-gate", "NAND", "--dynamic", "--seeds", "1000000000"], ["--seeds", "days", "at most 1000"]),
+    (["check-gate", "NAND", "--branches", "--kT", "inf"], ["--kT", "finite kT > 0"]),
+    (["stl", "NAND", "--min-wall", "1e-9"], ["min_wall 1e-09 mm is below 0.01 mm"]),
+    (["core", "--data", "/dev/full"], ["--data", "/dev/full"]),
+    (["gate", "NAND", "-o", "/dev/full"], ["-o", "/dev/full"]),
+])
+def test_refused_at_once(argv, words, scene_text, tmp_path, capsys):
+    src = tmp_path / "s.yaml"
+    src.write_text(scene_text)
+    before = listing(tmp_path)
+    code, _, err = run(capsys, *[a.format(scene=src) for a in argv])
+    assert_clean_failure(code, err, before, tmp_path, *words)
+
+
+def test_abandoned_outputs_leave_no_staging(tmp_path):
+    """A command that checks its outputs, then fails outside the ``with`` block (mlc compile's
+    pattern), leaves no staging directory: removed when collected, or at exit."""
+    import gc
+    from mlc.io import outputs
+    outs = Outputs()
+    outs.file(tmp_path / "a.png", "--a")
+    outs.check()
+    assert [p.name[:13] for p in tmp_path.iterdir()] == [".mlc-staging-"]
+    del outs
+    gc.collect()
+    assert list(tmp_path.iterdir()) == []
+    keep = Outputs()
+    keep.file(tmp_path / "b.png", "--b")
+    keep.check()
+    outputs._discard_all()                     # what atexit runs
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_sigterm_leaves_nothing(tmp_path):
+    """`timeout` or `kill` during an export: handled like Ctrl-C, no staging directory left."""
+    import signal
+    import time as _time
+    code = ("import sys; from mlc.cli import main; "
+            f"sys.exit(main(['stl', 'NAND', '--min-wall', '0.01', '-o', {str(tmp_path / 'x.stl')!r}]))")
+    p = subprocess.Popen([sys.executable, "-P", "-c", code], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                         text=True)
+    deadline = _time.time() + 60
+    while not any(tmp_path.iterdir()) and _time.time() < deadline:     # wait for the staging area
+        _time.sleep(0.05)
+    p.send_signal(signal.SIGTERM)
+    err = p.communicate(timeout=60)[1]
+    assert p.returncode == 130 and "mlc: interrupted" in err, err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_stl_time_estimate():
+    from mlc.gates.library import gate_scene
+    from mlc.mesh.profiles import PROFILES, estimate_seconds, load_profile
+    sc = gate_scene("NAND", "expand")
+    t = estimate_seconds(PROFILES["mjp"], sc)
+    fine = estimate_seconds(load_profile("mjp", {"min_wall": 0.01, "slab_thickness": 0.01}), sc)
+    assert 2 < t < 10 and 15 < fine < 40           # measured: about 5 s and 22 s

@@ -56,6 +56,20 @@ def _selection(args):
 
 
 RISK_KT = 20.0     # a fold barrier below this many kT is reported as a risk
+MAX_GRID = 100          # overlap sweep points per input (10^4 poses per gate and convention)
+SECONDS_PER_POSE = 0.05  # one pose of the overlap sweep (NAND, --grid 10: 100 poses in 5 s)
+MAX_SEEDS = 1000        # --dynamic seeds per state
+SECONDS_PER_RUN = 0.1   # one seed of one state by Brownian dynamics (NAND, 8 seeds: 2 s)
+
+
+def _duration(sec: float) -> str:
+    if sec < 120:
+        return f"{sec:.0f} s"
+    if sec < 7200:
+        return f"{sec / 60:.0f} min"
+    if sec < 2 * 86400:
+        return f"{sec / 3600:.1f} h"
+    return f"{sec / 86400:.3g} days"
 
 
 def _branch_risk(scene, name, signal, kT) -> dict:
@@ -87,13 +101,18 @@ def run_check(args) -> int:
     if args.branches and args.dynamic:
         from mlc.errors import MlcError
         raise MlcError("--branches is part of the static check", "--branches", "drop --dynamic")
-    if args.branches and not args.kT > 0:
+    if args.branches and not (args.kT > 0 and args.kT != float("inf")):
         from mlc.errors import MlcError
-        raise MlcError(f"the branch risk needs kT > 0, got {args.kT}", "--kT")
+        raise MlcError(f"the branch risk needs a finite kT > 0, got {args.kT}", "--kT", "e.g. --kT 1e-5")
     if args.dynamic:
         from mlc.errors import MlcError
         if args.seeds < 1:
             raise MlcError(f"need at least one seed, got {args.seeds}", "--seeds")
+        if args.seeds > MAX_SEEDS:
+            est = args.seeds * 4 * len(names) * len(signals) * SECONDS_PER_RUN
+            raise MlcError(f"{args.seeds} seeds would take about {_duration(est)} "
+                           f"({SECONDS_PER_RUN:g} s per seed and state)", "--seeds",
+                           f"use at most {MAX_SEEDS} seeds")
         if not args.kT >= 0:
             raise MlcError(f"kT must be >= 0, got {args.kT}", "--kT")
         from mlc.io.progress import Progress
@@ -113,12 +132,20 @@ def run_check(args) -> int:
         from mlc.errors import MlcError
         if args.grid < 2:
             raise MlcError(f"the overlap sweep needs at least 2 points per input, got {args.grid}", "--grid")
+        if args.grid > MAX_GRID:
+            poses = float(args.grid) ** 2 * len(names) * len(signals)
+            raise MlcError(f"--grid {args.grid} is {poses:.3g} poses (every library gate has 2 inputs), about "
+                           f"{_duration(poses * SECONDS_PER_POSE)} at {SECONDS_PER_POSE:g} s a pose", "--grid",
+                           f"use at most {MAX_GRID} (3: the states and the half-way poses)")
         from mlc.gates.library import gate_scene
         from mlc.verify.overlap import sweep_clearance
         from mlc.verify.static import verify_scene
+        from mlc.io.progress import Progress
         rows = []
+        bar = Progress("mlc check-gate", total=len(names) * len(signals)).__enter__()
         for name in names:
             for signal in signals:
+                bar.update(len(clear))
                 scene = gate_scene(name, signal)
                 worst, frac, poses = sweep_clearance(scene, grid=args.grid)
                 at_state = {"".join(str(int(v)) for v in f): rep for f, rep in poses if all(v in (0.0, 1.0) for v in f)}
@@ -131,6 +158,7 @@ def run_check(args) -> int:
                 clear.append({"gate": name, "signal": signal, "min_clearance": worst.min_clearance,
                               "pair": list(worst.pair), "strokes": list(frac), "poses": len(poses),
                               "overlaps": [[a, b, d] for a, b, d in worst.overlaps], "ok": worst.ok()})
+        bar.close()
         mode = "static"
     ok = all(r["ok"] for r in rows) and all(c["ok"] for c in clear)
     if args.json:

@@ -70,8 +70,9 @@ def run(args) -> int:
     drives = parse_sets(args.set, scene)
     if args.frames < 1:
         raise MlcError("--frames must be >= 1", "--frames")
-    if not args.drift_tol > 0:
-        raise MlcError(f"--drift-tol must be > 0, got {args.drift_tol}", "--drift-tol")
+    if not (math.isfinite(args.drift_tol) and args.drift_tol > 0):
+        raise MlcError(f"--drift-tol must be a positive number of sigma, got {args.drift_tol}", "--drift-tol",
+                       "the default 0.01 keeps probe errors near 0.001 sigma")
     if not (math.isfinite(args.time) and args.time > 0):
         raise MlcError(f"--time must be a positive number of t0, got {args.time}", "--time")
     if args.dt is not None and not (math.isfinite(args.dt) and 0 < args.dt <= args.time):
@@ -81,6 +82,11 @@ def run(args) -> int:
         raise MlcError(f"--record must be a positive number of t0, got {args.record}", "--record")
     if args.threads < 1:
         raise MlcError(f"--threads must be >= 1, got {args.threads}", "--threads")
+    import os
+    cores = os.cpu_count() or 1
+    if args.threads > max(cores, 1):
+        raise MlcError(f"--threads {args.threads} is more than the {cores} cores of this machine", "--threads",
+                       f"use at most {cores}")
     if args.fluct and args.scheme != "stiff":
         raise MlcError("--fluct is a mode of the stiff scheme", "--fluct", "drop --scheme euler")
     from mlc.io.outputs import Outputs
@@ -94,6 +100,10 @@ def run(args) -> int:
                      threads=args.threads, disp_acc=args.drift_tol, fluct=args.fluct)
     with outs:          # every output location checked before the run; all written, or none
         sim = Simulation(scene, drives, opt)
+        steps = args.time / sim.dt
+        if not (math.isfinite(steps) and steps <= sim.opt.max_steps):
+            raise MlcError(f"--time {args.time:g} at a step of {sim.dt:g} t0 is {steps:.3g} steps (more than "
+                           f"{sim.opt.max_steps:.3g})", "--time", "use a shorter --time or a larger --dt")
         if not (args.quiet or args.json):
             from mlc.io.warmup import notice
             notice(args.scheme, sim.parallel)

@@ -79,7 +79,9 @@ def run(args) -> int:
     rep_out = outs.file(args.report, "--report", suffixes=(".json",))
     with outs:              # every output location checked before the meshes are built; all or none
         # a library gate takes about 5 s; a circuit of many gates minutes (quiet when not a terminal)
-        with Progress(f"mlc stl: building and checking the parts of {scene.name}"):
+        from mlc.mesh.profiles import estimate_seconds
+        with Progress(f"mlc stl: building and checking the parts of {scene.name}",
+                      expect=estimate_seconds(prof, scene)):
             asm, report = export_assembly(scene, prof, solve=not args.no_states)
         report.outputs = []
         if report.ok or args.force:

@@ -28,23 +28,50 @@ nothing is written.  Checks made by :meth:`Outputs.check` (also run by ``with``)
 * the file system has free space.
 
 Special files (``/dev/null``, ``/dev/stdout``, a FIFO) are written directly, first, at
-commit time, so ``/dev/full`` fails before any regular file is moved into place.  If a
+commit time (``/dev/full`` itself is refused by the check).  A staging area left by a command
+that called :meth:`Outputs.check` and then failed outside the ``with`` block is removed when the
+object is collected or at exit; SIGTERM while outputs are staged is handled like Ctrl-C.  If a
 move fails half way, the files already moved are put back as they were.  An output that
 is a symbolic link is replaced by the new file (the link's target is left alone), as
 with any write-then-rename.
 """
 from __future__ import annotations
 
+import atexit
 import errno
 import os
 import shutil
+import signal
 import stat
 import tempfile
+import threading
+import weakref
 from pathlib import Path
 
 from mlc.errors import InternalError, MlcError
 
 _STAGING_PREFIX = ".mlc-staging-"
+#: Outputs with a staging area on disk; removed at exit if a command never committed or discarded
+_LIVE: "weakref.WeakSet[Outputs]" = weakref.WeakSet()
+
+
+@atexit.register
+def _discard_all() -> None:
+    for outs in list(_LIVE):
+        outs.discard()
+
+
+class Terminated(KeyboardInterrupt):
+    """SIGTERM (``timeout``, ``kill``) while outputs are staged: handled like Ctrl-C, so the
+    staging area is removed and nothing is written."""
+
+
+def _on_sigterm(signum, frame):
+    raise Terminated()
+
+
+#: /dev/full: a character device that takes no data (found by its device number, Linux 1:7)
+_DEV_FULL = os.makedev(1, 7) if hasattr(os, "makedev") else None
 
 
 def _why(e: OSError) -> str:
@@ -134,6 +161,7 @@ class Outputs:
         self._staging: dict[str, Path] = {}     # staging root key -> staging directory
         self._checked = False
         self._done = False
+        self._old_sigterm = None
 
     # -- declaring ---------------------------------------------------------------------
     def file(self, path, option: str, suffixes=None, parents: bool = False) -> OutputFile | None:
@@ -221,6 +249,8 @@ class Outputs:
         if out.special:
             if not os.access(p, os.W_OK):
                 raise out.error("special file is not writable", "choose another location")
+            if stat.S_ISCHR(st.st_mode) and _DEV_FULL is not None and st.st_rdev == _DEV_FULL:
+                raise out.error("cannot write: No space left on device (it is /dev/full)", "choose another location")
             return
         if out.suffixes and p.suffix.lower() not in out.suffixes:
             raise out.error(f"the file name must end in {' or '.join(out.suffixes)}",
@@ -246,7 +276,31 @@ class Outputs:
                 self._staging[key] = Path(tempfile.mkdtemp(prefix=_STAGING_PREFIX, dir=root))
             except OSError as e:
                 raise out.error(f"cannot write in {root}: {_why(e)}", _fix_for(e)) from None
+            _LIVE.add(self)
+            self._catch_sigterm()
         return self._staging[key]
+
+    def _catch_sigterm(self) -> None:
+        """While outputs are staged, SIGTERM raises :class:`Terminated` (so they are removed)."""
+        if self._old_sigterm is not None or threading.current_thread() is not threading.main_thread():
+            return
+        try:
+            if signal.getsignal(signal.SIGTERM) is signal.SIG_DFL:
+                signal.signal(signal.SIGTERM, _on_sigterm)
+                self._old_sigterm = signal.SIG_DFL
+        except (ValueError, OSError, AttributeError):
+            pass
+
+    def _release_sigterm(self) -> None:
+        if self._old_sigterm is None:
+            return
+        try:
+            if threading.current_thread() is threading.main_thread() and \
+                    signal.getsignal(signal.SIGTERM) is _on_sigterm:
+                signal.signal(signal.SIGTERM, self._old_sigterm)
+        except (ValueError, OSError, AttributeError):
+            pass
+        self._old_sigterm = None
 
     # -- the context manager -------------------------------------------------------------
     def __enter__(self) -> "Outputs":
@@ -347,3 +401,12 @@ class Outputs:
             shutil.rmtree(d, ignore_errors=True)
         self._staging.clear()
         self._done = True
+        _LIVE.discard(self)
+        self._release_sigterm()
+
+    def __del__(self):          # checked, then abandoned by an exception outside a ``with``
+        try:
+            if self._staging:
+                self.discard()
+        except Exception:
+            pass
