@@ -80,6 +80,6 @@ def _plot(args) -> int:
                 print(f"  units {r['units']:>2}  f {r['frequency']:<5g} {extra if extra else ''} RMS deviation "
                       f"{100 * r['rms_dev_mean']:.1f} ± {100 * r['rms_dev_sd']:.1f} % ({r['seeds']} seeds)")
             else:
-                head = {k: v for k, v in r.items() if k not in ("units", "mean", "var", "var_time", "var_seed_means")}
+                head = {k: v for k, v in r.items() if k not in ("units", "mean", "var", "var_time", "var_seed_means", "sem", "drift")}
                 print(f"  {head}: signal length " + ", ".join(f"{m:.4f}" for m in r["mean"]))
     return 0

@@ -145,7 +145,7 @@ def signal_vs_length(d: Path, png: Path):
     markers = "osD^vP*X"
     summary = []
     for c, (combo, sel) in enumerate(sorted(groups.items(), key=lambda kv: [_num(v) for v in kv[0]])):
-        means, var_tot, var_t, var_s = [], [], [], []
+        means, var_tot, var_t, var_s, drift = [], [], [], [], []
         us = [u for u in units if all(r.get(f"u{u}_mean", "") != "" for r in sel)]
         for u in us:
             m = np.array([float(r[f"u{u}_mean"]) for r in sel])
@@ -154,8 +154,11 @@ def signal_vs_length(d: Path, png: Path):
             var_t.append(float(v.mean()))
             var_s.append(float(m.var()))
             var_tot.append(float(v.mean() + m.var()))     # variance over seeds and time (equal samples per seed)
+            if all(r.get(f"u{u}_drift", "") not in ("", "nan") for r in sel):
+                drift.append(float(np.mean([float(r[f"u{u}_drift"]) for r in sel])))
         ent = {**dict(zip(keys, map(_num, combo))), "seeds": len(sel), "units": us, "mean": means,
-               "var": var_tot, "var_time": var_t, "var_seed_means": var_s}
+               "var": var_tot, "var_time": var_t, "var_seed_means": var_s,
+               "sem": [math.sqrt(v / len(sel)) for v in var_s], "drift": drift}
         summary.append(ent)
         ax.errorbar(us, means, yerr=var_tot, marker=markers[c % len(markers)], ms=4, capsize=2.5, lw=1,
                     label=_label(keys, combo) or "all runs")
@@ -168,6 +171,8 @@ def signal_vs_length(d: Path, png: Path):
     plt.close(fig)
     return {"kind": "signal_vs_length", "failed_runs": nfail,
             "bars": "variance over seeds and time (sigma^2) = mean per-seed time variance + variance of the seed means",
+            "sem": "standard error of the mean over seeds (sigma), from the spread of the seed means",
+            "drift": "mean over seeds of (second half - first half of the measured window) (sigma)",
             "rows": summary}
 
 

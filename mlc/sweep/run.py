@@ -141,8 +141,8 @@ def _client(scheduler: str | None, workers: int):
             raise MlcError(f"cannot reach the Dask scheduler at {scheduler!r}: {' '.join(str(e).split())[:200]}",
                            "--scheduler", "start it (dask scheduler) or give its address as tcp://HOST:PORT") from None
         return client, None
-    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                           silence_logs=logging.ERROR)
+    cluster = LocalCluster(n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=":0",
+                           silence_logs=logging.CRITICAL)
     return Client(cluster), cluster
 
 
