@@ -771,3 +771,26 @@ def test_stl_time_estimate():
     t = estimate_seconds(PROFILES["mjp"], sc)
     fine = estimate_seconds(load_profile("mjp", {"min_wall": 0.01, "slab_thickness": 0.01}), sc)
     assert 2 < t < 10 and 15 < fine < 40           # measured: about 5 s and 22 s
+
+
+def test_probes_to_redirected_stdout(scene_text, tmp_path):
+    """`--probes /dev/stdout > file`: the CSV goes through standard output, in order with the
+    summary (opening /dev/stdout anew would truncate the file), and /dev/stdout stays a link."""
+    src = tmp_path / "s.yaml"
+    src.write_text(scene_text)
+    out = tmp_path / "o.txt"
+    with open(out, "w") as f:
+        r = _mlc(["simulate", str(src), "--time", "0.1", "--record", "0.05", "--probes", "/dev/stdout"], stdout=f)
+    assert r.returncode == 0, r.stderr
+    text = out.read_text()
+    assert text.startswith("time_t0,out\n0,1.5\n") and "NAND_expand: 2 steps" in text, text
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["o.txt", "s.yaml"]          # no .npz anywhere
+    assert not Path("/dev/stdout.npz").exists() and Path("/dev/stdout").is_symlink()
+
+
+def test_scene_name_length_is_bounded(scene_text, tmp_path, capsys):
+    src = tmp_path / "s.yaml"
+    src.write_text(scene_text.replace("name: NAND_expand", "name: " + "x" * 100000, 1))
+    before = listing(tmp_path)
+    code, _, err = run(capsys, "draw", src, "-o", tmp_path / "x.png")        # took minutes to draw
+    assert_clean_failure(code, err, before, tmp_path, f"{src}:", "100000 characters (at most 200)")

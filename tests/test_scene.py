@@ -76,3 +76,40 @@ def test_malformed_scene_reports_file_line(text, line, words):
 def test_same_body_bond_rejected():
     with pytest.raises(MlcError, match="same body"):
         parse_scene(_minimal(bond_sites="[p.x, p.x]"), "t.yaml")
+
+
+def test_load_scene_refuses_hostile_files_with_one_error(tmp_path):
+    """load_scene reads through mlc.io.yamlsrc: non-UTF-8 bytes, alias bombs and directories are
+    one MlcError at the file (and line:col where there is one)."""
+    from mlc.scene.io import load_scene
+    text = dump_scene(gate_scene("NAND", "expand"))
+    cases = {
+        "latin1.yaml": (text.replace("name: NAND_expand", "name: caf\u00e9").encode("latin-1"),
+                        ["latin1.yaml:", "0xe9", "UTF-8"]),
+        "bomb.yaml": (("a: &a [x, x, x, x, x, x, x, x, x, x]\n" + "".join(
+            f"{c}: &{c} [" + ", ".join([f"*{p}"] * 10) + "]\n" for p, c in zip("abcdefg", "bcdefgh"))).encode(),
+            ["alias", "bomb"]),
+    }
+    for name, (data, words) in cases.items():
+        p = tmp_path / name
+        p.write_bytes(data)
+        with pytest.raises(MlcError) as e:
+            load_scene(p)
+        for w in words:
+            assert w in str(e.value), (name, str(e.value))
+    with pytest.raises(MlcError, match="it is a directory"):
+        load_scene(tmp_path)
+
+
+@pytest.mark.parametrize("old,new,words", [
+    ("  k: 1.0", "  k: 2e6", ["must be <= 1e+06", "stiffness in k0/sigma^2"]),
+    ("  actuated: 1.5", "  actuated: 1e308", ["must be <= 1000", "length in sigma"]),
+    ("  k: 1.0", "  k: '3'", ["expected number, got str", "without quotes"]),
+])
+def test_scene_numbers_have_upper_bounds(old, new, words):
+    text = dump_scene(gate_scene("NAND", "expand"))
+    with pytest.raises(MlcError) as e:
+        parse_scene(text.replace(old, new, 1), "s.yaml")
+    assert str(e.value).startswith("s.yaml:")
+    for w in words:
+        assert w in str(e.value), str(e.value)

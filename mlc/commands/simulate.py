@@ -89,12 +89,12 @@ def run(args) -> int:
                        f"use at most {cores}")
     if args.fluct and args.scheme != "stiff":
         raise MlcError("--fluct is a mode of the stiff scheme", "--fluct", "drop --scheme euler")
-    from mlc.io.outputs import Outputs
+    from mlc.io.outputs import Outputs, is_special
     outs = Outputs(inputs=[args.scene])
     gsd = outs.file(args.out, "--out", suffixes=(".gsd",))
     csv = outs.file(args.probes, "--probes", suffixes=(".csv",))
     npz = None
-    if csv is not None and not (csv.path.exists() and not csv.path.is_file()):   # no .npz beside /dev/stdout
+    if csv is not None and not is_special(csv.path):          # no .npz beside /dev/stdout
         npz = outs.file(csv.path.with_suffix(".npz"), "--probes (its .npz)", suffixes=(".npz",))
     opt = SimOptions(dt=args.dt, scheme=args.scheme, kT=args.kT, seed=args.seed, rot_noise=args.rot_noise,
                      threads=args.threads, disp_acc=args.drift_tol, fluct=args.fluct)

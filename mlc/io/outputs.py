@@ -88,6 +88,36 @@ def _fix_for(e: OSError) -> str:
     return "choose another location"
 
 
+def is_special(path) -> bool:
+    """True for an output written in place rather than renamed over: an existing file that is not
+    a regular file (a device, a FIFO), and anything under /dev or /proc (``/dev/stdout`` redirected
+    to a regular file is a link that a rename would replace)."""
+    p = Path(path)
+    try:
+        st = os.stat(p)
+    except OSError:
+        return False
+    return not stat.S_ISREG(st.st_mode) or str(p.absolute()).startswith(("/dev/", "/proc/"))
+
+
+def _std_stream(path):
+    """sys.stdout or sys.stderr if ``path`` is the file behind it (``/dev/stdout``, ``/dev/fd/2``):
+    opening it anew would truncate a redirected file and write over what the command prints."""
+    import sys
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    for stream in (sys.stdout, sys.stderr):
+        try:
+            fst = os.fstat(stream.fileno())
+        except (OSError, ValueError, AttributeError):
+            continue
+        if (fst.st_dev, fst.st_ino) == (st.st_dev, st.st_ino) and hasattr(stream, "buffer"):
+            return stream
+    return None
+
+
 def _existing_ancestor(p: Path) -> Path:
     p = p.absolute()
     while not p.exists() and p != p.parent:
@@ -245,7 +275,7 @@ class Outputs:
             raise out.error(f"cannot use: {_why(e)}", _fix_for(e)) from None
         if st is not None and stat.S_ISDIR(st.st_mode):
             raise out.error("is a directory", f"give a file name, e.g. {p / ('output' + (out.suffixes or ('',))[0])}")
-        out.special = st is not None and not stat.S_ISREG(st.st_mode)
+        out.special = st is not None and is_special(p)
         if out.special:
             if not os.access(p, os.W_OK):
                 raise out.error("special file is not writable", "choose another location")
@@ -344,6 +374,13 @@ class Outputs:
             for out, src, dst in moves:          # devices and FIFOs: no rename, no undo
                 if out.special:
                     try:
+                        std = _std_stream(dst)
+                        if std is not None:          # /dev/stdout: through the stream, in order
+                            std.flush()
+                            with open(src, "rb") as g:
+                                shutil.copyfileobj(g, std.buffer)
+                            std.flush()
+                            continue
                         with open(dst, "wb") as f:
                             with open(src, "rb") as g:
                                 shutil.copyfileobj(g, f)

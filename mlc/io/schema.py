@@ -8,7 +8,7 @@ schemas use, so that every error quotes ``file:line`` of the offending value
 Supported keywords: ``type``, ``properties``, ``required``,
 ``additionalProperties``, ``patternProperties``, ``items``, ``prefixItems``,
 ``minItems``, ``maxItems``, ``enum``, ``const``, ``minimum``, ``maximum``,
-``exclusiveMinimum``, ``exclusiveMaximum``, ``pattern``, ``$ref`` (to
+``exclusiveMinimum``, ``exclusiveMaximum``, ``maxLength``, ``pattern``, ``$ref`` (to
 ``#/$defs/...``), ``oneOf`` and ``anyOf`` (first branch error reported),
 ``description``/``title``/``$schema``/``$id``/``$comment`` (ignored).
 """
@@ -85,6 +85,8 @@ def _check(v, s, root, path, loc):
         raise _Fail(f"must be one of {', '.join(map(repr, s['enum']))}, got {v!r}", loc, path)
     if "const" in s and v != s["const"]:
         raise _Fail(f"must be {s['const']!r}, got {v!r}", loc, path)
+    if isinstance(v, str) and "maxLength" in s and len(v) > s["maxLength"]:
+        raise _Fail(f"a string of {len(v)} characters (at most {s['maxLength']})", loc, path, s.get("description"))
     if isinstance(v, str) and "pattern" in s and not re.search(s["pattern"], v):
         raise _Fail(f"{v!r} does not match the pattern {s['pattern']}", loc, path)
     if isinstance(v, dict):
@@ -114,7 +116,8 @@ def _check(v, s, root, path, loc):
                 _check(item, addl, root, sub, iloc)
     if isinstance(v, list):
         if "minItems" in s and len(v) < s["minItems"]:
-            raise _Fail(f"expected at least {s['minItems']} items, got {len(v)}", loc, path)
+            raise _Fail(f"expected at least {s['minItems']} item{'' if s['minItems'] == 1 else 's'}, got {len(v)}",
+                        loc, path, s.get("description"))
         if "maxItems" in s and len(v) > s["maxItems"]:
             raise _Fail(f"expected at most {s['maxItems']} items, got {len(v)}", loc, path)
         prefix = s.get("prefixItems", [])
