@@ -43,6 +43,9 @@ def register(sub):
     p.add_argument("--stl", metavar="STL", help="printable mesh of the whole circuit (through mlc stl)")
     p.add_argument("--3mf", dest="threemf", metavar="3MF", help="3MF of the circuit with named parts (through mlc stl)")
     p.add_argument("--profile", default="mjp", help="printer profile for --stl/--3mf (mjp, sla, fdm or a file)")
+    p.add_argument("--robot", metavar="ROBOT.yaml",
+                   help="also build the robot body the circuit drives (docs/robot.md): OUTDIR/robot.yaml, one scene; "
+                        "--verify, --stl and --3mf then apply to the robot")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(func=run)
 
@@ -135,7 +138,12 @@ def run(args) -> int:
         raise MlcError(f"need at least one seed, got {args.seeds}", "--seeds")
     if not (args.kT >= 0 and args.kT < float("inf")):
         raise MlcError(f"kT must be finite and >= 0, got {args.kT}", "--kT")
-    outs = Outputs(inputs=[args.input] if args.input else [])
+    if getattr(args, "robot", None):
+        if not want_circuit:
+            raise MlcError("--robot needs the circuit", "--no-circuit", "drop --no-circuit")
+        from mlc.robot.spec import load_robot
+        load_robot(args.robot)                      # the file alone, before the work
+    outs = Outputs(inputs=[args.input, getattr(args, "robot", None)])
     outdir = outs.directory(args.outdir, "-o")
     draw = outs.file(args.draw, "--draw", suffixes=(".png",), parents=True)
     stl = outs.file(args.stl, "--stl", suffixes=(".stl",), parents=True)
@@ -155,6 +163,11 @@ def run(args) -> int:
         files["circuit.yaml"] = dump_scene(scene).encode()
         from mlc.circuit.draw import render_circuit
         files["circuit.png"] = render_circuit(scene)
+        if args.robot:                              # docs/robot.md
+            from mlc.commands.robot import robot_files
+            robot_scene, robot_out = robot_files(scene, args.robot)
+            files.update(robot_out)
+            scene = robot_scene
         if args.verify:
             from mlc.commands.verify import verify_scene_file
             report = verify_scene_file(scene, args.dynamic, args.kT, args.seeds, args.scheme)
@@ -167,9 +180,9 @@ def run(args) -> int:
         if report is not None:
             outdir.write_text("verify.json", json.dumps(report.as_dict(), indent=1))
         if stl is not None or threemf is not None:
-            _mesh(outdir.file("circuit.yaml"), stl, threemf, args.profile)
+            _mesh(outdir.file("robot.yaml" if args.robot else "circuit.yaml"), stl, threemf, args.profile)
         if report is not None and not report.ok:
-            from mlc.verify.circuit import format_report
+            from mlc.robot.verify import format_any as format_report
             sys.stdout.write(format_report(report) + "\n")
             raise MlcError(f"the circuit failed {args.dynamic and 'dynamic' or 'static'} verification "
                            f"(rows {', '.join(r['state'] for r in report.rows if not r['ok'])})",
@@ -184,7 +197,7 @@ def run(args) -> int:
     else:
         print(format_summary(d))
         if report is not None:
-            from mlc.verify.circuit import format_report
+            from mlc.robot.verify import format_any as format_report
             print(format_report(report))
     return 0
 

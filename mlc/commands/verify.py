@@ -29,6 +29,9 @@ def verify_scene_file(scene, dynamic: bool = False, kT: float = 1e-5, seeds: int
     from mlc.io.progress import Progress
     from mlc.verify.circuit import select_rows, verify_dynamic, verify_static
 
+    if isinstance(scene.meta, dict) and scene.meta.get("element") == "robot":     # docs/robot.md
+        from mlc.robot.verify import verify_robot
+        return verify_robot(scene, dynamic, kT, seeds, scheme, rows)
     n = len(select_rows(scene, rows))
     if dynamic:
         return verify_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme)
@@ -47,5 +50,7 @@ def run(args) -> int:
     scene = load_scene(args.scene)
     rep = verify_scene_file(scene, args.dynamic, args.kT, args.seeds, args.scheme, args.rows,
                             args.require_clearance)
+    if isinstance(scene.meta, dict) and scene.meta.get("element") == "robot":
+        from mlc.robot.verify import format_robot_report as format_report
     print(json.dumps(rep.as_dict()) if args.json else format_report(rep))
     return 0 if rep.ok else 1

@@ -1,0 +1,317 @@
+"""A circuit scene plus a robot body (:mod:`mlc.robot.spec`) becomes one robot scene.
+
+**Skeleton** (docs/robot.md, section 2).  A planar chain in a horizontal plane (normal
++z) ``height`` sigma above the circuit's top, heading +x.  Local coordinates: x along
+the chain, y towards the "up" side.  The body (unit 0, cell (0, 0)) is a slab over
+x in [-l/2, l/2]; unit i (l = ``unit_length``, a_i = (i - 1/2) l) is two bodies: a
+joint piece ``skel_j{i}`` over [a_i, a_i + s] (s = ``JOINT_LENGTH``) and a link
+``skel_u{i}`` over [a_i + s, a_i + l].  The up hinge sits at (a_i, +w/2) between the
+previous link and the joint piece; the down hinge at (a_i + s, -w/2) between the joint
+piece and the link.  Both hinges have their axis along +z.
+
+**A DOF** is a hinge with two lever arms of length r, one on each body, at the angle
+theta0 apart when straight.  The distance of the arm tips, 2 r sin(theta/2), is the
+DOF's length: ``dof_rest`` (d0) straight, d0 + ``dof_stroke`` (d1) turned by 90 degrees.
+With x = theta0/2 the two conditions give
+
+    cot x = (d1/d0 - cos 45deg) / sin 45deg,     r = d0 / (2 sin x)
+
+(d0 = 2, d1 = 3 sigma: x = 41.72 deg, theta0 = 83.4 deg, r = 1.503 sigma).
+
+**Coupling** ("lever").  The circuit's output pair (length L0 at 0, L1 at 1) is carried
+by a connector chain (routed by :func:`mlc.circuit.route.solve_route`, an even number of
+half units, so it arrives with the output's own state) to two sites on the arms at
+distance r L0/d0 from the hinge.  By similar triangles the sites' distance is L0/d0
+times the tips' distance, so the pair's L0 -> L1 is the DOF's d0 -> d1 exactly when
+L1/L0 = d1/d0 (1.5 for the paper's numbers and expanding wires): the arms are levers of
+gain d0/L0 = 2.  The sites sit ``POST`` sigma below the skeleton plane, so the chain's
+last layer stays under the skeleton.  "lock": a constant output (its probe spans one
+rigid slab) holds its DOF with a plain bond between the tips at its constant length.
+
+Every DOF has a probe across its tips, named ``dof_u{i}_{side}``, reading the DOF's
+own output (rest d0, actuated d1): the circuit verifier checks the DOF lengths like any
+output, and :mod:`mlc.robot.verify` reads the shape.  Units: sigma, k0, radians.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from mlc.errors import MlcError
+from mlc.gates.connector import Pair, chain_parts, connector_geometry, join
+from mlc.gates.parts import axis_sites, hinge, segment_box, slab_body
+from mlc.geometry.rotation import matrix_to_quat
+from mlc.robot.spec import RobotSpec
+from mlc.scene.model import Body, Bond, Probe, Scene
+
+JOINT_LENGTH = 2.0       # sigma: length of a unit's joint piece (between its up and down hinges)
+POST = 0.6               # sigma: the lever sites sit this far below the skeleton plane
+HINGE_WIDTH = 0.5        # sigma between the two bonds of a skeleton hinge (along z)
+APPROACH_RUN = 4.0       # sigma: the chain's last stretch rises straight into the skeleton
+BACK = 4.0               # sigma behind the circuit (+y) where a chain from inside the circuit rises
+
+
+@dataclass
+class DofGeometry:
+    """The lever triangle of a DOF (sigma, rad): arms from the hinge at the angle theta0
+    apart (theta0 + 90 deg when turned); the output pair joins them at ``p`` (first body)
+    and ``q`` (second body) from the hinge, the DOF's tips sit at ``gain`` times that."""
+
+    L0: float
+    L1: float
+    theta0: float
+    p: float
+    q: float
+    gain: float
+    alpha1: float           # direction of the first arm (rad from +x, up hinge; mirrored for dn)
+
+    @property
+    def d0(self) -> float:
+        return self.gain * self.L0
+
+    @property
+    def d1(self) -> float:
+        return self.gain * self.L1
+
+
+def dof_geometry(L0: float, L1: float, d0: float, turn: float = math.pi / 2,
+                 alpha1: float = math.radians(-130.0)) -> DofGeometry:
+    """Arms at theta0 = 90 deg - turn/2 apart, so the mechanism swings from 45 to 135 deg
+    (far from the dead points 0 and 180 deg, where the pair length stops depending on
+    the angle).  With P = p q and S = p^2 + q^2 the law of cosines at theta0 and
+    theta0 + turn gives
+
+        L1^2 - L0^2 = 2 P (cos theta0 - cos(theta0 + turn)),   S = L0^2 + 2 P cos theta0,
+
+    p, q = (sqrt(S + 2P) +- sqrt(S - 2P)) / 2; the tips are at gain = d0/L0 times p, q."""
+    th0 = math.pi / 2 - turn / 2
+    P = (L1 * L1 - L0 * L0) / (2.0 * (math.cos(th0) - math.cos(th0 + turn)))
+    S = L0 * L0 + 2.0 * P * math.cos(th0)
+    if P <= 0 or S < 2 * P:
+        raise MlcError(f"no lever triangle turns a {L0} -> {L1} sigma signal into a {math.degrees(turn):.0f}-degree "
+                       "turn", "dof_stroke", "use expanding wires (mlc compile --signal expand)")
+    a, b = math.sqrt(S + 2 * P), math.sqrt(S - 2 * P)
+    return DofGeometry(L0, L1, th0, 0.5 * (a + b), 0.5 * (a - b), d0 / L0, alpha1)
+
+
+@dataclass
+class Robot:
+    scene: Scene
+    chains: int
+    half_units: int
+    seconds: float
+
+
+def _rotz(a):
+    c, s = math.cos(a), math.sin(a)
+    return np.array([[c, -s, 0.0], [s, c, 0.0], [0.0, 0.0, 1.0]])
+
+
+def _pair_tangent(scene: Scene, lo: str, hi: str, centre, axis):
+    """The side a pair is open to: from its carrier bodies' centres to the pair, across its axis."""
+    cb = 0.5 * (scene.body(lo.split(".")[0]).position + scene.body(hi.split(".")[0]).position)
+    t = centre - cb
+    t = t - float(t @ axis) * axis
+    n = float(np.linalg.norm(t))
+    if n < 1e-6:
+        t = np.array([0.0, 0.0, 1.0]) - axis[2] * axis
+        n = float(np.linalg.norm(t))
+    return t / n
+
+
+def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
+    """One scene: the circuit, the skeleton and a coupling per DOF (see the module doc),
+    posed in the all-zero input row."""
+    import time
+
+    from mlc.circuit.route import solve_route
+
+    t0 = time.perf_counter()
+    meta = circuit.meta if isinstance(circuit.meta, dict) else {}
+    signal = meta.get("signal", "expand")
+    geo = connector_geometry(signal, gap=float(meta.get("connector", {}).get("gap", 0.5)))
+    if abs(geo.L1 / geo.L0 - (spec.dof_rest + spec.dof_stroke) / spec.dof_rest) > 1e-9:
+        need = spec.dof_rest * (geo.L1 / geo.L0 - 1.0)
+        raise MlcError(f"the circuit's wires go {geo.L0} -> {geo.L1} sigma ({signal}ing), a ratio the DOFs "
+                       f"({spec.dof_rest} -> {spec.dof_rest + spec.dof_stroke}) must share for the lever coupling", f"{spec.source}: dof_stroke",
+                       f"use dof_stroke: {need:g} with dof_rest: {spec.dof_rest:g}" if need > 0 else
+                       "compile with --signal expand")
+    dg = dof_geometry(geo.L0, geo.L1, spec.dof_rest)
+    l, w, s, th = spec.unit_length, spec.width, JOINT_LENGTH, spec.thickness
+    tip1 = dg.gain * dg.p * np.array([math.cos(dg.alpha1), math.sin(dg.alpha1)])
+    if w + tip1[1] < 0.1:
+        raise MlcError(f"width {w} is too narrow for the lever arms (they reach {-tip1[1]:.2f} sigma across)",
+                       f"{spec.source}: width", f"use at least {-tip1[1] + 0.1:.1f}")
+    if min(s, l - s) + tip1[0] < 0.1:
+        raise MlcError(f"unit_length {l} leaves no room for the lever arms", f"{spec.source}: unit_length",
+                       f"use at least {2 * (-tip1[0] + 0.1):.1f}")
+    A = circuit.arrays()
+    lo_c, hi_c = A.pos.min(0), A.pos.max(0)
+    zs = float(hi_c[2]) + spec.height
+    driven = [p for p in circuit.probes if p.output in {d.output for d in spec.dofs}
+              and p.a.split(".")[0] != p.b.split(".")[0]]
+    xc = float(np.mean([circuit.site_world(p.a)[0] for p in driven])) if driven else 0.5 * (lo_c[0] + hi_c[0])
+    origin = np.array([xc - 0.5 * spec.units * l, 0.5 * (lo_c[1] + hi_c[1]), zs])
+
+    def W(x, y, z=0.0):
+        return origin + np.array([x, y, z])
+
+    zrow = "0" * len(circuit.inputs)
+    table = circuit.truth_table or {}
+    outs = circuit.outputs
+    bits0 = table.get(zrow, "0" * len(outs))
+
+    # ---- skeleton bodies, straight, in the local frame ---------------------------------
+    ey, ez = np.array([0.0, 1.0, 0]), np.array([0.0, 0, 1.0])
+    segs = {"skel_u0": (-0.5 * l, 0.5 * l)}
+    for i in range(1, spec.units + 1):
+        a = (i - 0.5) * l
+        segs[f"skel_j{i}"] = (a, a + s)
+        segs[f"skel_u{i}"] = (a + s, a + l)
+    sites: dict[str, dict] = {k: {} for k in segs}
+    bonds: list[Bond] = []
+    probes: list[Probe] = []
+    dofs_meta = []
+    targets = []           # (dof spec, pair sites lo/hi, centre, axis) to route to
+    posts = {k: [] for k in segs}
+    for i in range(1, spec.units + 1):
+        a = (i - 0.5) * l
+        for side in ("up", "dn"):
+            if side == "up":
+                O, b1, b2, sgn = np.array([a, w / 2]), f"skel_u{i - 1}", f"skel_j{i}", 1.0
+            else:
+                O, b1, b2, sgn = np.array([a + s, -w / 2]), f"skel_j{i}", f"skel_u{i}", -1.0
+            a1, a2 = dg.alpha1, dg.alpha1 + dg.theta0
+            dir1 = np.array([math.cos(a1), sgn * math.sin(a1)])
+            dir2 = np.array([math.cos(a2), sgn * math.sin(a2)])
+            name = f"u{i}_{side}"
+            hw = HINGE_WIDTH
+            sites[b1].update(axis_sites(f"h_{name}", W(*O), ez, hw))
+            sites[b2].update(axis_sites(f"h_{name}", W(*O), ez, hw))
+            bonds += hinge(f"skel_h_{name}", b1, b2, f"h_{name}", f"h_{name}")
+            sites[b1][f"tip_{name}"] = W(*(O + dg.gain * dg.p * dir1))
+            sites[b2][f"tip_{name}"] = W(*(O + dg.gain * dg.q * dir2))
+            ds = spec.dof(i, side)
+            dofs_meta.append({"name": name, "unit": i, "side": side, "hinge": f"skel_h_{name}",
+                              "bodies": [b1, b2], "output": ds.output if ds else None})
+            if ds is None:                                  # not in the file: locked straight
+                bonds.append(Bond(f"skel_lock_{name}", f"{b1}.tip_{name}", f"{b2}.tip_{name}", geo.k, dg.d0,
+                                  0.0, "bond", None))
+                dofs_meta[-1]["coupling"] = "lock"
+                dofs_meta[-1]["value"] = 0
+                continue
+            pr = next((p for p in circuit.probes if p.output == ds.output), None)
+            if pr is None:
+                raise MlcError(f"dof {name}: the circuit has no probe for output {ds.output}", ds.loc)
+            const = pr.a.split(".")[0] == pr.b.split(".")[0]
+            coupling = ds.coupling or ("lock" if const else "lever")
+            if coupling == "lock" and not const:
+                raise MlcError(f"dof {name}: output {ds.output} is not constant, so it cannot be a lock", ds.loc,
+                               "use coupling: lever (or leave coupling out)")
+            col = sorted({r[outs.index(ds.output)] for r in table.values()})
+            dofs_meta[-1]["coupling"] = coupling
+            probes.append(Probe(f"dof_{name}", ds.output, f"{b1}.tip_{name}", f"{b2}.tip_{name}", dg.d0, dg.d1))
+            if coupling == "lock":
+                v = int(col[0]) if len(col) == 1 and col[0] in "01" else 0
+                bonds.append(Bond(f"skel_lock_{name}", f"{b1}.tip_{name}", f"{b2}.tip_{name}", geo.k,
+                                  dg.d1 if v else dg.d0, 0.0, "bond", None))
+                dofs_meta[-1]["value"] = v
+                continue
+            p1 = W(*(O + dg.p * dir1), -POST)
+            p2 = W(*(O + dg.q * dir2), -POST)
+            sites[b1][f"lever_{name}"] = p1
+            sites[b2][f"lever_{name}"] = p2
+            posts[b1].append(p1)
+            posts[b2].append(p2)
+            c = 0.5 * (p1 + p2)
+            axis = (p2 - p1) / np.linalg.norm(p2 - p1)
+            targets.append((ds, name, Pair(f"{b1}.lever_{name}", f"{b2}.lever_{name}", c, axis,
+                                           float(np.linalg.norm(p2 - p1))), pr))
+    bodies: list[Body] = []
+    for k, (x0, x1) in segs.items():
+        body = slab_body(k, [(W(x0, 0), W(x1, 0))], sites[k], ey, w, th)
+        for p in posts[k]:                     # a post from the slab's underside down to each lever site
+            top = p.copy()
+            top[2] = zs - 0.5 * th
+            body.boxes.append(segment_box(top - body.position, p + np.array([0, 0, 0.04]) - body.position,
+                                          np.array([1.0, 0, 0]), 0.08, 0.08))
+        bodies.append(body)
+    # DOFs driven at the all-zero row: turn the bodies downstream of them
+    order = list(segs)
+    for dm in dofs_meta:
+        out = dm["output"]
+        on = dm.get("value", 0) if dm["coupling"] == "lock" else (int(bits0[outs.index(out)]) if out else 0)
+        if not on:
+            continue
+        by = {b.name: b for b in bodies}
+        hb = by[dm["bodies"][0]]
+        O = hb.world(f"h_{dm['name']}_0")
+        Rz = _rotz(math.pi / 2 if dm["side"] == "up" else -math.pi / 2)
+        for name in order[order.index(dm["bodies"][1]):]:
+            b = by[name]
+            from mlc.geometry.rotation import quat_to_matrix
+            b.position = O + Rz @ (b.position - O)
+            b.orientation = matrix_to_quat(Rz @ quat_to_matrix(b.orientation))
+    # ---- couplings: a chain from each output pair to its DOF's lever sites ---------------
+    parts_bodies, parts_bonds = [], []
+    n_chains = n_half = 0
+    cbyname = {b.name: b for b in circuit.bodies}
+    sbyname = {b.name: b for b in bodies}
+    for ds, name, target, pr in targets:
+        pa = cbyname[pr.a.split(".")[0]].world(pr.a.split(".", 1)[1])
+        pb = cbyname[pr.b.split(".")[0]].world(pr.b.split(".", 1)[1])
+        L = float(np.linalg.norm(pb - pa))
+        start = Pair(pr.a, pr.b, 0.5 * (pa + pb), (pb - pa) / L, L)
+        # the target as built (the skeleton may be turned at the zero row)
+        ta = sbyname[target.lo.split(".")[0]].world(target.lo.split(".", 1)[1])
+        tb = sbyname[target.hi.split(".")[0]].world(target.hi.split(".", 1)[1])
+        tc, tax = 0.5 * (ta + tb), (tb - ta) / np.linalg.norm(tb - ta)
+        t0v = _pair_tangent(circuit, pr.a, pr.b, start.centre, start.axis)
+        sstate = int(bits0[outs.index(ds.output)])
+        wps = []
+        if start.centre[2] < hi_c[2] - 3.0:          # an output inside the circuit: out at the back, then up
+            yb = float(hi_c[1]) + BACK
+            wps = [(start.centre[0], yb, start.centre[2] + 2.0), (start.centre[0], yb, hi_c[2] + 2.0)]
+        route = None
+        tr = time.perf_counter()
+        for wp in (wps, []):
+            route = solve_route(start.centre, start.axis, tc, tax, geo, 0, waypoints=wp, tangent=t0v,
+                                free_start=True, approach=ez)
+            if route is not None:
+                break
+        if route is None:
+            raise MlcError(f"cannot route output {ds.output} to dof {name}: no connector chain reaches it",
+                           ds.loc, "this is a placement limit of mlc; try a larger skeleton height")
+        tag = f"rc_{name}"
+        parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, sstate, geo)
+        parts.bonds += join(f"{tag}_j0", start, pairs[0], geo.k)
+        lout = pairs[-1]
+        same = float(lout.axis @ tax) > 0
+        ends = (lout.lo, lout.hi) if same else (lout.hi, lout.lo)
+        parts.bonds.append(Bond(f"{tag}_end_lo", ends[0], target.lo, geo.k, 0.0, 0.0, "universal", f"{tag}_end_lo"))
+        parts.bonds.append(Bond(f"{tag}_end_hi", ends[1], target.hi, geo.k, 0.0, 0.0, "universal", f"{tag}_end_hi"))
+        parts_bodies += parts.bodies
+        parts_bonds += parts.bonds
+        n_chains += 1
+        n_half += len(route.bends)
+        next(d for d in dofs_meta if d["name"] == name)["chain"] = {
+            "half_units": len(route.bends), "prefix": tag, "route_seconds": round(time.perf_counter() - tr, 2)}
+    rmeta = spec.as_dict()
+    rmeta.update({"origin": [float(v) for v in origin], "plane_normal": [0.0, 0.0, 1.0], "x_axis": [1.0, 0, 0],
+                  "joint_length": s, "links": [f"skel_u{i}" for i in range(spec.units + 1)],
+                  "dof_geometry": {"rest": dg.d0, "actuated": dg.d1, "p": dg.p, "q": dg.q, "gain": dg.gain,
+                                   "theta0_deg": math.degrees(dg.theta0),
+                                   "alpha1_deg": math.degrees(dg.alpha1)},
+                  "dofs": dofs_meta, "chains": n_chains, "half_units": n_half})
+    scene = Scene(name=f"robot_{spec.name}", bodies=list(circuit.bodies) + bodies + parts_bodies,
+                  bonds=list(circuit.bonds) + bonds + parts_bonds, muscles=list(circuit.muscles),
+                  probes=list(circuit.probes) + probes, inputs=list(circuit.inputs), outputs=list(circuit.outputs),
+                  truth_table=dict(circuit.truth_table) if circuit.truth_table else None,
+                  meta={"element": "robot", "robot": rmeta, "circuit": meta})
+    scene.check()
+    return Robot(scene, n_chains, n_half, time.perf_counter() - t0)
+
+
+__all__ = ["DofGeometry", "Robot", "build_robot", "dof_geometry"]

@@ -1,0 +1,285 @@
+"""Verification of a robot scene: the skeleton's shape read from body poses, per input row.
+
+The shape is read from the final poses alone (not from the probes): the heading of link
+i is its body's x axis in the world (the links are built straight along x), the plane
+normal is the body's (link 0) z axis, and the turn at unit i is the signed angle from
+the heading of link i-1 to that of link i about the normal.  Each turn is rounded to
+the nearest of -90, 0, +90 degrees (a turn nearer 180 is read as a U-turn and is wrong);
+walking the rounded turns gives the grid cells.  A DOF's angle is the rotation of its
+second body relative to its first about the normal; its target is +90 (up) or -90 (dn)
+degrees when its output is 1 and 0 otherwise.
+
+A row passes when the turns read are the expected pose (the robot file's, stored in the
+scene's meta), every probe reads its bit (circuit outputs and DOF lengths) and, for the
+static check, the largest joint stretch is below ``TOL_STRETCH``.
+
+* **static**: :func:`mlc.verify.static.equilibrium` of each row, reached from the rest
+  pose in ``STEPS`` continuation steps (the skeleton folds far, so more than the
+  circuit verifier's four);
+* **dynamic**: Brownian dynamics from rest into each row, over several seeds, until
+  every probe has relaxed (:func:`mlc.verify.dynamic.relax_all`, with the time floor of
+  3 slowest relaxation times) or ``max_time``; the shape is read from the final poses.
+
+Units: sigma, k0, t0, degrees in reports.
+"""
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from mlc.errors import MlcError
+from mlc.geometry.rotation import quat_to_matrix
+from mlc.robot.spec import walk
+from mlc.scene.model import Scene
+from mlc.verify.circuit import Report, select_rows
+
+STEPS = 12                # continuation steps of the static check
+TOL_STRETCH = 1e-3        # sigma
+TOL_LENGTH = 0.05         # sigma: static probe lengths within this of the ideal
+
+
+def robot_meta(scene: Scene) -> dict:
+    meta = scene.meta if isinstance(scene.meta, dict) else {}
+    rm = meta.get("robot")
+    if meta.get("element") != "robot" or not isinstance(rm, dict):
+        raise MlcError(f"scene {scene.name} is not a robot scene (meta.element != robot)", scene.source or scene.name,
+                       "compile with mlc compile LOGIC --robot ROBOT.yaml")
+    for key in ("links", "dofs", "poses", "units"):
+        if key not in rm:
+            raise MlcError(f"robot scene {scene.name}: meta.robot has no {key!r}", scene.source or scene.name,
+                           "recompile the robot with this version of mlc")
+    return rm
+
+
+def read_shape(scene: Scene, pos, quat, state: str | None = None) -> dict:
+    """The skeleton's pose in body poses ``pos``/``quat``: turns (deg, measured and rounded
+    to quarter turns), cells, and each DOF's angle (deg) and its error from the target of
+    row ``state`` (if given)."""
+    rm = robot_meta(scene)
+    idx = {b.name: i for i, b in enumerate(scene.bodies)}
+    R = {n: quat_to_matrix(quat[idx[n]]) for n in rm["links"] + [b for d in rm["dofs"] for b in d["bodies"]]}
+    nrm = R[rm["links"][0]][:, 2]
+    heads = [R[n][:, 0] for n in rm["links"]]
+    turns = []
+    for h0, h1 in zip(heads[:-1], heads[1:]):
+        turns.append(math.degrees(math.atan2(float(np.cross(h0, h1) @ nrm), float(h0 @ h1))))
+    q = []
+    for t in turns:
+        k = int(round(t / 90.0))
+        q.append(k if k in (-1, 0, 1) else 2)
+    outs = scene.outputs
+    want = scene.truth_table.get(state) if (state is not None and scene.truth_table) else None
+    dofs = []
+    for d in rm["dofs"]:
+        Ra, Rb = R[d["bodies"][0]], R[d["bodies"][1]]
+        rel = Ra.T @ Rb
+        ang = math.degrees(math.atan2(rel[1, 0], rel[0, 0]))
+        e = {"name": d["name"], "angle": ang}
+        if want is not None:
+            if d.get("coupling") == "lock" or d.get("output") is None:
+                on = int(d.get("value", 0))
+            else:
+                on = int(want[outs.index(d["output"])] == "1")
+            target = (90.0 if d["side"] == "up" else -90.0) if on else 0.0
+            e["target"] = target
+            e["error"] = ang - target
+        dofs.append(e)
+    cells = walk([k if k != 2 else 2 for k in q]) if 2 not in q else None
+    return {"turns": turns, "quarter_turns": q, "cells": cells, "dofs": dofs}
+
+
+def _shape_row(scene, rm, state, pos, quat) -> dict:
+    got = read_shape(scene, pos, quat, state)
+    pose = rm["poses"].get(state)
+    if pose is None:
+        raise MlcError(f"robot scene {scene.name} has no expected pose for row {state}", scene.source or scene.name)
+    exp_q = [int(t) // 90 for t in pose["turns"]]
+    ok = got["quarter_turns"] == exp_q
+    # a turn error per unit: measured minus expected (deg)
+    terr = [t - 90.0 * e for t, e in zip(got["turns"], exp_q)]
+    derr = [abs(d["error"]) for d in got["dofs"] if "error" in d]
+    return {"shape_expected": pose.get("shape", state), "turns_expected": [90 * e for e in exp_q],
+            "turns_read": [round(t, 3) for t in got["turns"]], "cells_expected": walk(exp_q),
+            "cells_read": got["cells"], "turn_errors_deg": [round(e, 3) for e in terr],
+            "dof_angles": got["dofs"], "max_dof_error_deg": max(derr, default=0.0),
+            "max_dof_error_rad": math.radians(max(derr, default=0.0)), "shape_ok": bool(ok),
+            "shape_read": _name_of(got["quarter_turns"], rm)}
+
+
+def _name_of(q, rm) -> str:
+    for row, p in rm["poses"].items():
+        if [int(t) // 90 for t in p["turns"]] == q:
+            return p.get("shape", row)
+    return "?" + "".join({-1: "d", 0: "s", 1: "u", 2: "x"}[k] for k in q)
+
+
+def verify_robot_static(scene: Scene, rows=None, steps: int = STEPS, progress=None, keep_poses: bool = False) -> Report:
+    """Static check of every row (see the module doc)."""
+    from mlc.verify.static import equilibrium
+
+    rm = robot_meta(scene)
+    states = select_rows(scene, rows)
+    t0 = time.perf_counter()
+    rep = Report(scene.name, "static", params={"tol_length": TOL_LENGTH, "tol_stretch": TOL_STRETCH, "steps": steps,
+                                               "robot": True})
+    poses = {}
+    for i, state in enumerate(states):
+        t_row = time.perf_counter()
+        eq = equilibrium(scene, state, steps=steps)
+        want = scene.truth_table.get(state)
+        row_ok = eq.max_joint_stretch <= TOL_STRETCH
+        for pr in scene.probes:
+            k = scene.outputs.index(pr.output)
+            bit = None if want is None or want[k] == "-" else int(want[k])
+            L = eq.probes[pr.name]
+            ideal = None if bit is None else (pr.actuated if bit else pr.rest)
+            ok = bit is None or (pr.bit(L) == bit and abs(L - ideal) <= TOL_LENGTH * max(1.0, abs(pr.actuated - pr.rest) / 0.5))
+            row_ok &= ok
+            rep.entries.append({"state": state, "output": pr.name if pr.name.startswith("dof_") else pr.output,
+                                "expected": bit, "measured": L, "bit": pr.bit(L),
+                                "margin": None if bit is None else float(pr.margin(L, bit)),
+                                "error": None if ideal is None else float(abs(L - ideal)), "ok": bool(ok)})
+        row = {"state": state, "joint_stretch": eq.max_joint_stretch}
+        row.update(_shape_row(scene, rm, state, eq.pos, eq.quat))
+        row["ok"] = bool(row_ok and row["shape_ok"])
+        row["seconds"] = time.perf_counter() - t_row
+        rep.rows.append(row)
+        poses[state] = (eq.pos, eq.quat)
+        if progress:
+            progress(i + 1, len(states))
+    rep.seconds = time.perf_counter() - t0
+    if keep_poses:
+        rep.poses = poses
+    return rep
+
+
+def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
+                         max_time: float | None = None, progress=None, keep_poses: bool = False,
+                         tau: float | None = None) -> Report:
+    """Brownian dynamics from rest into each row, ``seeds`` seeds, until every probe has
+    relaxed (at least 3 slowest relaxation times) or ``max_time`` t0; the shape is read
+    from each seed's final poses (see the module doc)."""
+    from mlc.io.progress import Progress
+    from mlc.sim.drive import Drive
+    from mlc.sim.integrator import SimOptions, Simulation
+    from mlc.verify.dynamic import DT, MAX_TAUS, MAX_TIME, TAU_FACTOR, WINDOW, relax_all, relaxation_time
+
+    rm = robot_meta(scene)
+    states = select_rows(scene, rows)
+    if int(seeds) < 1:
+        raise MlcError(f"need at least one seed, got {seeds}", "--seeds")
+    if not (math.isfinite(kT) and kT >= 0):
+        raise MlcError(f"kT must be finite and >= 0, got {kT}", "--kT")
+    t0 = time.perf_counter()
+    opt0 = SimOptions(scheme=scheme)
+    tau = relaxation_time(scene, gamma_r=opt0.gamma_r) if tau is None else float(tau)
+    window = max(WINDOW, tau / 20.0)
+    rep = Report(scene.name, "dynamic", params={"kT": kT, "seeds": int(seeds), "scheme": scheme, "tau": tau,
+                                                "robot": True})
+    names = [p.name for p in scene.probes]
+    rest = "0" * len(scene.inputs)
+    poses = {}
+    total, done = len(states) * int(seeds), 0
+    bar = Progress(f"dynamic check of {scene.name}", total=total, show=None if progress is None else False)
+    with bar:
+        for state in states:
+            want = scene.truth_table.get(state)
+            drives = {inp: Drive.constant(int(b)) for inp, b in zip(scene.inputs, state)}
+            t_min = TAU_FACTOR * tau if state != rest else 0.0
+            t_max = float(max_time) if max_time is not None else max(MAX_TIME, MAX_TAUS * tau)
+            per = []
+            for seed in range(int(seeds)):
+                sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed, dt=DT.get(scheme)))
+                means, t_rel, relaxed = relax_all(sim, names, kT, t_min, window, t_max, None, tau)
+                shape = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy())
+                per.append((means, t_rel, relaxed, shape))
+                poses[(state, seed)] = (sim.pos.copy(), sim.quat.copy())
+                done += 1
+                bar.update(done)
+                if callable(progress):
+                    progress(done, total)
+            row_ok = True
+            for pr in scene.probes:
+                k = scene.outputs.index(pr.output)
+                bit = None if want is None or want[k] == "-" else int(want[k])
+                vals = [m[pr.name] for m, *_ in per]
+                margins = None if bit is None else [float(pr.margin(v, bit)) for v in vals]
+                ok = bit is None or all(pr.bit(v) == bit and m > 0 for v, m in zip(vals, margins))
+                row_ok &= ok
+                rep.entries.append({"state": state, "output": pr.name if pr.name.startswith("dof_") else pr.output,
+                                    "expected": bit, "measured": float(np.mean(vals)), "bit": pr.bit(float(np.mean(vals))),
+                                    "margin": None if margins is None else min(margins), "per_seed": vals,
+                                    "ok": bool(ok)})
+            shapes = [sh for *_, sh in per]
+            worst = max(shapes, key=lambda sh: (not sh["shape_ok"], sh["max_dof_error_deg"]))
+            row = {"state": state, "relax_time": max(t for _, t, _, _ in per),
+                   "relaxed": all(r for _, _, r, _ in per), "seeds": int(seeds)}
+            row.update(worst)
+            row["per_seed"] = [{"seed": s, "shape_read": sh["shape_read"], "turns_read": sh["turns_read"],
+                                "max_dof_error_deg": sh["max_dof_error_deg"], "time": t}
+                               for s, (_, t, _, sh) in enumerate(per)]
+            row["shape_ok"] = all(sh["shape_ok"] for sh in shapes)
+            row["ok"] = bool(row_ok and row["shape_ok"])
+            rep.rows.append(row)
+    rep.seconds = time.perf_counter() - t0
+    if keep_poses:
+        rep.poses = poses
+    return rep
+
+
+def verify_robot(scene: Scene, dynamic: bool = False, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
+                 rows=None) -> Report:
+    """``mlc verify`` of a robot scene: static (default) or by Brownian dynamics."""
+    from mlc.io.progress import Progress
+
+    robot_meta(scene)
+    if dynamic:
+        return verify_robot_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme)
+    n = len(select_rows(scene, rows))
+    with Progress(f"static verification of {scene.name}", total=n) as bar:
+        return verify_robot_static(scene, rows, progress=lambda done, total: bar.update(done))
+
+
+def format_robot_report(rep: Report) -> str:
+    """The probe table of :func:`mlc.verify.circuit.format_report` (circuit outputs and DOF
+    lengths), then one line per row: shape read vs expected, turns (deg) and the largest
+    DOF angle error."""
+    from mlc.verify.circuit import format_report
+
+    table = [ln for ln in format_report(rep).splitlines() if not ln.startswith(("all ", "WRONG"))]
+    lines = table + [f"{rep.scene}: {rep.mode} verification of the skeleton, {len(rep.rows)} rows"
+             + (f", {rep.params.get('seeds')} seeds, kT = {rep.params.get('kT')}" if rep.mode == "dynamic" else "")]
+    for r in rep.rows:
+        turns = " ".join(f"{t:+7.2f}" for t in r["turns_read"])
+        tail = (f"stretch {r['joint_stretch']:.1e}" if rep.mode == "static"
+                else f"t = {r['relax_time']:.1f} t0{'' if r['relaxed'] else ' (not relaxed)'}")
+        lines.append(f"row {r['state']}: shape {r['shape_read']:<6} expected {r['shape_expected']:<6} turns (deg) "
+                     f"{turns}  largest DOF error {r['max_dof_error_deg']:.2f} deg ({r['max_dof_error_rad']:.4f} rad)"
+                     f"  {tail}  {'ok' if r['ok'] else 'WRONG'}")
+    for r in rep.rows:
+        if not r["shape_ok"]:
+            lines.append(f"WRONG: row {r['state']}: the skeleton folded into {r['shape_read']} (turns "
+                         f"{[round(t) for t in r['turns_read']]}, cells {r['cells_read']}), expected "
+                         f"{r['shape_expected']} (turns {r['turns_expected']}, cells {[list(c) for c in r['cells_expected']]})")
+        elif not r["ok"]:
+            bad = [e for e in rep.entries if e["state"] == r["state"] and not e["ok"]]
+            what = ", ".join(f"{e['output']} read {e['measured']:.3f}" for e in bad[:4])
+            if rep.mode == "static" and r["joint_stretch"] > TOL_STRETCH:
+                what = (what + ", " if what else "") + f"joint stretch {r['joint_stretch']:.2e} sigma"
+            lines.append(f"WRONG: row {r['state']}: {what}")
+    lines.append(f"all {len(rep.rows)} rows fold correctly ({rep.seconds:.1f} s)" if rep.ok else
+                 f"FAILED: rows {', '.join(r['state'] for r in rep.rows if not r['ok'])}")
+    return "\n".join(lines)
+
+
+def format_any(rep: Report) -> str:
+    """:func:`format_robot_report` for a robot's report, else the circuit's table."""
+    if rep.params.get("robot"):
+        return format_robot_report(rep)
+    from mlc.verify.circuit import format_report
+    return format_report(rep)
+
+
+__all__ = ["format_any", "format_robot_report", "read_shape", "robot_meta", "verify_robot_dynamic", "verify_robot_static"]
