@@ -592,6 +592,11 @@ def test_stl_memory_estimate_refuses_with_the_estimate(monkeypatch):
                                      options={"sigma_mm": "--sigma-mm"})
     for name in profiles.PROFILES:                  # the built-in profiles fit the library gates
         profiles.check_against_scene(profiles.PROFILES[name], sc)
+    # repeated mechanisms are built once: a grid of 36 NAND fits, one of 900 does not (~0.8 MB a body)
+    from mlc.mesh import examples as ex
+    profiles.check_against_scene(profiles.PROFILES["mjp"], ex.grid(sc, 6, 6, (6.0, 6.0)))
+    with pytest.raises(MlcError, match="GiB of memory"):
+        profiles.check_against_scene(profiles.PROFILES["mjp"], ex.grid(sc, 30, 30, (6.0, 6.0)))
 
 
 def test_simulate_outputs_checked_before_the_run(scene_text, tmp_path, capsys):

@@ -194,49 +194,95 @@ def _widths(scene) -> tuple[float, float]:
     return min(widths), ext
 
 
+def _mechanisms(scene) -> tuple[list[list], int]:
+    """(the bodies of each distinct mechanism, number of mechanisms).  Bodies joined by bonds or
+    muscles form a mechanism; mechanisms equal up to a translation are built once (as
+    mlc.mesh.pipeline does; here compared by their bodies' boxes and relative positions)."""
+    import numpy as np
+    idx = {b.name: i for i, b in enumerate(scene.bodies)}
+    parent = list(range(len(scene.bodies)))
+
+    def find(i):
+        while parent[i] != i:
+            parent[i] = parent[parent[i]]
+            i = parent[i]
+        return i
+
+    for it in list(scene.bonds) + list(scene.muscles):
+        a, b = idx.get(it.a.split(".")[0]), idx.get(it.b.split(".")[0])
+        if a is not None and b is not None:
+            parent[find(a)] = find(b)
+    groups: dict = {}
+    for i in range(len(scene.bodies)):
+        groups.setdefault(find(i), []).append(scene.bodies[i])
+    distinct = {}
+    for bodies in groups.values():
+        p0 = np.asarray(bodies[0].position, float)
+        key = tuple((tuple(np.round(np.asarray(b.position, float) - p0, 6)),
+                     tuple(tuple(np.round(np.asarray(x.size, float), 6)) for x in b.boxes)) for b in bodies)
+        distinct.setdefault(key, bodies)
+    return list(distinct.values()), len(groups)
+
+
+def _body_cells(b, prof: Profile) -> float:
+    """Cells of the voxel wall check's grid (spacing min_wall / 8) over one body, uncapped."""
+    import numpy as np
+    lo = np.min([np.asarray(x.center, float) - 0.5 * np.asarray(x.size, float) for x in b.boxes], axis=0)
+    hi = np.max([np.asarray(x.center, float) + 0.5 * np.asarray(x.size, float) for x in b.boxes], axis=0)
+    size = np.maximum((hi - lo) * prof.sigma_mm, prof.slab_thickness)
+    return float(np.prod(size / (prof.min_wall / 8) + 5))
+
+
+_WALL_CELLS = 6e6       # mlc.mesh.walls.MAX_CELLS
+
+
 def estimate_memory(prof: Profile, scene) -> dict:
     """Rough peak memory (bytes) of an export of ``scene`` at ``prof``, from the sizes in mm.
 
-    Counted: the sample points on every slab's mid-plane (spacing as in mlc.mesh.build,
-    about 100 bytes a point with the copies made while trimming), the support-column grid of
-    the bed check (mlc.mesh.checks: spacing ``max(0.05, min(min_wall, size/150))`` mm, about
-    300 bytes a column) and a fixed 300 MB for the meshes and the voxel wall check (its grid is
-    capped at 6e6 cells).  Calibrated on NAND (mjp: ~0.2 GB measured; sigma 20 mm: 0.5 GB)."""
+    Counted: the sample points on the mid-planes of the slabs of each distinct mechanism
+    (spacing as in mlc.mesh.build, about 100 bytes a point with the copies made while trimming),
+    the voxel grid of the wall check (one part at a time, at most 6e6 cells, about 40 bytes a
+    cell), the support-column grid of the bed check over the whole print (spacing
+    ``max(0.05, min(min_wall, size/150))`` mm, about 300 bytes a column), 0.8 MB of meshes per
+    body and a fixed 250 MB.  Measured peaks (NAND at sigma 20 mm: 0.50 GB, estimate 0.51; grids of
+    9 and 36 NAND at mjp: 0.24 and 0.41 GB, estimates 0.33 and 0.52; a grid of 900 NAND is
+    estimated at 6.7 GB and refused)."""
     import numpy as np
     s = prof.sigma_mm
     t = prof.slab_thickness
     c = prof.clearance
     h = float(np.clip(max(min(t, c) if c > 0 else t, 0.015 * s), 0.05, 0.5))
+    reps, _ = _mechanisms(scene)
     n = 0.0
-    for b in scene.bodies:
-        for x in b.boxes:
-            w = sorted(float(v) * s for v in x.size)
-            n += (w[1] / h + 2) * (w[2] / h + 2)
+    cells = 0.0
+    for bodies in reps:
+        for b in bodies:
+            cells = max(cells, min(_body_cells(b, prof), _WALL_CELLS))
+            for x in b.boxes:
+                w = sorted(float(v) * s for v in x.size)
+                n += (w[1] / h + 2) * (w[2] / h + 2)
     _, ext = _widths(scene)
     size = np.sort(np.asarray(ext, float) * s)
     hb = max(0.05, min(prof.min_wall, float(size[-1]) / 150))
     cols = (size[-1] / hb + 2) * (size[-2] / hb + 2)
-    total = 100.0 * n + 300.0 * cols + 300e6
+    total = 100.0 * n + 40.0 * cells + 300.0 * cols + 0.8e6 * len(scene.bodies) + 250e6
     return {"bytes": total, "samples": n, "sample_step_mm": h, "columns": cols, "column_step_mm": hb}
 
 
 def estimate_seconds(prof: Profile, scene) -> float:
     """A rough duration (s) of an export with its checks, for the progress line's ETA.
 
-    Half a second per body for building and trimming, plus the voxel wall check: three distance
-    transforms per part on a grid of spacing ``min_wall / 8`` (at most 6e6 cells), about 1.4e-7 s
-    a cell (NAND at mjp: about 5 s measured; with every grid at its cap: 22 s)."""
-    import numpy as np
-    h = prof.min_wall / 8
+    For each distinct mechanism half a second per body (building, trimming, posing) plus the
+    voxel wall check: three distance transforms per part on a grid of spacing ``min_wall / 8``
+    (at most 6e6 cells), about 1.4e-7 s a cell; 0.15 s for each copy of a mechanism.  Measured on
+    a loaded 2-core machine: NAND at mjp about 5 s (estimate 4.5), with every grid at its cap 22 s
+    (24); grids of 9 and 36 NAND 12 and 16 s (estimates 5.7 and 9.8)."""
+    reps, count = _mechanisms(scene)
     t = 0.0
-    for b in scene.bodies:
-        lo = np.min([np.asarray(x.center, float) - 0.5 * np.asarray(x.size, float) for x in b.boxes], axis=0)
-        hi = np.max([np.asarray(x.center, float) + 0.5 * np.asarray(x.size, float) for x in b.boxes], axis=0)
-        size = (hi - lo) * prof.sigma_mm
-        size = np.maximum(size, prof.slab_thickness)
-        cells = float(np.prod(size / h + 5))
-        t += 0.5 + 3 * min(cells, 6e6) * 1.4e-7
-    return t
+    for bodies in reps:
+        for b in bodies:
+            t += 0.5 + 3 * min(_body_cells(b, prof), _WALL_CELLS) * 1.4e-7
+    return t + 0.15 * (count - len(reps))
 
 
 def check_against_scene(prof: Profile, scene, where: str = "--profile", options: dict | None = None) -> None:
