@@ -86,7 +86,7 @@ def read_shape(scene: Scene, pos, quat, state: str | None = None) -> dict:
             e["target"] = target
             e["error"] = ang - target
         dofs.append(e)
-    cells = walk([k if k != 2 else 2 for k in q]) if 2 not in q else None
+    cells = [list(c) for c in walk(q)] if 2 not in q else None
     return {"turns": turns, "quarter_turns": q, "cells": cells, "dofs": dofs}
 
 
@@ -101,7 +101,7 @@ def _shape_row(scene, rm, state, pos, quat) -> dict:
     terr = [t - 90.0 * e for t, e in zip(got["turns"], exp_q)]
     derr = [abs(d["error"]) for d in got["dofs"] if "error" in d]
     return {"shape_expected": pose.get("shape", state), "turns_expected": [90 * e for e in exp_q],
-            "turns_read": [round(t, 3) for t in got["turns"]], "cells_expected": walk(exp_q),
+            "turns_read": [round(t, 3) for t in got["turns"]], "cells_expected": [list(c) for c in walk(exp_q)],
             "cells_read": got["cells"], "turn_errors_deg": [round(e, 3) for e in terr],
             "dof_angles": got["dofs"], "max_dof_error_deg": max(derr, default=0.0),
             "max_dof_error_rad": math.radians(max(derr, default=0.0)), "shape_ok": bool(ok),
@@ -262,7 +262,7 @@ def format_robot_report(rep: Report) -> str:
         if not r["shape_ok"]:
             lines.append(f"WRONG: row {r['state']}: the skeleton folded into {r['shape_read']} (turns "
                          f"{[round(t) for t in r['turns_read']]}, cells {r['cells_read']}), expected "
-                         f"{r['shape_expected']} (turns {r['turns_expected']}, cells {[list(c) for c in r['cells_expected']]})")
+                         f"{r['shape_expected']} (turns {r['turns_expected']}, cells {r['cells_expected']})")
         elif not r["ok"]:
             bad = [e for e in rep.entries if e["state"] == r["state"] and not e["ok"]]
             what = ", ".join(f"{e['output']} read {e['measured']:.3f}" for e in bad[:4])

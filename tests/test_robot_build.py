@@ -1,0 +1,97 @@
+"""A small robot end to end through the CLI (docs/robot.md): one input folds a two-unit
+skeleton into a hook.  mlc compile --robot writes one scene that the existing scene tools
+load; mlc verify reads the shape from the body poses and fails when the expected pose is
+altered; mlc robot draws the shapes and writes a fold as GIF and GSD."""
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mlc.cli import main
+from mlc.scene.io import dump_scene, load_scene
+
+TINY = """mlc_robot: 1
+name: tiny
+inputs: [a]
+skeleton: {units: 2}
+dofs:
+  - {unit: 1, side: up, output: u1_up}
+  - {unit: 2, side: dn, output: u2_dn}
+poses:
+  - {row: "0", shape: I, turns: [0, 0]}
+  - {row: "1", shape: hook, turns: [90, -90]}
+"""
+
+
+@pytest.fixture(scope="module")
+def robot(tmp_path_factory):
+    d = tmp_path_factory.mktemp("tiny")
+    (d / "tiny.robot.yaml").write_text(TINY)
+    rc = main(["compile", "-e", "u1_up = a; u2_dn = a", "--robot", str(d / "tiny.robot.yaml"), "-o", str(d / "out")])
+    assert rc == 0
+    return d
+
+
+def test_one_scene_with_circuit_skeleton_and_couplings(robot):
+    sc = load_scene(robot / "out" / "robot.yaml")
+    names = [b.name for b in sc.bodies]
+    assert sc.meta["element"] == "robot"
+    assert {"skel_u0", "skel_j1", "skel_u1", "skel_j2", "skel_u2"} <= set(names)
+    assert any(n.startswith("rc_u1_up_") for n in names) and any(n.startswith("rc_u2_dn_") for n in names)
+    # the skeleton hangs on the chains only: every coupling ends in two universal joints on lever sites
+    ends = [b for b in sc.bonds if b.name.startswith("rc_") and "_end_" in b.name]
+    assert len(ends) == 4 and all(b.kind == "universal" and ".lever_" in b.b for b in ends)
+    assert [p.name for p in sc.probes if p.name.startswith("dof_")] == ["dof_u1_up", "dof_u2_dn"]
+
+
+def test_static_verify_reads_the_shapes(robot, capsys):
+    rc = main(["verify", str(robot / "out" / "robot.yaml"), "--json"])
+    rep = json.loads(capsys.readouterr().out)
+    assert rc == 0 and rep["ok"]
+    rows = {r["state"]: r for r in rep["rows"]}
+    assert rows["1"]["shape_read"] == "hook" and rows["1"]["turns_expected"] == [90, -90]
+    assert np.allclose(rows["1"]["turns_read"], [90, -90], atol=0.01)
+    assert rows["0"]["cells_read"] == [[1, 0], [2, 0]] and rows["1"]["cells_read"] == [[0, 1], [1, 1]]
+    assert rows["1"]["max_dof_error_deg"] < 0.01
+
+
+def test_altered_expected_pose_is_a_wrong_shape(robot, capsys):
+    sc = load_scene(robot / "out" / "robot.yaml")
+    sc.meta["robot"]["poses"]["1"]["turns"] = [90, 90]
+    sc.meta["robot"]["poses"]["1"]["shape"] = "U"
+    bad = robot / "altered.yaml"
+    bad.write_text(dump_scene(sc))
+    rc = main(["verify", str(bad)])
+    out = capsys.readouterr().out
+    assert rc == 1
+    assert "WRONG: row 1: the skeleton folded into ?ud (turns [90, -90], cells [[0, 1], [1, 1]]), expected U" in out
+
+
+def test_dynamic_verify_folds(robot, capsys):
+    rc = main(["verify", str(robot / "out" / "robot.yaml"), "--dynamic", "--seeds", "2", "--json"])
+    rep = json.loads(capsys.readouterr().out)
+    assert rc == 0, rep["rows"]
+    r1 = next(r for r in rep["rows"] if r["state"] == "1")
+    assert r1["shape_read"] == "hook" and all(s["shape_read"] == "hook" for s in r1["per_seed"])
+    assert r1["max_dof_error_rad"] < 0.05
+
+
+def test_pictures_and_trajectory(robot, capsys):
+    out = robot / "out"
+    assert main(["robot", "shapes", str(out / "robot.yaml"), "-o", str(out / "shapes.png")]) == 0
+    assert (out / "shapes.png").read_bytes()[:4] == b"\x89PNG"
+    rc = main(["robot", "fold", str(out / "robot.yaml"), "--row", "1", "--time", "3", "--frames", "4",
+               "--gif", str(out / "fold.gif"), "--gsd", str(out / "fold.gsd")])
+    assert rc == 0, capsys.readouterr()
+    assert (out / "fold.gif").read_bytes()[:3] == b"GIF"
+    import gsd.hoomd
+    with gsd.hoomd.open(str(out / "fold.gsd"), "r") as f:
+        assert len(f) == 4 and f[0].particles.N == len(load_scene(out / "robot.yaml").bodies)
+        assert f[0].particles.type_shapes[0]["type"] == "Mesh"
+
+
+def test_existing_scene_tools_load_the_robot(robot, capsys):
+    out = robot / "out"
+    assert main(["simulate", str(out / "robot.yaml"), "--time", "0.2", "--set", "a=1", "--quiet"]) == 0
+    capsys.readouterr()
