@@ -56,6 +56,7 @@ import numpy as np
 from mlc.errors import MlcError
 from mlc.geometry.rotation import quat_to_matrix
 from mlc.mesh.profiles import PAPER_SLAB_MM, Profile
+from mlc.mesh.spatial import box_pairs, posed_boxes, solid_boxes
 from mlc.scene.model import Scene
 
 _TOL = 1e-3  # sigma: tolerance for "same point / same line"
@@ -419,7 +420,9 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
             part_name = jname if jname not in bodies else f"joint_{jname}"
             uj = UJoint(jname, part_name, center, (cb, ob), (u, v), lays, hub, R, r_pin, r_hole,
                         (float(np.hypot(lays[1].extent, R)) + c, float(np.hypot(lays[0].extent, R)) + c))
-            smp = dict(base_samples)
+            if best is not None and not (uj.rho[0] + uj.rho[1], modes != ("both", "both")) < best[0]:
+                continue     # its trim radii are at least these: it cannot beat the best layout
+            smp = {bn: base_samples[bn] for bn in uj.bodies}
             for side, bn in enumerate(uj.bodies):
                 smp[bn] = np.concatenate([smp[bn], _slab_samples(
                     _yoke_plates(slabs[bn], center, uj.axes[side], [lays[side].plate], uj.rho[side] + reach, t), h)])
@@ -678,14 +681,19 @@ def _inside(s, intervals):
     return out
 
 
-def _close_pairs(pa, pb, thr):
+def _close_pairs(pa, pb, thr, ta=None):
     """Pairs (i, j) of points of ``pa`` and ``pb`` closer than ``thr``: each point with its
     nearest partner (both ways) -- enough to see every point that has a close partner, and far
-    fewer pairs than all of them (the final trims and the checks see the exact solids)."""
+    fewer pairs than all of them (the final trims and the checks see the exact solids).
+    ``ta``: a ``cKDTree`` of ``pa`` already built (``pa`` is the fixed side of many calls)."""
     from scipy.spatial import cKDTree
     if len(pa) == 0 or len(pb) == 0:
         return np.zeros(0, int), np.zeros(0, int)
-    ta, tb = cKDTree(pa), cKDTree(pb)
+    lo, hi = pb.min(axis=0), pb.max(axis=0)
+    if np.any(pa.min(axis=0) > hi + thr) or np.any(pa.max(axis=0) < lo - thr):
+        return np.zeros(0, int), np.zeros(0, int)      # the two point sets are farther apart than thr
+    ta = cKDTree(pa) if ta is None else ta
+    tb = cKDTree(pb)
     d1, j1 = tb.query(pa, k=1, distance_upper_bound=thr)
     d2, i2 = ta.query(pb, k=1, distance_upper_bound=thr)
     a = np.isfinite(d1)
@@ -693,6 +701,49 @@ def _close_pairs(pa, pb, thr):
     ii = np.concatenate([np.nonzero(a)[0], i2[b]]).astype(int)
     jj = np.concatenate([j1[a], np.nonzero(b)[0]]).astype(int)
     return ii, jj
+
+
+def _close_pairs_posed(pa, pb, Ms, thr, ta=None, tb=None):
+    """:func:`_close_pairs` of ``pa`` and ``pb`` moved by each rigid 4x4 ``M`` of ``Ms`` (``None``:
+    not moved): ``[(ii, jj)]``, one per ``M``, in two tree queries in all.  ``pa`` is queried in
+    ``pb``'s own frame (moved back by ``M``'s inverse), so neither tree is built per pose;
+    ``ta``/``tb``: trees of ``pa``/``pb`` already built."""
+    from scipy.spatial import cKDTree
+    empty = (np.zeros(0, int), np.zeros(0, int))
+    if len(pa) == 0 or len(pb) == 0 or not Ms:
+        return [empty] * len(Ms)
+    ta = cKDTree(pa) if ta is None else ta
+    tb = cKDTree(pb) if tb is None else tb
+    na, nb = len(pa), len(pb)
+    PB = np.concatenate([pb if M is None else pb @ M[:3, :3].T + M[:3, 3] for M in Ms])
+    PA = np.concatenate([pa if M is None else (pa - M[:3, 3]) @ M[:3, :3] for M in Ms])
+    # only points within thr of the other set's box can have a partner: query those alone
+    alo, ahi = pa.min(axis=0) - thr, pa.max(axis=0) + thr
+    blo, bhi = pb.min(axis=0) - thr, pb.max(axis=0) + thr
+    qb = np.nonzero(np.all((PB >= alo) & (PB <= ahi), axis=1))[0]
+    qa = np.nonzero(np.all((PA >= blo) & (PA <= bhi), axis=1))[0]
+    d1, j1 = np.full(len(PA), np.inf), np.full(len(PA), nb)
+    d2, i2 = np.full(len(PB), np.inf), np.full(len(PB), na)
+    if len(qb):
+        d2[qb], i2[qb] = ta.query(PB[qb], k=1, distance_upper_bound=thr)
+    if len(qa):
+        d1[qa], j1[qa] = tb.query(PA[qa], k=1, distance_upper_bound=thr)
+    out = []
+    for k in range(len(Ms)):
+        e1, f1 = d1[k * na:(k + 1) * na], j1[k * na:(k + 1) * na]
+        e2, g2 = d2[k * nb:(k + 1) * nb], i2[k * nb:(k + 1) * nb]
+        a, b = np.isfinite(e1), np.isfinite(e2)
+        if not a.any() and not b.any():
+            out.append(empty)
+            continue
+        out.append((np.concatenate([np.nonzero(a)[0], g2[b]]).astype(int),
+                    np.concatenate([f1[a], np.nonzero(b)[0]]).astype(int)))
+    return out
+
+
+def _relative(A, B, Ts):
+    """4x4 taking body B's rest frame to body A's in a posed state (None at rest)."""
+    return None if Ts is None else np.linalg.inv(Ts[A]) @ Ts[B]
 
 
 def _trim_radius(ax: HingeAxis, samples, state_T, t, c, h, s, notes) -> float:
@@ -712,12 +763,14 @@ def _trim_radius(ax: HingeAxis, samples, state_T, t, c, h, s, notes) -> float:
         a, r = _axis_coords(ax.origin, ax.direction, samples[bn])
         keep = (np.abs(a) <= ax.span / 2 + thr) & (r <= cap + thr)
         near[bn] = (samples[bn][keep], a[keep], r[keep], ~_inside(a[keep], ax.intervals[bn]))
-    for _, Ts in states:
-        for i, A in enumerate(ax.bodies):
-            for B in ax.bodies[i + 1:]:
-                pa, sa, ra, ea = near[A]
-                pb, sb_, rb, eb = near[B]
-                ii, jj = _close_pairs(pa, _in_frame_of(A, B, pb, Ts), thr)
+    from scipy.spatial import cKDTree
+    trees = {bn: cKDTree(near[bn][0]) for bn in ax.bodies if len(near[bn][0])}
+    for i, A in enumerate(ax.bodies):
+        for B in ax.bodies[i + 1:]:
+            pa, sa, ra, ea = near[A]
+            pb, sb_, rb, eb = near[B]
+            for ii, jj in _close_pairs_posed(pa, pb, [_relative(A, B, Ts) for _, Ts in states], thr,
+                                             trees.get(A), trees.get(B)):
                 if len(ii) == 0:
                     continue
                 req = np.minimum(np.where(ea[ii], ra[ii], np.inf), np.where(eb[jj], rb[jj], np.inf))
@@ -764,8 +817,8 @@ def _ujoint_trim(uj: UJoint, samples, state_T, t, c, h):
         coords.append((samples[bn][keep], r[keep], elig[keep]))
     (pc, rc, ec), (po, ro, eo) = coords
     VC, VO = [], []
-    for _, Ts in (state_T or [("rest", None)]):
-        ii, jj = _close_pairs(pc, _in_frame_of(C, O, po, Ts), thr)
+    Ms = [_relative(C, O, Ts) for _, Ts in (state_T or [("rest", None)])]
+    for ii, jj in _close_pairs_posed(pc, po, Ms, thr):
         if len(ii):
             VC.append(np.where(ec[ii], rc[ii] + h, np.inf))
             VO.append(np.where(eo[jj], ro[jj] + h, np.inf))
@@ -870,10 +923,15 @@ def _ring_clear(asm: "Assembly", part: "Part", ring) -> bool:
     for other in asm.parts:
         if other is part:
             continue
-        if _bb_near(rb, np.asarray(other.solid.bounding_box()), 2 * c) and ring.min_gap(other.solid, c) < c - 1e-6:
+        ob = np.asarray(other.solid.bounding_box())
+        if _bb_near(rb, ob, 2 * c) and ring.min_gap(other.solid, c) < c - 1e-6:
             return False
         for T in Ts:
-            o = transform_solid(other.solid, np.linalg.inv(T[part.name]) @ T[other.name])
+            M = np.linalg.inv(T[part.name]) @ T[other.name]
+            plo, phi = posed_boxes(ob[:3], ob[3:], [M])
+            if not _bb_near(rb, np.concatenate([plo[0], phi[0]]), 0.0):
+                continue       # the moved part's box (which contains its exact box) misses the ring
+            o = transform_solid(other.solid, M)
             if _bb_near(rb, np.asarray(o.bounding_box()), 0.0) and (ring ^ o).volume() > 1e-6:
                 return False
     return True
@@ -946,15 +1004,23 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T) ->
     parts = asm.parts
     Ts = [asm.part_transforms(pos, quat) for pos, quat in poses.values()]
 
-    def conflicts_of(pairs):
+    def conflicts_of(filters):
+        # the pairs of parts that can meet (bounding boxes, spatial.box_pairs) instead of all
+        # pairs; ``filters``: sets of parts changed in earlier rounds (a pair must touch each)
+        def wanted(i, j):
+            return all(i in f or j in f for f in filters)
+
         out: dict = {}
-        boxes = [np.asarray(p.solid.bounding_box()) for p in parts]
-        for i, j in pairs:
-            if _bb_near(boxes[i], boxes[j], 2 * c) and parts[i].solid.min_gap(parts[j].solid, c) < c - 1e-6:
+        lo, hi = solid_boxes([p.solid for p in parts])
+        for i, j in box_pairs(lo, hi, 2 * c):
+            if wanted(i, j) and parts[i].solid.min_gap(parts[j].solid, c) < c - 1e-6:
                 out.setdefault((i, j), []).append(None)
         for T in Ts:
+            plo, phi = posed_boxes(lo, hi, [T[p.name] for p in parts])
             posed = {}
-            for i, j in pairs:
+            for i, j in box_pairs(plo, phi, 0.0):
+                if not wanted(i, j):
+                    continue
                 for k in (i, j):
                     if k not in posed:
                         posed[k] = transform_solid(parts[k].solid, T[parts[k].name])
@@ -974,9 +1040,9 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T) ->
                 return False
         return True
 
-    pairs = [(i, j) for i in range(len(parts)) for j in range(i + 1, len(parts))]
+    filters: list[set] = []
     for _ in range(4):
-        conflicts = conflicts_of(pairs)
+        conflicts = conflicts_of(filters)
         if not conflicts:
             return
         changed = set()
@@ -1018,7 +1084,7 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T) ->
                                 if any(s is not None for s in sts) else " as printed"))
         if not changed:
             return
-        pairs = [(i, j) for i, j in pairs if i in changed or j in changed]
+        filters.append(changed)
 
 
 def _trim_by(X, Y, sts, grow, dirs, keep, state_grow):

@@ -114,11 +114,8 @@ def _pairs(boxes, margin):
     """Index pairs whose boxes (lo, hi) come within ``margin``."""
     if len(boxes) < 2:
         return []
-    lo = np.array([b[0] for b in boxes])
-    hi = np.array([b[1] for b in boxes])
-    ok = np.all((lo[:, None, :] <= hi[None, :, :] + margin) & (lo[None, :, :] <= hi[:, None, :] + margin), axis=2)
-    i, j = np.nonzero(np.triu(ok, 1))
-    return list(zip(i.tolist(), j.tolist()))
+    from mlc.mesh.spatial import box_pairs
+    return box_pairs([b[0] for b in boxes], [b[1] for b in boxes], margin)
 
 
 def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True) -> Report:
