@@ -723,13 +723,17 @@ def test_kernel_compile_notice_once(monkeypatch):
     (["check-gate", "NAND", "--branches", "--kT", "inf"], ["--kT", "finite kT > 0"]),
     (["stl", "NAND", "--min-wall", "1e-9"], ["min_wall 1e-09 mm is below 0.01 mm"]),
     (["core", "--data", "/dev/full"], ["--data", "/dev/full"]),
+    (["simulate", "{scene}", "--time", "1", "--record", "1e308", "--probes", "{d}/p.csv"],
+     ["--record", "longer than the run"]),
+    (["simulate", "", "--time", "1"], ["empty scene file name"]),
+    (["verify", ""], ["empty scene file name"]),
     (["gate", "NAND", "-o", "/dev/full"], ["-o", "/dev/full"]),
 ])
 def test_refused_at_once(argv, words, scene_text, tmp_path, capsys):
     src = tmp_path / "s.yaml"
     src.write_text(scene_text)
     before = listing(tmp_path)
-    code, _, err = run(capsys, *[a.format(scene=src) for a in argv])
+    code, _, err = run(capsys, *[a.format(scene=src, d=tmp_path) for a in argv])
     assert_clean_failure(code, err, before, tmp_path, *words)
 
 

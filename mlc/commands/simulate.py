@@ -80,6 +80,9 @@ def run(args) -> int:
                        "--dt", f"e.g. --dt {args.time / 10:g}; the last step ends exactly at --time")
     if args.record is not None and not (math.isfinite(args.record) and args.record > 0):
         raise MlcError(f"--record must be a positive number of t0, got {args.record}", "--record")
+    if args.record is not None and args.record > args.time:
+        raise MlcError(f"--record {args.record:g} is longer than the run (--time {args.time:g})", "--record",
+                       "give a sampling interval of at most --time (t0); the default takes about 2000 samples")
     if args.threads < 1:
         raise MlcError(f"--threads must be >= 1, got {args.threads}", "--threads")
     import os

@@ -282,7 +282,7 @@ class Outputs:
             if stat.S_ISCHR(st.st_mode) and _DEV_FULL is not None and st.st_rdev == _DEV_FULL:
                 raise out.error("cannot write: No space left on device (it is /dev/full)", "choose another location")
             return
-        if out.suffixes and p.suffix.lower() not in out.suffixes:
+        if out.suffixes and not p.name.lower().endswith(out.suffixes):
             raise out.error(f"the file name must end in {' or '.join(out.suffixes)}",
                             f"this output is written in that format, e.g. {p.with_suffix(out.suffixes[0]).name}")
         parent = p.parent

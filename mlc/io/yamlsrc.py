@@ -170,6 +170,8 @@ def read_text(path, what: str = "file") -> str:
     """Read a UTF-8 text file; a missing, unreadable or non-UTF-8 file is an :class:`MlcError`.
 
     ``what`` names the file in the message ("scene", "profile", ...)."""
+    if str(path).strip() == "":
+        raise MlcError(f"empty {what} file name", None, f"give the path of a {what} file")
     try:
         with open(path, "rb") as f:
             data = f.read(MAX_BYTES + 1)
