@@ -276,13 +276,19 @@ def estimate_seconds(prof: Profile, scene) -> float:
     voxel wall check: three distance transforms per part on a grid of spacing ``min_wall / 8``
     (at most 6e6 cells), about 1.4e-7 s a cell; 0.15 s for each copy of a mechanism.  Measured on
     a loaded 2-core machine: NAND at mjp about 5 s (estimate 4.5), with every grid at its cap 22 s
-    (24); grids of 9 and 36 NAND 12 and 16 s (estimates 5.7 and 9.8)."""
+    (24); grids of 9 and 36 NAND 12 and 16 s (estimates 5.7 and 9.8); with cone pins 105 s
+    (:data:`CONE_SLOWDOWN`: 104)."""
     reps, count = _mechanisms(scene)
     t = 0.0
     for bodies in reps:
         for b in bodies:
-            t += 0.5 + 3 * min(_body_cells(b, prof), _WALL_CELLS) * 1.4e-7
+            t += (0.5 * CONE_SLOWDOWN if prof.pin == "cone" else 0.5) + \
+                3 * min(_body_cells(b, prof), _WALL_CELLS) * 1.4e-7
     return t + 0.15 * (count - len(reps))
+
+
+#: cone pins make building and trimming much slower (NAND, mjp, no states: 105 s against 4 s)
+CONE_SLOWDOWN = 25.0
 
 
 def check_against_scene(prof: Profile, scene, where: str = "--profile", options: dict | None = None) -> None:
