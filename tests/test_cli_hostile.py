@@ -587,13 +587,16 @@ def test_stl_memory_estimate_refuses_with_the_estimate(monkeypatch):
     small = profiles.estimate_memory(profiles.PROFILES["mjp"], sc)
     big = profiles.estimate_memory(profiles.load_profile("mjp", {"sigma_mm": 1000}), sc)
     assert small["bytes"] < 0.5 * 2 ** 30 < 2 ** 31 < big["bytes"]     # grows with the size in mm
+    monkeypatch.setattr(profiles, "memory_budget", lambda: 2.0 * 2 ** 30)
     with pytest.raises(MlcError, match=r"--sigma-mm: this export would need about [0-9.]+ GiB"):
         profiles.check_against_scene(profiles.load_profile("mjp", {"sigma_mm": 1000}), sc,
                                      options={"sigma_mm": "--sigma-mm"})
     for name in profiles.PROFILES:                  # the built-in profiles fit the library gates
         profiles.check_against_scene(profiles.PROFILES[name], sc)
-    # repeated mechanisms are built once: a grid of 36 NAND fits, one of 900 does not (~0.8 MB a body)
+    # repeated mechanisms are built once: a grid of 36 NAND fits, one of 900 (~0.8 MB a body) not in 2 GiB
     from mlc.mesh import examples as ex
+    assert profiles.memory_budget() >= 2 * 2 ** 30
+    monkeypatch.setattr(profiles, "memory_budget", lambda: 2.0 * 2 ** 30)
     profiles.check_against_scene(profiles.PROFILES["mjp"], ex.grid(sc, 6, 6, (6.0, 6.0)))
     with pytest.raises(MlcError, match="GiB of memory"):
         profiles.check_against_scene(profiles.PROFILES["mjp"], ex.grid(sc, 30, 30, (6.0, 6.0)))
@@ -803,3 +806,18 @@ def test_scene_name_length_is_bounded(scene_text, tmp_path, capsys):
     before = listing(tmp_path)
     code, _, err = run(capsys, "draw", src, "-o", tmp_path / "x.png")        # took minutes to draw
     assert_clean_failure(code, err, before, tmp_path, f"{src}:", "100000 characters (at most 200)")
+
+
+def test_posts_are_not_slabs():
+    """Compiled circuits hang connector slabs on square posts (0.08 x 0.08 sigma): the profile
+    checks measure the plates (0.5 sigma wide), so the built-in profiles still fit a circuit."""
+    import numpy as np
+    from mlc.gates.library import gate_scene
+    from mlc.mesh import profiles
+    from mlc.scene.model import Box
+    sc = gate_scene("NAND", "expand")
+    sc.bodies[0].boxes.append(Box(np.array([0.08, 0.08, 0.17]), np.array([0.3, 0.0, 0.0]),
+                                  np.array([1.0, 0.0, 0.0, 0.0])))
+    assert profiles._widths(sc)[0] == pytest.approx(0.5)
+    for p in profiles.PROFILES.values():
+        profiles.check_against_scene(p, sc)

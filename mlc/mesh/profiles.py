@@ -171,23 +171,41 @@ def _plain(v):
 MAX_SIGMA_MM = 1000.0
 #: most polygon segments per circle (a 3 mm pin at 256 segments is within 0.0001 mm of a circle)
 MAX_SEGMENTS = 256
-#: memory an export may plan to use (bytes); beyond it `mlc stl` refuses with the estimate
+#: memory an export may always plan to use (bytes); see :func:`memory_budget`
 MEMORY_BUDGET = 2 * 2 ** 30
 
 
+def memory_budget() -> float:
+    """Bytes an export may plan to use: half the memory available now (Linux: MemAvailable in
+    /proc/meminfo), and never less than :data:`MEMORY_BUDGET` (2 GiB)."""
+    avail = 0.0
+    try:
+        with open("/proc/meminfo") as f:
+            for line in f:
+                if line.startswith("MemAvailable:"):
+                    avail = float(line.split()[1]) * 1024
+                    break
+    except (OSError, ValueError, IndexError):
+        pass
+    return max(float(MEMORY_BUDGET), 0.5 * avail)
+
+
 def _widths(scene) -> tuple[float, float]:
-    """(narrowest slab width, largest extent of the scene), both in sigma.  A slab box's width is
-    its middle edge length (thickness < width <= length)."""
+    """(narrowest slab width, extent of the scene), in sigma.  A slab is a plate: a box whose
+    thickness is at most half its width (its middle edge length); bars of square section (the
+    posts of compiled circuits' connectors, 0.08 x 0.08 sigma) are not slabs and carry no hinge
+    knuckles of their own.  Without plates, every box counts."""
     import numpy as np
-    widths, lo, hi = [], [], []
+    widths, bars, lo, hi = [], [], [], []
     for b in scene.bodies:
         for x in b.boxes:
             w = sorted(float(v) for v in x.size)
-            widths.append(w[1])
+            (widths if w[0] <= 0.5 * w[1] else bars).append(w[1])
             c = np.asarray(b.position, float) + np.asarray(x.center, float)
             r = 0.5 * float(np.linalg.norm(x.size))
             lo.append(c - r)
             hi.append(c + r)
+    widths = widths or bars
     if not widths:
         return 0.0, 0.0
     ext = np.max(hi, axis=0) - np.min(lo, axis=0)
@@ -306,7 +324,7 @@ def check_against_scene(prof: Profile, scene, where: str = "--profile", options:
     * hinges wider across (pin + 2 clearance + 2 walls) than the narrowest slab: the knuckles of
       neighbouring hinges would overlap, and the trimming that follows runs for minutes (NAND at
       sigma 4 mm: more than 30 s and 0.8 GB; at 5 mm, 2.2 mm hinges on 2.5 mm slabs: 4 s);
-    * an estimated peak memory (:func:`estimate_memory`) above :data:`MEMORY_BUDGET`.
+    * an estimated peak memory (:func:`estimate_memory`) above :func:`memory_budget`.
     """
     options = options or {}
 
@@ -348,9 +366,11 @@ def check_against_scene(prof: Profile, scene, where: str = "--profile", options:
                 fix = f"use {f} <= {part * W:.3g} mm, or sigma_mm >= {s_min:.3g}"
             raise MlcError(f"{msg}: {at}", opt(f), fix)
     est = estimate_memory(prof, scene)
-    if est["bytes"] > MEMORY_BUDGET:
+    budget = memory_budget()
+    if est["bytes"] > budget:
         raise MlcError(f"this export would need about {est['bytes'] / 2 ** 30:.3g} GiB of memory "
                        f"({est['samples']:.3g} slab samples {est['sample_step_mm']:.2g} mm apart, "
-                       f"{est['columns']:.3g} support columns {est['column_step_mm']:.2g} mm apart); "
-                       f"the limit is {MEMORY_BUDGET / 2 ** 30:.3g} GiB", opt("sigma_mm"),
-                       "use a smaller sigma_mm")
+                       f"{est['columns']:.3g} support columns {est['column_step_mm']:.2g} mm apart, "
+                       f"{len(scene.bodies)} bodies); the limit is {budget / 2 ** 30:.3g} GiB (half the memory "
+                       f"available, at least 2 GiB)", opt("sigma_mm"),
+                       "use a smaller sigma_mm, or mesh the circuit in parts")
