@@ -56,7 +56,7 @@ import numpy as np
 from mlc.errors import MlcError
 from mlc.geometry.rotation import quat_to_matrix
 from mlc.mesh.profiles import PAPER_SLAB_MM, Profile
-from mlc.mesh.spatial import box_pairs, posed_boxes, solid_boxes
+from mlc.mesh.spatial import box_pairs, local_boxes, obb_overlap, part_frames, posed_boxes, solid_boxes
 from mlc.scene.model import Scene
 
 _TOL = 1e-3  # sigma: tolerance for "same point / same line"
@@ -1015,10 +1015,12 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T) ->
         for i, j in box_pairs(lo, hi, 2 * c):
             if wanted(i, j) and parts[i].solid.min_gap(parts[j].solid, c) < c - 1e-6:
                 out.setdefault((i, j), []).append(None)
+        llo, lhi = local_boxes([p.solid for p in parts], frames)
         for T in Ts:
-            plo, phi = posed_boxes(lo, hi, [T[p.name] for p in parts])
+            Tp = [T[p.name] for p in parts]
+            plo, phi = posed_boxes(lo, hi, Tp)
             posed = {}
-            for i, j in box_pairs(plo, phi, 0.0):
+            for i, j in obb_overlap(box_pairs(plo, phi, 0.0), [t @ f for t, f in zip(Tp, frames)], llo, lhi):
                 if not wanted(i, j):
                     continue
                 for k in (i, j):
@@ -1041,6 +1043,7 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T) ->
         return True
 
     filters: list[set] = []
+    frames = part_frames(asm)
     for _ in range(4):
         conflicts = conflicts_of(filters)
         if not conflicts:

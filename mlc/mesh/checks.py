@@ -176,13 +176,25 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
 
     # -- logic states --------------------------------------------------------------------
     if poses:
+        from mlc.mesh.spatial import box_pairs, local_boxes, obb_overlap, part_frames, posed_boxes
         worst = 0.0
         fails = []
+        # candidate pairs: rest boxes moved (world boxes), then each part's box in its own frame
+        # (separating axes); only pairs that are certainly apart are skipped
+        frames = part_frames(asm)
+        llo, lhi = local_boxes([p.solid for p in parts], frames)
+        rlo = np.array([b[0] for b in boxes]).reshape(-1, 3)
+        rhi = np.array([b[1] for b in boxes]).reshape(-1, 3)
         for st, (pos, quat) in poses.items():
             T = asm.part_transforms(pos, quat)
-            posed = [transform_solid(p.solid, T[p.name]) for p in parts]
-            bxs = [_bbox(s) for s in posed]
-            for i, j in _pairs(bxs, 0.0):
+            Tp = [T[p.name] for p in parts]
+            plo, phi = posed_boxes(rlo, rhi, Tp)
+            cand = obb_overlap(box_pairs(plo, phi, 0.0), [t @ f for t, f in zip(Tp, frames)], llo, lhi)
+            posed = {}
+            for i, j in cand:
+                for k in (i, j):
+                    if k not in posed:
+                        posed[k] = transform_solid(parts[k].solid, Tp[k])
                 v = float((posed[i] ^ posed[j]).volume())
                 worst = max(worst, v)
                 if v > VOL_EPS:

@@ -11,7 +11,9 @@ returns them in the same order as a test of all pairs would (``i < j``, lexicogr
 :func:`posed_boxes` bounds the boxes of parts moved by rigid transforms without moving their
 meshes: the box of a box's eight transformed corners contains the box of the moved part.  A
 pair whose bounding boxes are apart is apart, so these boxes only ever *select* pairs; the
-exact tests (manifold3d ``min_gap``, intersection volume) decide.
+exact tests (manifold3d ``min_gap``, intersection volume) decide.  :func:`obb_overlap` narrows
+them further with each part's box in its own body frame (oriented boxes, separating-axis test):
+a slab tilted in a connector chain has a world box far larger than the slab.
 """
 from __future__ import annotations
 
@@ -68,4 +70,82 @@ def posed_boxes(lo, hi, transforms, pad: float = 1e-6) -> tuple[np.ndarray, np.n
     return moved.min(axis=1) - pad, moved.max(axis=1) + pad
 
 
-__all__ = ["box_pairs", "posed_boxes", "solid_boxes"]
+def part_frames(asm) -> list[np.ndarray]:
+    """A rest frame (4x4, mm) for each part of an assembly: its body's frame (orientation and
+    position), for a joint part the frame of its two pin axes at the joint point."""
+    from mlc.geometry.rotation import quat_to_matrix
+    s = asm.profile.sigma_mm
+    bodies = {b.name: b for b in asm.scene.bodies}
+    joints = {u.part: u for u in asm.ujoints}
+    out = []
+    for p in asm.parts:
+        F = np.eye(4)
+        if p.name in bodies:
+            b = bodies[p.name]
+            F[:3, :3] = quat_to_matrix(b.orientation)
+            F[:3, 3] = s * np.asarray(b.position, float)
+        elif p.name in joints:
+            u = joints[p.name]
+            a, b = np.asarray(u.axes[0], float), np.asarray(u.axes[1], float)
+            a = a / np.linalg.norm(a)
+            b = b - np.dot(b, a) * a
+            b = b / np.linalg.norm(b)
+            F[:3, :3] = np.column_stack([a, b, np.cross(a, b)])
+            F[:3, 3] = u.center
+        out.append(F)
+    return out
+
+
+def local_boxes(solids, frames) -> tuple[np.ndarray, np.ndarray]:
+    """Each solid's bounding box in its own frame (an oriented box, tighter than the world box
+    of a tilted slab): arrays ``(n, 3)`` of lower and upper corners in frame coordinates (mm)."""
+    lo, hi = [], []
+    for solid, F in zip(solids, frames):
+        m = solid.to_mesh()
+        V = np.asarray(m.vert_properties, float)[:, :3]
+        if len(V) == 0:
+            lo.append(np.full(3, np.inf))
+            hi.append(np.full(3, -np.inf))
+            continue
+        L = (V - F[:3, 3]) @ F[:3, :3]
+        lo.append(L.min(axis=0))
+        hi.append(L.max(axis=0))
+    return np.array(lo).reshape(-1, 3), np.array(hi).reshape(-1, 3)
+
+
+def obb_overlap(pairs, frames, lo, hi, pad: float = 1e-6) -> list[tuple[int, int]]:
+    """The pairs ``(i, j)`` whose oriented boxes (local boxes ``[lo, hi]`` in the 4x4 ``frames``,
+    posed) are *not* separated by one of the 15 axes of the separating-axis test; boxes grown by
+    ``pad`` (mm).  Only pairs that are certainly apart are dropped (separated boxes hold
+    separated parts); the exact test decides the rest."""
+    if not pairs:
+        return []
+    P = np.asarray(pairs, int)
+    F = np.asarray(frames, float)
+    lo = np.asarray(lo, float)
+    hi = np.asarray(hi, float)
+    e = 0.5 * (hi - lo) + pad
+    cl = 0.5 * (hi + lo)
+    c = np.einsum("nij,nj->ni", F[:, :3, :3], cl) + F[:, :3, 3]
+    i, j = P[:, 0], P[:, 1]
+    RA, RB = F[i, :3, :3], F[j, :3, :3]
+    eA, eB = e[i], e[j]
+    R = np.einsum("nki,nkj->nij", RA, RB)                  # B's axes in A's frame
+    t = np.einsum("nki,nk->ni", RA, c[j] - c[i])           # B's centre in A's frame
+    AR = np.abs(R) + 1e-9
+    sep = np.zeros(len(P), bool)
+    for k in range(3):
+        sep |= np.abs(t[:, k]) > eA[:, k] + np.einsum("nj,nj->n", eB, AR[:, k, :])
+        sep |= np.abs(np.einsum("ni,ni->n", t, R[:, :, k])) > np.einsum("ni,ni->n", eA, AR[:, :, k]) + eB[:, k]
+    for a in range(3):
+        a1, a2 = (a + 1) % 3, (a + 2) % 3
+        for b in range(3):
+            b1, b2 = (b + 1) % 3, (b + 2) % 3
+            ra = eA[:, a1] * AR[:, a2, b] + eA[:, a2] * AR[:, a1, b]
+            rb = eB[:, b1] * AR[:, a, b2] + eB[:, b2] * AR[:, a, b1]
+            sep |= np.abs(t[:, a2] * R[:, a1, b] - t[:, a1] * R[:, a2, b]) > ra + rb
+    ok = ~sep & np.all(np.isfinite(e[i]) & np.isfinite(e[j]), axis=1)
+    return [(int(x), int(y)) for x, y in P[ok]]
+
+
+__all__ = ["box_pairs", "local_boxes", "obb_overlap", "part_frames", "posed_boxes", "solid_boxes"]
