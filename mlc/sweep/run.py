@@ -150,6 +150,11 @@ def run_sweep(spec: SweepSpec, outdir, scheduler: str | None = None, workers: in
               retry_failed: bool = False, progress: bool | None = None, log=None) -> dict:
     """Run the spec's missing runs; returns {"runs", "skipped", "ran", "failed", "table"}."""
     from mlc.io.progress import Progress
+    try:
+        import dask.distributed  # noqa: F401
+    except ImportError:
+        raise MlcError("mlc sweep runs on Dask, which is not installed", None,
+                       "pip install 'mlc[sweep]' (or pip install 'dask[distributed]')") from None
     out = Path(outdir)
     if out.exists() and not out.is_dir():
         raise MlcError("the output location exists and is not a directory", "-o", "give a directory")
