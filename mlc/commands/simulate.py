@@ -86,7 +86,10 @@ def run(args) -> int:
     if args.threads < 1:
         raise MlcError(f"--threads must be >= 1, got {args.threads}", "--threads")
     import os
-    cores = os.cpu_count() or 1
+    try:
+        cores = len(os.sched_getaffinity(0))       # the cores this process may use
+    except (AttributeError, OSError):
+        cores = os.cpu_count() or 1
     if args.threads > max(cores, 1):
         raise MlcError(f"--threads {args.threads} is more than the {cores} cores of this machine", "--threads",
                        f"use at most {cores}")

@@ -321,6 +321,7 @@ def check_against_scene(prof: Profile, scene, where: str = "--profile", options:
       times its width in sigma), or a slab thickness, wall, clearance or knuckle gap of more than
       half of it: the parts would not fit between each other (a 2 mm slab on the 2.5 mm slabs of
       NAND at sigma 5 mm ran for more than 30 s; 1.2 mm took 6 s);
+    * a knuckle gap below the clearance (knuckles of different parts closer than the clearance);
     * hinges wider across (pin + 2 clearance + 2 walls) than the narrowest slab: the knuckles of
       neighbouring hinges would overlap, and the trimming that follows runs for minutes (NAND at
       sigma 4 mm: more than 30 s and 0.8 GB; at 5 mm, 2.2 mm hinges on 2.5 mm slabs: 4 s);
@@ -365,6 +366,13 @@ def check_against_scene(prof: Profile, scene, where: str = "--profile", options:
             else:
                 fix = f"use {f} <= {part * W:.3g} mm, or sigma_mm >= {s_min:.3g}"
             raise MlcError(f"{msg}: {at}", opt(f), fix)
+    if prof.knuckle_gap < prof.clearance:
+        f = "clearance" if "clearance" in options and "knuckle_gap" not in options else "knuckle_gap"
+        raise MlcError(f"knuckle_gap {prof.knuckle_gap:g} mm is less than the clearance {prof.clearance:g} mm: "
+                       f"consecutive knuckles belong to different parts, which must stay a clearance apart "
+                       f"(every knuckle would be trimmed: a single hinge then takes 20 s instead of 2 s)", opt(f),
+                       f"use knuckle_gap >= {prof.clearance:g} mm" if f == "knuckle_gap" else
+                       f"use clearance <= {prof.knuckle_gap:g} mm, or raise knuckle_gap with it")
     est = estimate_memory(prof, scene)
     budget = memory_budget()
     if est["bytes"] > budget:
