@@ -869,10 +869,17 @@ def test_generated_hostile_numbers(cmd, opt, value, scene_text, hinge_scene, tmp
             argv += [f"{o}={value}"]
         elif default is not None:
             argv += [o, default]
-    code, _, err = run(capsys, *argv)
+    import warnings
+    with warnings.catch_warnings(record=True) as caught:      # a warning would be a second stderr line
+        warnings.simplefilter("always")
+        code, _, err = run(capsys, *argv)
+    assert not [w for w in caught if issubclass(w.category, RuntimeWarning)], [str(w.message) for w in caught]
     assert "Traceback" not in err and "internal error" not in err, err
     if code == 2:
-        assert err.strip().splitlines()[-1].startswith("mlc: error: "), err
+        lines = err.splitlines()
+        assert lines[-1].startswith("mlc: error: ") and err.endswith("\n"), err
+        # one line, after argparse's usage for a value that is not a number
+        assert all(line.startswith(("usage: ", " ")) for line in lines[:-1]), err
         assert listing(d) == {}, "a failed run wrote something"
     else:
         assert code in (0, 1), (code, err)

@@ -19,8 +19,11 @@ def register(sub):
 
 
 def run(args) -> int:
+    import numpy as np
+
     from mlc.geometry.lever import solve_lever
-    sol = solve_lever(args.lin, args.lout, args.dlin, args.dlout, args.l, args.type)
+    with np.errstate(all="ignore"):     # lengths near 1e308 overflow: reported as "no lever", not as warnings
+        sol = solve_lever(args.lin, args.lout, args.dlin, args.dlout, args.l, args.type)
     d = sol.to_dict()
     d["residual"] = float(abs(sol.residuals()).max())
     if args.json:

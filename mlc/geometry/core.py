@@ -88,14 +88,14 @@ def _f(phi, din: float, h: float):
     """Height of d above h with one input actuated (vectorised over ``phi``; NaN where
     the linkage cannot close)."""
     phi = np.asarray(phi, dtype=float)
-    s = np.sin(phi)
-    x = h - np.cos(phi)
-    L = 1.0 + din
-    cx = (1 + 4 * s * s - L * L) / (4 * s)      # from a, |ac| = 1 (rest input), |bc| = L
-    cy2 = 1 - cx * cx
-    q = x * x - (s - cx) ** 2
-    bad = (x <= 0) | (cy2 < 0) | (q < 0)
-    with np.errstate(invalid="ignore"):
+    with np.errstate(all="ignore"):      # huge din or h overflow to inf: no solution there, no warning
+        s = np.sin(phi)
+        x = h - np.cos(phi)
+        L = 1.0 + din
+        cx = (1 + 4 * s * s - L * L) / (4 * s)      # from a, |ac| = 1 (rest input), |bc| = L
+        cy2 = 1 - cx * cx
+        q = x * x - (s - cx) ** 2
+        bad = (x <= 0) | (cy2 < 0) | (q < 0) | ~np.isfinite(q) | ~np.isfinite(cy2)
         out = np.sqrt(cy2) + np.sqrt(q) - h
     out = np.where(bad, np.nan, out)
     return float(out) if out.ndim == 0 else out
