@@ -883,3 +883,60 @@ def test_generated_hostile_numbers(cmd, opt, value, scene_text, hinge_scene, tmp
         assert listing(d) == {}, "a failed run wrote something"
     else:
         assert code in (0, 1), (code, err)
+
+
+# generated: every output option of every command against every kind of bad location
+OUTPUT_OPTIONS = {
+    # (argv before the output option, option, suffix the option writes)
+    "draw -o": (["draw", "NAND"], "-o", ".png"),
+    "gate -o": (["gate", "NAND"], "-o", ".yaml"),
+    "core --plot": (["core"], "--plot", ".png"),
+    "core --data": (["core"], "--data", ".json"),
+    "simulate --out": (["simulate", "{scene}", "--time", "0.1", "--quiet"], "--out", ".gsd"),
+    "simulate --probes": (["simulate", "{scene}", "--time", "0.1", "--quiet"], "--probes", ".csv"),
+    "stl -o": (["stl", "{hinge}"], "-o", ".stl"),
+    "stl --3mf": (["stl", "{hinge}"], "--3mf", ".3mf"),
+    "stl --report": (["stl", "{hinge}"], "--report", ".json"),
+}
+BAD_LOCATIONS = {
+    # name: (path maker given the output directory and the suffix, words)
+    "directory": (lambda d, sfx: d, ["is a directory"]),
+    "missing_directory": (lambda d, sfx: d / "no" / f"x{sfx}", ["does not exist"]),
+    "parent_is_file": (lambda d, sfx: d / "f.txt" / f"x{sfx}", ["not a directory"]),
+    "proc": (lambda d, sfx: Path(f"/proc/mlc-x{sfx}"), ["cannot write in /proc"]),
+    "dev_full": (lambda d, sfx: Path("/dev/full"), ["/dev/full"]),
+    "wrong_suffix": (lambda d, sfx: d / "x.txt", ["must end in {sfx}"]),
+    "empty": (lambda d, sfx: "", ["empty output path"]),
+    "the_input": (lambda d, sfx: "{input}", []),
+}
+
+
+@pytest.mark.parametrize("where", sorted(BAD_LOCATIONS))
+@pytest.mark.parametrize("what", sorted(OUTPUT_OPTIONS))
+def test_generated_bad_output_locations(what, where, scene_text, hinge_scene, tmp_path, capsys):
+    """Refused before the work (fast), naming the option; nothing written anywhere."""
+    pre, option, sfx = OUTPUT_OPTIONS[what]
+    make, words = BAD_LOCATIONS[where]
+    src = tmp_path / f"s{sfx}"                 # an input named like the output, for "the_input"
+    src.write_text(scene_text)
+    d = tmp_path / "out"
+    d.mkdir()
+    (d / "f.txt").write_text("keep")
+    before, before_top = listing(d), listing(tmp_path)
+    inp = {"simulate": src, "stl": hinge_scene}.get(pre[0])
+    if where == "the_input":
+        if inp is None:
+            pytest.skip("this command reads no input file")
+        if pre[0] == "stl":
+            target = hinge_scene.with_suffix(sfx)
+            target.write_text(hinge_scene.read_text())
+            inp = target
+        out = inp
+    else:
+        out = make(d, sfx)
+    argv = [a.format(scene=src, hinge=inp or hinge_scene) for a in pre] + [option, out]
+    code, stdout, err = run(capsys, *argv)
+    assert_clean_failure(code, err, before, d, f"mlc: error: {option}", *[w.format(sfx=sfx) for w in words])
+    assert listing(tmp_path) == before_top or where == "the_input" and pre[0] == "stl"
+    if where == "the_input":
+        assert "is an input" in err or f"must end in {sfx}" in err, err

@@ -18,7 +18,7 @@ def register(sub):
 
 def run(args) -> int:
     from mlc.geometry.core import design_space, solve_core
-    if args.plot or args.data:
+    if args.plot is not None or args.data is not None:
         from mlc.io.outputs import Outputs
         from mlc.io.progress import Progress
         outs = Outputs()
