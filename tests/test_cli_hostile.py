@@ -772,6 +772,7 @@ def test_sigterm_leaves_nothing(tmp_path):
     deadline = _time.time() + 60
     while not any(tmp_path.iterdir()) and _time.time() < deadline:     # wait for the staging area
         _time.sleep(0.05)
+    _time.sleep(0.5)            # past the handler's installation, which follows the mkdir; the export takes ~20 s
     p.send_signal(signal.SIGTERM)
     err = p.communicate(timeout=60)[1]
     assert p.returncode == 130 and "mlc: interrupted" in err, err
