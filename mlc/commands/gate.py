@@ -142,23 +142,23 @@ def run_check(args) -> int:
         from mlc.verify.static import verify_scene
         from mlc.io.progress import Progress
         rows = []
-        bar = Progress("mlc check-gate", total=len(names) * len(signals)).__enter__()
-        for name in names:
-            for signal in signals:
-                bar.update(len(clear))
-                scene = gate_scene(name, signal)
-                worst, frac, poses = sweep_clearance(scene, grid=args.grid)
-                at_state = {"".join(str(int(v)) for v in f): rep for f, rep in poses if all(v in (0.0, 1.0) for v in f)}
-                for r in verify_scene(scene):
-                    rep = at_state[r["state"]]
-                    rows.append({"gate": name, "signal": signal, **r, "clearance": rep.min_clearance,
-                                 "ok": bool(r["ok"] and rep.ok())})
-                if args.branches:
-                    branch_rows.append(_branch_risk(scene, name, signal, args.kT))
-                clear.append({"gate": name, "signal": signal, "min_clearance": worst.min_clearance,
-                              "pair": list(worst.pair), "strokes": list(frac), "poses": len(poses),
-                              "overlaps": [[a, b, d] for a, b, d in worst.overlaps], "ok": worst.ok()})
-        bar.close()
+        with Progress("mlc check-gate", total=len(names) * len(signals)) as bar:
+            for name in names:
+                for signal in signals:
+                    bar.update(len(clear))
+                    scene = gate_scene(name, signal)
+                    worst, frac, poses = sweep_clearance(scene, grid=args.grid)
+                    at_state = {"".join(str(int(v)) for v in f): rep for f, rep in poses
+                                if all(v in (0.0, 1.0) for v in f)}
+                    for r in verify_scene(scene):
+                        rep = at_state[r["state"]]
+                        rows.append({"gate": name, "signal": signal, **r, "clearance": rep.min_clearance,
+                                     "ok": bool(r["ok"] and rep.ok())})
+                    if args.branches:
+                        branch_rows.append(_branch_risk(scene, name, signal, args.kT))
+                    clear.append({"gate": name, "signal": signal, "min_clearance": worst.min_clearance,
+                                  "pair": list(worst.pair), "strokes": list(frac), "poses": len(poses),
+                                  "overlaps": [[a, b, d] for a, b, d in worst.overlaps], "ok": worst.ok()})
         mode = "static"
     ok = all(r["ok"] for r in rows) and all(c["ok"] for c in clear)
     if args.json:

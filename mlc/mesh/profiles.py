@@ -361,7 +361,9 @@ def check_against_scene(prof: Profile, scene, where: str = "--profile", options:
     for f, part, v, msg in limits:
         if v > part * W * (1 + 1e-9):
             if f == "hinge" or (f not in options and "sigma_mm" in options):
-                fix = f"use sigma_mm >= {s_min:.3g}" + (", or a smaller pin, clearance or min_wall" if f == "hinge" else "")
+                fix = f"use sigma_mm >= {s_min:.3g}"
+                if f == "hinge":
+                    fix += ", or a smaller pin, clearance or min_wall"
                 f = f if f in options else "sigma_mm"
             else:
                 fix = f"use {f} <= {part * W:.3g} mm, or sigma_mm >= {s_min:.3g}"
