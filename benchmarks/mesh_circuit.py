@@ -1,0 +1,138 @@
+"""Printable meshes of compiled circuits: ``mlc stl`` of a whole circuit, timed by stage.
+
+    python benchmarks/mesh_circuit.py [--cases tetris,full_adder,expr] [--profile mjp]
+
+For each case the circuit is compiled (``mlc.pipeline``: load, synthesize, map, place and route)
+and meshed as ``mlc stl`` does it (``mlc.mesh.export_scene``: static verification of the logic
+states, build, printability report, STL + 3MF written with ``force`` so that the files exist
+even when a check fails).  Stages: ``poses_s`` (static verification: equilibrium poses of every
+mechanism, the same solves ``mlc stl`` makes), ``build_s`` (parts), ``report_s`` (checks),
+``write_s`` (STL + 3MF).  The files are then read back independently with trimesh: STL pieces,
+3MF named volumes, each watertight with its volume.
+
+Cases: ``tetris`` (examples/tetris.tt, the README's main job), ``full_adder``
+(examples/full_adder.tt), ``expr`` (the expression ``(a & b) | c``: two gates and one chain).
+Writes benchmarks/results/mesh_circuit.json (one row per case; a case that hits ``--limit``
+seconds is recorded as not finished).  Wall-clock seconds on the shared 2-core machine.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import multiprocessing as mp
+import os
+import platform
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+RESULTS = ROOT / "benchmarks" / "results"
+CASES = {"tetris": ("examples/tetris.tt", None), "full_adder": ("examples/full_adder.tt", None),
+         "expr": (None, "(a & b) | c")}
+
+
+def run_case(name: str, profile: str, queue, keep: str | None = None) -> None:
+    import numpy as np
+    import trimesh
+
+    from mlc import pipeline
+    from mlc.mesh import build as mbuild
+    from mlc.mesh import checks as mchecks
+    from mlc.mesh.export import part_meshes, read_3mf, write_outputs
+    from mlc.mesh.pipeline import export_assembly, split_mechanisms, state_poses
+    from mlc.mesh.profiles import load_profile
+
+    path, expr = CASES[name]
+    t0 = time.perf_counter()
+    scene = pipeline.build(pipeline.compile_spec(pipeline.load(str(ROOT / path) if path else None, expr))).circuit.scene
+    compile_s = time.perf_counter() - t0
+    prof = load_profile(profile)
+    mechs = split_mechanisms(scene)
+    # stage timers: wrap the two library stages export_assembly calls
+    timers = {"poses_s": 0.0, "build_s": 0.0, "report_s": 0.0}
+
+    def timed(fn, key):
+        def f(*a, **k):
+            t = time.perf_counter()
+            try:
+                return fn(*a, **k)
+            finally:
+                timers[key] += time.perf_counter() - t
+        return f
+
+    import mlc.mesh.pipeline as mp_
+    mp_.state_poses = timed(state_poses, "poses_s")
+    mp_.build_assembly = timed(mbuild.build_assembly, "build_s")
+    mp_.check_assembly = timed(mchecks.check_assembly, "report_s")
+    t1 = time.perf_counter()
+    asm, rep = export_assembly(scene, prof)
+    t2 = time.perf_counter()
+    with tempfile.TemporaryDirectory() as d:
+        d = keep or d
+        Path(d).mkdir(parents=True, exist_ok=True)
+        stl, mf3 = Path(d) / f"{name}.stl", Path(d) / f"{name}.3mf"
+        (Path(d) / f"{name}_report.json").write_text(json.dumps(rep.to_dict(), indent=1) + "\n")
+        meshes = part_meshes(asm)
+        write_outputs(asm, stl=stl, threemf=mf3, meshes=meshes)
+        t3 = time.perf_counter()
+        # independent read-back: trimesh on the STL (connected pieces) and the 3MF (named volumes)
+        whole = trimesh.load(str(stl), force="mesh")
+        pieces = whole.split(only_watertight=False)
+        vols = read_3mf(mf3)
+        sizes = {"stl_bytes": stl.stat().st_size, "threemf_bytes": mf3.stat().st_size}
+    row = {"case": name, "source": path or expr, "profile": profile, "bodies": len(scene.bodies),
+           "mechanisms": len(mechs), "inputs": len(scene.inputs), "parts": len(asm.parts),
+           "triangles": int(sum(len(m.faces) for _, m in meshes)), **sizes,
+           "ok": rep.ok, "failed_checks": [c.name for c in rep.checks if not c.ok],
+           "compile_s": round(compile_s, 2), **{k: round(v, 2) for k, v in timers.items()},
+           "mesh_s": round(t2 - t1, 2), "write_s": round(t3 - t2, 2), "total_s": round(t3 - t1, 2),
+           "readback": {"stl_pieces": len(pieces), "stl_pieces_watertight": int(sum(p.is_watertight for p in pieces)),
+                        "threemf_volumes": len(vols),
+                        "threemf_volumes_watertight": int(sum(m.is_watertight for _, m in vols)),
+                        "threemf_volume_mm3": round(float(sum(m.volume for _, m in vols)), 2),
+                        "report_volume_mm3": round(float(sum(p["volume_mm3"] for p in rep.parts)), 2),
+                        "smallest_part_mm3": round(float(np.min([m.volume for _, m in vols])), 4)},
+           "finished": True}
+    queue.put(row)
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--cases", default="expr,tetris,full_adder")
+    ap.add_argument("--profile", default="mjp")
+    ap.add_argument("--limit", type=float, default=1800.0, help="seconds per case before it is recorded unfinished")
+    ap.add_argument("--out", default=str(RESULTS / "mesh_circuit.json"))
+    ap.add_argument("--keep", metavar="DIR", help="keep the STL, 3MF and JSON report of each case in DIR")
+    args = ap.parse_args()
+    rows = []
+    for name in args.cases.split(","):
+        q = mp.get_context("fork").Queue()
+        t = time.perf_counter()
+        p = mp.get_context("fork").Process(target=run_case, args=(name, args.profile, q, args.keep))
+        p.start()
+        p.join(args.limit)
+        if p.is_alive():
+            p.terminate()
+            p.join()
+            row = {"case": name, "profile": args.profile, "finished": False,
+                   "note": f"stopped after {args.limit:g} s"}
+        else:
+            row = q.get() if not q.empty() else {"case": name, "finished": False, "note": f"exit {p.exitcode}"}
+        row["wall_s"] = round(time.perf_counter() - t, 1)
+        rows.append(row)
+        print(json.dumps(row), flush=True)
+    out = {"benchmark": "mesh_circuit", "python": platform.python_version(), "machine": platform.machine(),
+           "cpus": os.cpu_count(), "load_average": [round(x, 2) for x in os.getloadavg()],
+           "note": "wall-clock seconds on a shared 2-core machine (other jobs running); mesh_s = mlc stl's "
+                   "export_assembly (poses + build + report), write_s = STL + 3MF", "rows": rows}
+    Path(args.out).parent.mkdir(parents=True, exist_ok=True)
+    Path(args.out).write_text(json.dumps(out, indent=2) + "\n")
+    return 0 if all(r.get("finished") for r in rows) else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())
