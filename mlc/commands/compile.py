@@ -119,6 +119,10 @@ def format_summary(d: dict) -> str:
         v = d["verification"]
         lines.append(f"verification ({v['mode']}): {'all ' + str(v['rows']) + ' rows correct' if v['ok'] else 'FAILED'}"
                      f" in {v['seconds']:.1f} s")
+    if d.get("robot"):
+        r = d["robot"]
+        lines.append(f"robot: {r['units']} skeleton units, {r['chains']} coupling chains ({r['half_units']} half units), "
+                     f"{r['bodies']} bodies in robot.yaml")
     lines.append("wrote " + ", ".join(d["files"]))
     return "\n".join(lines)
 
@@ -189,6 +193,10 @@ def run(args) -> int:
                            f"{spec.source}", "this is a bug in mlc's circuit back end: please report it")
     written = outs.written
     d = summary(c, written, args.level)
+    if args.robot:
+        rm = scene.meta["robot"]
+        d["robot"] = {"units": rm["units"], "chains": rm["chains"], "half_units": rm["half_units"],
+                      "bodies": len(scene.bodies)}
     if report is not None:
         d["verification"] = {"mode": report.mode, "ok": report.ok, "rows": len(report.rows),
                              "seconds": report.seconds, **report.params}
