@@ -42,23 +42,39 @@ def draw_skeleton(ax, scene, pos, quat, title: str = "", cells=None):
         b = scene.bodies[i]
         Rb = quat_to_matrix(quat[i])
         k = order.get(b.name)
-        col = "#555555" if b.name == rm["links"][0] else _COLOURS[(int(b.name[6:]) if b.name.startswith("skel_u")
-                                                                   else int(b.name[6:]) + 1) % 2]
+        # a unit is a joint piece (yellow) and a link (blue); the body grey
+        col = "#555555" if b.name == rm["links"][0] else _COLOURS[1 if b.name.startswith("skel_u") else 0]
         for box in b.boxes:
-            f = box_faces(box, pos[i], Rb)[1]            # the top face
+            faces = box_faces(box, pos[i], Rb)
+            f = max(faces, key=lambda F: float(((F - o) @ R)[:, 2].mean()))     # the face on top
             loc = (f - o) @ R                            # into the skeleton's plane frame
             polys.append(loc[:, :2])
             cols.append(col)
         del k
-    for c in cells or []:
-        ax.add_patch(Rectangle(((c[0] - 0.5) * l, (c[1] - 0.5) * l), l, l, facecolor="#dddddd",
-                               edgecolor="#bbbbbb", zorder=0))
-    ax.add_patch(Rectangle((-0.5 * l, -0.5 * l), l, l, facecolor="#bbbbbb", edgecolor="#999999", zorder=0))
+    if cells:
+        # the expected pose as grid cells, in an inset (the two-hinge joints pivot at the
+        # units' corners, so the folded skeleton is not centred on the cells)
+        ins = ax.inset_axes([0.68, 0.02, 0.3, 0.3])
+        for k, c in enumerate([(0, 0)] + [tuple(c) for c in cells]):
+            ins.add_patch(Rectangle((c[0] - 0.45, c[1] - 0.45), 0.9, 0.9, facecolor="#555555" if k == 0 else
+                                    _COLOURS[1], alpha=0.6))
+        xs = [c[0] for c in cells] + [0]
+        ys = [c[1] for c in cells] + [0]
+        ins.set_xlim(min(xs) - 0.6, max(xs) + 0.6)
+        ins.set_ylim(min(ys) - 0.6, max(ys) + 0.6)
+        ins.set_aspect("equal")
+        ins.set_xticks([])
+        ins.set_yticks([])
+        ins.set_title("expected", fontsize=6, pad=1)
     ax.add_collection(PolyCollection(polys, facecolors=cols, edgecolors="k", linewidths=0.3, zorder=2))
     ax.set_aspect("equal")
     ax.set_title(title, fontsize=9)
-    ax.set_xlim(-0.75 * l, 4.75 * l)
-    ax.set_ylim(-2.25 * l, 2.25 * l)
+    n = int(rm["units"])
+    pts = np.concatenate(polys)
+    span = max((n + 1.5) * l, float(np.ptp(pts[:, 0])) + 2, float(np.ptp(pts[:, 1])) + 2)
+    cx, cy = 0.5 * (pts[:, 0].min() + pts[:, 0].max()), 0.5 * (pts[:, 1].min() + pts[:, 1].max())
+    ax.set_xlim(cx - 0.5 * span, cx + 0.5 * span)
+    ax.set_ylim(cy - 0.5 * span, cy + 0.5 * span)
     ax.tick_params(labelsize=6)
 
 
