@@ -121,5 +121,8 @@ def run_fold(args) -> int:
     print(f"row {args.row}: after {args.time:g} t0 the skeleton reads {shape['shape_read']} (expected "
           f"{shape['shape_expected']}), turns {shape['turns_read']} deg, largest DOF error "
           f"{shape['max_dof_error_deg']:.2f} deg")
-    print(f"wrote {', '.join(outs.written)}")
+    shown = [w for w in outs.written if not (pdir is not None and w.startswith(str(args.png_dir)))]
+    if pdir is not None:
+        shown.append(f"{args.png_dir}/frame_*.png ({args.frames} frames)")
+    print(f"wrote {', '.join(shown)}")
     return 0                 # a picture, not a check: mlc verify --dynamic is the check
