@@ -141,3 +141,28 @@ def test_lever_triangle_by_the_law_of_cosines(L0, L1):
 def test_no_lever_for_a_contracting_signal():
     with pytest.raises(MlcError, match="no lever triangle"):
         dof_geometry(1.0, 0.5, 2.0)
+
+
+def _tt_table(path):
+    """The rows of a .tt file, read directly from its text (independent of mlc.front)."""
+    ins = outs = None
+    table = {}
+    for ln in Path(path).read_text().splitlines():
+        ln = ln.split("#")[0].strip()
+        if ln.startswith(".inputs"):
+            ins = ln.split()[1:]
+        elif ln.startswith(".outputs"):
+            outs = ln.split()[1:]
+        elif "|" in ln:
+            a, b = ln.split("|")
+            table["".join(a.split())] = "".join(b.split())
+    return SimpleNamespace(inputs=ins, outputs=outs, truth_table=table)
+
+
+@pytest.mark.parametrize("name", ["tetris", "snake3"])
+def test_example_robots_agree_with_their_logic(name):
+    logic = _tt_table(ROOT / "examples" / f"{name}.tt")
+    spec = load_robot(ROOT / "examples" / f"{name}.robot.yaml", logic)
+    assert len(spec.poses) == 2 ** len(logic.inputs)
+    # every row a different pose (snake3: 3 inputs, 8 poses)
+    assert len({tuple(p.turns) for p in spec.poses.values()}) == len(spec.poses)
