@@ -54,8 +54,11 @@ def test_every_row_verifies_statically_and_reports_clearance(tetris):
     for row in rep.rows:
         assert row["joint_stretch"] < 1e-3           # no gate strained by its wiring
         assert isinstance(row["clearance"], float) and row["clearance_ok"] == (row["clearance"] > -1e-6)
+        # the lanes keep every pair of slabs of different bodies apart in every row (exact box test)
+        assert row["clearance"] > 0, (row["state"], row["clearance_pair"])
     strict = verify_static(tetris[2].scene, rows=["11"], require_clearance=True)
-    assert strict.ok == strict.rows[0]["clearance_ok"]
+    assert strict.ok and strict.rows[0]["clearance_ok"]
+    assert tetris[2].scene.meta["connector"]["tight_chains"] == []
 
 
 def test_a_swapped_gate_is_caught(tetris):

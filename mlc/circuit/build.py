@@ -36,19 +36,28 @@ from functools import lru_cache
 import numpy as np
 
 from mlc.errors import MlcError
-from mlc.gates.connector import (ConnectorGeometry, Pair, Parts, branch_angles, chain_parts, connector_geometry,
+from mlc.gates.connector import (POST_WIDTH, ConnectorGeometry, Pair, Parts, branch_angles, chain_parts, connector_geometry,
                                  half_unit_parts, join, max_bend, rotate)
 from mlc.gates.parts import slab_body
 from mlc.scene.model import Body, Bond, Muscle, Probe, Scene
 
 MAX_GATES = 2000            # larger netlists are refused (the scene would not fit a verification)
 MAX_INPUTS = 14             # the scene's truth table lists every row
-LEVEL_PITCH = 12.0          # sigma between logic levels (z)
+LEVEL_PITCH = 18.5          # sigma between logic levels (z), plus LAYER_PITCH per route arriving
 GATE_PITCH = 12.0           # sigma between gates of one level (x)
-TERMINAL_POST = 0.6         # sigma: the last half unit's layer stays this far below a lever's plane
+TERMINAL_POST = 0.8         # sigma: the last half unit's layer stays this far below a lever's plane
+LEVER_STOP = 0.35           # sigma: the last posts stop this short of a lever's joint sites (the lever is 0.5 wide)
+PAGE_CLEAR = 0.2           # sigma: extra post length that keeps a branch page clear of the driving lever
 LAYER_PITCH = 2.5           # sigma between the horizontal layers of the routes into one level
-RISER_Y = -5.0              # sigma: plane (y) of the routes' vertical runs, in front of the gates
-RUN_Y = -8.5                # sigma: plane (y) of their horizontal runs
+RUN_LIFT = 1.0              # sigma: the lowest run of a level sits this far above mid-gap (clear of the taps)
+PLANE_TRIES = 4             # routing planes tried per chain before keeping the best
+LANE_BEND = 0.6             # bends of a routed chain stay within this fraction of the largest (floppy slack)
+TURN_RADIUS = 5.0           # sigma: lane corners are rounded to this radius (a chain turns 90 degrees in ~6 sigma)
+WAYPOINT_STEP = 2.0         # sigma between the lane points a chain is pulled towards
+WAYPOINT_WEIGHT = 0.5       # their weight in the inverse kinematics
+END_JUNCTIONS, END_BEND = 4, 0.4   # the last 4 junctions bend at most 0.4 of the largest bend (lever travel)
+LANE_EXTRAS = (0, 4, 8)     # chain lengths (half units beyond the steered guess) tried in a plane before the next
+LAYER_RADIUS = 0.9          # sigma: bounds a half unit's layer with its posts (reach 0.75, half pitch 0.5)
 PIN_SPREAD = 2.5            # sigma: a gate's two input chains arrive this far apart in x
 RISER_PITCH = 3.5           # sigma between the risers of the routes from one tap (x)
 # Gates are turned by +90 degrees about z (gate x -> world y): every output pair's axis is
@@ -157,7 +166,8 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
     """One scene of the whole circuit, posed in the all-zero input row (see module doc)."""
     import time
 
-    from mlc.circuit.route import solve_route
+    from mlc.circuit.lanes import Lane, Lanes, Space, layer_centres, plane_y, rounded
+    from mlc.circuit.route import _fk, solve_route
 
     opt = options or CircuitOptions()
     t_start = time.perf_counter()
@@ -262,6 +272,11 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
     # ---- wires: branches, chains, output probes ----------------------------------------
     t_route = time.perf_counter()
     n_chains = n_half = 0
+    lanes = Lanes()
+    space = Space(LAYER_RADIUS)
+    space_clear = 2.0 * LAYER_RADIUS
+    tight: list = []                        # chains that could not be kept apart by the lanes
+    depth_of = {g.id: g.depth for g in netlist.gates}
     wires = [w for w in taps if consumers.get(w)]
     for wi, wire in enumerate(wires):
         if progress:
@@ -270,6 +285,7 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
         cons = consumers[wire]
         wname = wire[1]
         state_at_tap = zero[wire] ^ pol
+        stop_at_tap = LEVER_STOP if wire[0] == "gate" else POST_WIDTH     # a gate's tap is on its lever
         up = np.array([0.0, 0.0, 1.0])
         t_up = up - float(up @ tap.axis) * tap.axis
         t_up /= np.linalg.norm(t_up)
@@ -281,17 +297,23 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
                 return xpos[("gate", c[1])]
             return xpos[wire]
         cons = sorted(cons, key=cx)
+        # an output that reads the tap's own polarity is a probe across the tap: no page
+        for c in [c for c in cons if c[0] == "out" and c[2] == pol]:
+            probes.append(Probe(c[1], c[1], tap.lo, tap.hi, geo.L0, geo.L1))
+        cons = [c for c in cons if not (c[0] == "out" and c[2] == pol)]
+        if not cons:
+            continue
         if len(cons) == 1:
             starts = [(tap, pol, True, rotate(t_up, tap.axis, sgn * math.radians(45.0)), None)]
         else:
             starts = []
             angs = branch_angles(len(cons))
             spread = abs(angs[1] - angs[0])
-            post = max(geo.branch_post, geo.reach / math.tan(0.5 * spread) + 0.25)
+            post = max(geo.branch_post, geo.reach / math.tan(0.5 * spread) + 0.25) + PAGE_CLEAR
             for k, (c, ang) in enumerate(zip(cons, angs)):
                 t = rotate(t_up, tap.axis, sgn * ang)
                 parts, pin, pout = half_unit_parts(f"w_{wname}_p{k}", tap.centre, tap.axis, t, state_at_tap, geo,
-                                                   in_post=post)
+                                                   in_post=post, in_stop=stop_at_tap)
                 parts.bonds += join(f"w_{wname}_p{k}_j", tap, pin, geo.k)
                 add(parts)
                 n_half += 1
@@ -304,7 +326,8 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
                 extra = spol ^ need
                 end = start
                 if extra:
-                    parts, pin, pout = half_unit_parts(f"{tag}_stub", start.centre, start.axis, t0, sstate, geo)
+                    parts, pin, pout = half_unit_parts(f"{tag}_stub", start.centre, start.axis, t0, sstate, geo,
+                                                       in_stop=stop_at_tap if start is tap else POST_WIDTH)
                     parts.bonds += join(f"{tag}_stub_j", start, pin, geo.k)
                     add(parts)
                     n_half += 1
@@ -315,28 +338,54 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
             target = _pair(by_name, f"{gid}_{pin_name}_lo.in", f"{gid}_{pin_name}_hi.in")
             ext = TERMINAL_POST - 0.5 * geo.gap
             app = np.array([0.0, 0.0, 1.0])
-            d_sink = next(g.depth for g in netlist.gates if g.id == gid)
+            d_sink = depth_of[gid]
             k_layer = layer_next[d_sink]
             layer_next[d_sink] += 1
-            z_run = zlevel[d_sink - 1] + 0.5 * opt.level_pitch + LAYER_PITCH * k_layer
+            z_run = zlevel[d_sink - 1] + 0.5 * opt.level_pitch + RUN_LIFT + LAYER_PITCH * k_layer
             x_rise = tap.centre[0] + RISER_PITCH * (k - 0.5 * (len(starts) - 1))
             xp, yp, zp = target.centre
             # the two inputs of a gate sit at one x (they differ in y): come in from either side
             side = -1.0 if pin_name == "a" else 1.0
             x_in = xp + side * PIN_SPREAD
-            wps = [(x_rise, RISER_Y, start.centre[2] + 3.0), (x_rise, RISER_Y, z_run - 1.5),
-                   (x_rise, RUN_Y, z_run), (x_in, RUN_Y, z_run), (x_in, yp - 2.0, zp - 4.0)]
-            route = solve_route(start.centre, start.axis, target.centre, target.axis, geo, spol, waypoints=wps,
+            lane = Lane(x_rise, start.centre[2] + 3.0, z_run, x_in, zp - 8.0)
+            sbm = math.radians(50.0) if len(starts) == 1 else 0.75 * max_bend(geo)
+            plane = lanes.assign(lane)
+            route = None
+            best = (-math.inf, None, plane)
+            for attempt in range(PLANE_TRIES):
+                y_k = plane_y(plane)
+                corners = [(x_rise, y_k, lane.z_a), (x_rise, y_k, z_run), (x_in, y_k, z_run),
+                           (x_in, y_k, lane.z_in), (xp + side * 1.0, yp - 1.0, zp - 6.0)]
+                wps = [tuple(p) for p in rounded(corners, TURN_RADIUS, WAYPOINT_STEP)]
+                r = solve_route(start.centre, start.axis, target.centre, target.axis, geo, spol, waypoints=wps,
                                 tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
-                                start_bend_max=math.radians(50.0) if len(starts) == 1 else 0.75 * max_bend(geo))
+                                start_bend_max=sbm, extras=LANE_EXTRAS, bend_max=LANE_BEND * max_bend(geo),
+                                end_bends=(END_JUNCTIONS, END_BEND * max_bend(geo)), wp_weight=WAYPOINT_WEIGHT)
+                if r is not None:
+                    cs, _, _ = _fk(r.centre, r.axis, r.tangent, r.bends,
+                                   [geo.pitch] * (len(r.bends) - 1) + [geo.pitch + ext])
+                    gap_ = space.nearest(layer_centres(cs), tag)
+                    if gap_ > best[0]:
+                        best = (gap_, r, plane)
+                    if gap_ >= space_clear:
+                        break
+                plane = lanes.assign(lane, plane + 1)
+            gap_, route, plane = best
             if route is None:        # the lanes are a preference: route straight if they cannot be kept
                 route = solve_route(start.centre, start.axis, target.centre, target.axis, geo, spol,
                                     tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
-                                    start_bend_max=math.radians(50.0) if len(starts) == 1 else 0.75 * max_bend(geo))
+                                    start_bend_max=sbm)
             if route is None:
                 raise MlcError(f"cannot route wire {wname} to {gid}.{pin_name}: no connector chain reaches it",
                                netlist.source, "this is a placement limit of mlc; please report the netlist")
-            parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, sstate, geo)
+            lanes.take(lane, plane)
+            cs, _, _ = _fk(route.centre, route.axis, route.tangent, route.bends,
+                           [geo.pitch] * (len(route.bends) - 1) + [geo.pitch + ext])
+            space.add(layer_centres(cs), tag)
+            if gap_ < space_clear:
+                tight.append((tag, round(float(gap_), 3)))
+            parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, sstate, geo,
+                                       in_stop=stop_at_tap if start is tap else POST_WIDTH)
             # the last half unit's output post is longer so its layer clears the lever plane:
             last = len(route.bends) - 1
             for b in list(parts.bodies):
@@ -346,7 +395,8 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
             cs_in = pairs[-2]
             t_last = (pairs[-1].centre - cs_in.centre) / np.linalg.norm(pairs[-1].centre - cs_in.centre)
             lp, lin, lout = half_unit_parts(f"{tag}_{last}", cs_in.centre, cs_in.axis, t_last,
-                                            sstate ^ (last % 2), geo, out_post=0.5 * geo.gap + ext)
+                                            sstate ^ (last % 2), geo, out_post=0.5 * geo.gap + ext,
+                                            out_stop=LEVER_STOP)
             parts.add(lp)
             parts.bonds += join(f"{tag}_j0", start, pairs[0], geo.k)
             add(parts)
@@ -379,7 +429,8 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
                         "gates": {g.id: {"type": g.type, "origin": [float(v) for v in origin[g.id]],
                                          "depth": g.depth} for g in netlist.gates},
                         "connector": {"gap": geo.gap, "side": round(geo.side, 6), "chains": n_chains,
-                                      "half_units": n_half}})
+                                      "half_units": n_half, "planes": 1 + max((k for k, _ in lanes.placed), default=-1),
+                                      "tight_chains": [t for t, _ in tight]}})
     scene.check()
     t_end = time.perf_counter()
     return Circuit(scene, origin, n_chains, n_half,

@@ -28,6 +28,8 @@ from mlc.gates.connector import ConnectorGeometry, chain_frames, max_bend, rotat
 
 BEND_FRACTION = 0.75         # routing bends at most this fraction of the geometric largest bend
 EXACT = 1e-7                 # sigma: the last pair must land this close
+PASSES = (1.0, 1e-3)         # weights of the soft terms: shape the chain, then close it exactly
+DEBUG = False
 
 
 @dataclass
@@ -95,13 +97,28 @@ def _steer(c0, u0, t0, guide, pitch, bmax, free_start, max_half):
         u = np.cross(t, u)
         if float(np.linalg.norm(end - c)) < 0.75 * pitch and seg[j] > seg[-1] - 3 * pitch:
             break
+        if seg[j] >= seg[-1] - 1e-9 and float(np.linalg.norm(end - c)) < 3.0 * pitch:
+            break                   # passed the guide's end close by: the solve closes the rest
+        if i * pitch > 2.0 * seg[-1] + 20.0 * pitch:
+            break                   # lost the guide: stop (the solve starts from here)
     return bends
 
 
-def solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int, *,
+def solve_route(*args, **kw) -> Route | None:
+    """See :func:`_solve_route`; a chain steered far off (a failed length) may overflow on
+    the way, which only means that length does not close: the warnings are not shown."""
+    import warnings
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return _solve_route(*args, **kw)
+
+
+def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int, *,
                 tangent=None, free_start: bool = True, approach=None, waypoints=(),
                 min_half: int = 2, max_half: int = 400, bend_max: float | None = None,
-                last_pitch: float | None = None, start_bend_max: float = math.radians(50.0)) -> Route | None:
+                last_pitch: float | None = None, start_bend_max: float = math.radians(50.0),
+                extras=(0, 2, 4, 8, 12, 16, 24), end_bends: tuple[int, float] | None = None,
+                 wp_weight: float = 0.3) -> Route | None:
     """A chain from pair (c0, u0) to pair (target_c, +-target_a) with ``n % 2 == parity``
     half units; None when no chain closes.
 
@@ -110,7 +127,11 @@ def solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int,
     otherwise it is fixed.
     ``approach``: unit vector the last tangent should follow.  ``waypoints``: points the
     chain should pass (in order).  The bends are first found by steering along a smooth
-    guide curve through the waypoints, then refined by inverse kinematics."""
+    guide curve through the waypoints, then refined by inverse kinematics.  ``extras``:
+    the chain lengths tried, in half units beyond the steered guess (fewer: faster failure).
+    ``wp_weight``: weight of the waypoints against the exact equations (10).
+    ``end_bends = (m, b)``: the last ``m`` junctions bend at most ``b`` (rad), leaving room
+    for the consumer's lever to move the chain's end between rows."""
     c0, u0 = np.asarray(c0, float), np.asarray(u0, float) / np.linalg.norm(u0)
     P, a = np.asarray(target_c, float), np.asarray(target_a, float) / np.linalg.norm(target_a)
     e1, e2 = _perp_basis(a)
@@ -135,7 +156,7 @@ def solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int,
                             for i in range(len(knots) - 1)] + [P[None]])
     guess = _steer(c0, u0, t0, guide, geo.pitch, bmax, free_start and start_bend_max, max_half)
     best = None
-    for extra in (0, 2, 4, 8, 12, 16, 24):
+    for extra in extras:
         n = max(min_half, len(guess) + extra)
         if n % 2 != parity:
             n += 1
@@ -147,9 +168,12 @@ def solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int,
         wps = [(max(1, min(n - 1, int(np.argmin(np.linalg.norm(cs_g - np.asarray(w, float), axis=1))))),
                 np.asarray(w, float)) for w in waypoints]
         try:
-            r = _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start and start_bend_max, wps)
+            r = _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start and start_bend_max, wps,
+                         end_bends, wp_weight)
         except ValueError:          # a degenerate start (non-finite residuals): try the next length
             continue
+        if DEBUG:
+            print("len", n, "error", r.error, "approach", r.approach_error)
         if r.error < EXACT and r.approach_error < 0.5:
             return r
         if best is None or r.error < best.error:
@@ -205,9 +229,13 @@ def _fk(c0, u0, t0, b, pitch):
     return cs, us, ts
 
 
-def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=()) -> Route:
+def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=(), end_bends=None,
+             wp_weight=0.3) -> Route:
     lo = np.full(n, -bmax)
     hi = np.full(n, bmax)
+    if end_bends is not None:                  # (count, bound): the last junctions bend less
+        m, eb = end_bends
+        lo[-m:], hi[-m:] = -eb, eb
     lim0 = float(free_start) if free_start else 1e-12      # free_start: the first bend's bound (rad)
     lo[0], hi[0] = -lim0, lim0
 
@@ -217,7 +245,7 @@ def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=(
         if app is not None:
             out.append(w_soft * 2.0 * (ts[-1] - app))
         for k, p in wps:
-            out.append(w_soft * 0.3 * (cs[k] - p))
+            out.append(w_soft * wp_weight * (cs[k] - p))
         out.append(w_soft * 0.05 * np.asarray(b[1:]))
         return np.concatenate([np.ravel(x) for x in out])
 
@@ -234,21 +262,28 @@ def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=(
         for k, _ in wps:
             d = np.cross(U, cs[k] - C).T
             d[:, idx >= k] = 0.0
-            rows.append(w_soft * 0.3 * d)
+            rows.append(w_soft * wp_weight * d)
         sm = np.zeros((n - 1, n))
         sm[np.arange(n - 1), np.arange(1, n)] = w_soft * 0.05
         rows.append(sm)
         return np.vstack(rows)
 
     x = np.clip(np.asarray(x0, float), lo + 1e-12, hi - 1e-12)
-    # two passes: soft terms on (shape the chain), then nearly off (close exactly)
-    for w_soft in (1.0, 1e-3):
+
+    def errors(x):
+        cs, us, ts = _fk(c0, u0, t0, x, pitches)
+        err = float(max(np.linalg.norm(cs[-1] - P), abs(us[-1] @ e1), abs(us[-1] @ e2)))
+        return err, (0.0 if app is None else float(np.linalg.norm(ts[-1] - app)))
+
+    # passes: soft terms on (shape the chain), then nearly off (close exactly); a last,
+    # short polish with the soft terms all but gone where the closure is not yet exact
+    for i, w_soft in enumerate(PASSES + (1e-7,)):
+        if i == len(PASSES) and errors(x)[0] < EXACT:
+            break
         res = least_squares(resid, x, jac=jac, bounds=(lo, hi), args=(w_soft,), method="trf", xtol=1e-15,
-                            ftol=1e-15, gtol=1e-15, max_nfev=300 if w_soft == 1.0 else 200)
+                            ftol=1e-15, gtol=1e-15, max_nfev=300 if i == 0 else (200 if i < len(PASSES) else 50))
         x = res.x
-    cs, us, ts = _fk(c0, u0, t0, x, pitches)
-    err = float(max(np.linalg.norm(cs[-1] - P), abs(us[-1] @ e1), abs(us[-1] @ e2)))
-    aerr = 0.0 if app is None else float(np.linalg.norm(ts[-1] - app))
+    err, aerr = errors(x)
     return Route(c0, u0, t0, [float(v) for v in x], err, aerr)
 
 

@@ -173,13 +173,16 @@ def _unit(v) -> np.ndarray:
 
 
 def half_unit_parts(prefix: str, centre, axis, tangent, state: int, geo: ConnectorGeometry,
-                    in_post: float | None = None, out_post: float | None = None) -> tuple[Parts, Pair, Pair]:
+                    in_post: float | None = None, out_post: float | None = None,
+                    out_stop: float = POST_WIDTH, in_stop: float = POST_WIDTH) -> tuple[Parts, Pair, Pair]:
     """One half unit whose input pair (centre ``centre``, axis ``axis``) carries ``state``.
 
     Slabs ``{prefix}_AB, _BC, _CD, _DA``; A and C are the input vertices (``-/+ axis``),
     D and B the output vertices (``-/+ v``, ``v = tangent x axis``).  The layer spans
     ``in_post .. in_post + width`` along ``tangent`` from the input pair; the output pair
-    sits ``out_post`` beyond it.  Returns (parts, input pair, output pair)."""
+    sits ``out_post`` beyond it.  The output (input) posts stop ``out_stop`` (``in_stop``) short of their joint
+    sites (where the joint part sits; longer where the pair meets a wide slab, such as a
+    gate's lever).  Returns (parts, input pair, output pair)."""
     g2 = 0.5 * geo.gap
     in_post = g2 if in_post is None else float(in_post)
     out_post = g2 if out_post is None else float(out_post)
@@ -206,7 +209,8 @@ def half_unit_parts(prefix: str, centre, axis, tangent, state: int, geo: Connect
         # (it stops POST_WIDTH short of the joint site, where the joint part sits)
         face = V[post] + (0.5 * w if post in "DB" else -0.5 * w) * t
         run = float(np.linalg.norm(J[post] - face))
-        end = J[post] + (face - J[post]) * (POST_WIDTH / run) if run > POST_WIDTH else face
+        stop = out_stop if post in "DB" else in_stop
+        end = J[post] + (face - J[post]) * (stop / run) if run > stop else face
         if np.linalg.norm(end - face) > 1e-6:
             body.boxes.append(segment_box(face - body.position, end - body.position, u if post in "DB" else v,
                                           POST_WIDTH, POST_WIDTH))
@@ -244,15 +248,19 @@ def chain_frames(centre, axis, tangent, bends, pitch: float):
 
 
 def chain_parts(prefix: str, centre, axis, tangent, bends, state: int, geo: ConnectorGeometry,
-                k: float | None = None, tolerance: float = 0.0) -> tuple[Parts, list[Pair]]:
+                k: float | None = None, tolerance: float = 0.0,
+                in_stop: float = POST_WIDTH) -> tuple[Parts, list[Pair]]:
     """A chain of ``len(bends)`` half units (see :func:`chain_frames`), the first input pair
     carrying ``state``.  Consecutive half units are joined by two universal joints.
-    Returns (parts, pairs) with pairs[0] the chain's input and pairs[-1] its output."""
+    ``in_stop``: how far the first half unit's input posts stop short of their joints (see
+    :func:`half_unit_parts`).  Returns (parts, pairs) with pairs[0] the chain's input and
+    pairs[-1] its output."""
     cs, us, ts = chain_frames(centre, axis, tangent, bends, geo.pitch)
     parts, pairs = Parts(), []
     k = geo.k if k is None else k
     for i, t in enumerate(ts):
-        p, pin, pout = half_unit_parts(f"{prefix}_{i}", cs[i], us[i], t, (state + i) % 2, geo)
+        p, pin, pout = half_unit_parts(f"{prefix}_{i}", cs[i], us[i], t, (state + i) % 2, geo,
+                                       in_stop=in_stop if i == 0 else POST_WIDTH)
         parts.add(p)
         if pairs:
             parts.bonds += join(f"{prefix}_j{i}", pairs[-1], pin, k)

@@ -1,0 +1,62 @@
+"""Routing lanes (mlc/circuit/lanes.py): plane assignment, rounded guides, the keep-apart test."""
+import numpy as np
+
+from mlc.circuit.lanes import SEP, Lane, Lanes, Space, layer_centres, plane_y, rounded
+
+
+def test_a_lane_on_top_of_another_goes_to_the_next_plane():
+    lanes = Lanes()
+    a = Lane(0.0, 5.0, 20.0, 10.0, 30.0)
+    assert lanes.assign(a) == 0
+    lanes.take(a, 0)
+    # its riser passes a's run: not in plane 0; its crossings stay clear of a, so plane 1
+    assert lanes.assign(Lane(5.0, 10.0, 21.0, -5.0, 25.0)) == 1
+    far = Lane(40.0, 5.0, 20.0, 50.0, 30.0)                         # far away in x: shares plane 0
+    assert lanes.assign(far) == 0
+    assert plane_y(1) < plane_y(0) < 0
+
+
+def test_a_crossing_through_a_nearer_plane_is_a_conflict():
+    lanes = Lanes()
+    riser = Lane(0.0, 0.0, 40.0, 0.0, 40.0)          # plane 0: a riser at x = 0 from z 0 to 40
+    lanes.take(riser, 0)
+    # a chain entering at (x = 1, z = 20) crosses plane 0 right through that riser
+    through = Lane(1.0, 20.0, 30.0, 20.0, 35.0)
+    assert lanes.conflicts(through, 1) >= 1
+    assert lanes.conflicts(through, 0) >= 1
+    # moved 2 SEP along x it crosses clear of it
+    assert lanes.conflicts(Lane(1.0 + 2 * SEP, 20.0, 30.0, 20.0, 35.0), 1) == 0
+
+
+def test_rounded_guide_keeps_ends_and_spacing_and_cuts_corners_by_at_most_the_radius():
+    pts = [(0, 0, 0), (0, 0, 10), (10, 0, 10), (10, 5, 10)]
+    g = rounded(pts, 4.0, 2.0)
+    assert np.allclose(g[0], pts[0]) and np.allclose(g[-1], pts[-1])
+    steps = np.linalg.norm(np.diff(g, axis=0), axis=1)
+    assert steps.max() < 2.0 * 1.5 and steps.min() > 0.2
+    # every guide point is near the polyline (a corner cut by less than the radius)
+    def dist(p):
+        best = np.inf
+        for a, b in zip(pts[:-1], pts[1:]):
+            a, b = np.array(a, float), np.array(b, float)
+            s = np.clip((p - a) @ (b - a) / ((b - a) @ (b - a)), 0, 1)
+            best = min(best, np.linalg.norm(a + s * (b - a) - p))
+        return best
+    assert max(dist(p) for p in g) < 4.0
+
+
+def test_space_nearest_matches_brute_force():
+    rng = np.random.default_rng(3)
+    sp = Space(0.9)
+    placed = []
+    for owner in range(5):
+        pts = rng.uniform(0, 8, (30, 3))
+        sp.add(pts, owner)
+        placed += [(p, owner) for p in pts]
+    q = rng.uniform(0, 8, (20, 3))
+    got = sp.nearest(q, 2)
+    brute = min(np.linalg.norm(p - x) for x in q for p, o in placed if o != 2)
+    # the grid looks one cell (1.8) around: it is exact whenever the answer is below that
+    assert brute < 1.8 and abs(got - brute) < 1e-12
+    assert sp.nearest(np.array([[100.0, 100, 100]]), 0) == np.inf
+    assert np.allclose(layer_centres([[0, 0, 0], [0, 0, 1], [0, 0, 3]]), [[0, 0, 0.5], [0, 0, 2]])
