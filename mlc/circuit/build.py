@@ -43,22 +43,25 @@ from mlc.scene.model import Body, Bond, Muscle, Probe, Scene
 
 MAX_GATES = 2000            # larger netlists are refused (the scene would not fit a verification)
 MAX_INPUTS = 14             # the scene's truth table lists every row
-LEVEL_PITCH = 18.5          # sigma between logic levels (z), plus LAYER_PITCH per route arriving
+LEVEL_PITCH = 23.0          # sigma between logic levels (z), plus LAYER_PITCH per route arriving
 GATE_PITCH = 12.0           # sigma between gates of one level (x)
 TERMINAL_POST = 0.8         # sigma: the last half unit's layer stays this far below a lever's plane
 LEVER_STOP = 0.35           # sigma: the last posts stop this short of a lever's joint sites (the lever is 0.5 wide)
 PAGE_CLEAR = 0.2           # sigma: extra post length that keeps a branch page clear of the driving lever
 LAYER_PITCH = 2.5           # sigma between the horizontal layers of the routes into one level
-RUN_LIFT = 1.0              # sigma: the lowest run of a level sits this far above mid-gap (clear of the taps)
-PLANE_TRIES = 4             # routing planes tried per chain before keeping the best
+RUN_BASE = 9.5              # sigma: the lowest run sits this far above the level below (3.5 clear of its taps' crossings)
+PLANE_TRIES = 6             # routing planes tried per chain before keeping the best
 LANE_BEND = 0.6             # bends of a routed chain stay within this fraction of the largest (floppy slack)
 TURN_RADIUS = 5.0           # sigma: lane corners are rounded to this radius (a chain turns 90 degrees in ~6 sigma)
 WAYPOINT_STEP = 2.0         # sigma between the lane points a chain is pulled towards
 WAYPOINT_WEIGHT = 0.5       # their weight in the inverse kinematics
-END_JUNCTIONS, END_BEND = 4, 0.4   # the last 4 junctions bend at most 0.4 of the largest bend (lever travel)
+END_JUNCTIONS, END_BEND = 4, 0.4   # the 4 junctions at either end bend at most 0.4 of the largest (lever travel)
 LANE_EXTRAS = (0, 4, 8)     # chain lengths (half units beyond the steered guess) tried in a plane before the next
+BRANCH_LAYERS = 3           # layers of a chain next to its branch page, left out of the keep-apart test
 LAYER_RADIUS = 0.9          # sigma: bounds a half unit's layer with its posts (reach 0.75, half pitch 0.5)
 PIN_SPREAD = 2.5            # sigma: a gate's two input chains arrive this far apart in x
+PIN_STAGGER = 2.5           # sigma: the far input's chain crosses under the gate this much lower than the near one's
+PIN_END = 1.5               # sigma: and rises to its lever this far to its side of the gate (x)
 RISER_PITCH = 3.5           # sigma between the risers of the routes from one tap (x)
 # Gates are turned by +90 degrees about z (gate x -> world y): every output pair's axis is
 # then along world x, so branch pages (turned about that axis) fan out towards -y, where
@@ -341,21 +344,26 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
             d_sink = depth_of[gid]
             k_layer = layer_next[d_sink]
             layer_next[d_sink] += 1
-            z_run = zlevel[d_sink - 1] + 0.5 * opt.level_pitch + RUN_LIFT + LAYER_PITCH * k_layer
+            z_run = zlevel[d_sink - 1] + RUN_BASE + LAYER_PITCH * k_layer
             x_rise = tap.centre[0] + RISER_PITCH * (k - 0.5 * (len(starts) - 1))
             xp, yp, zp = target.centre
-            # the two inputs of a gate sit at one x (they differ in y): come in from either side
-            side = -1.0 if pin_name == "a" else 1.0
+            # the two inputs of a gate are near one x and differ in y: come in from either side
+            # (the input with the smaller x from -x), the far one (larger y) crossing lower
+            other = _pair(by_name, *(f"{gid}_{'b' if pin_name == 'a' else 'a'}_{e}.in" for e in ("lo", "hi")))
+            dx = xp - other.centre[0]
+            side = float(np.sign(dx)) if abs(dx) > 1e-6 else (-1.0 if pin_name == "a" else 1.0)
             x_in = xp + side * PIN_SPREAD
-            lane = Lane(x_rise, start.centre[2] + 3.0, z_run, x_in, zp - 8.0)
-            sbm = math.radians(50.0) if len(starts) == 1 else 0.75 * max_bend(geo)
+            z_in = zp - 8.0 - (PIN_STAGGER if yp > other.centre[1] else 0.0)
+            x_end = xp + side * PIN_END
+            lane = Lane(x_rise, start.centre[2] + 3.0, z_run, x_in, z_in, x_end, zp - 6.0)
+            sbm = math.radians(50.0) if len(starts) == 1 else LANE_BEND * max_bend(geo)
             plane = lanes.assign(lane)
             route = None
             best = (-math.inf, None, plane)
             for attempt in range(PLANE_TRIES):
                 y_k = plane_y(plane)
                 corners = [(x_rise, y_k, lane.z_a), (x_rise, y_k, z_run), (x_in, y_k, z_run),
-                           (x_in, y_k, lane.z_in), (xp + side * 1.0, yp - 1.0, zp - 6.0)]
+                           (x_in, y_k, lane.z_in), (x_end, yp - 1.0, zp - 6.0)]
                 wps = [tuple(p) for p in rounded(corners, TURN_RADIUS, WAYPOINT_STEP)]
                 r = solve_route(start.centre, start.axis, target.centre, target.axis, geo, spol, waypoints=wps,
                                 tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
@@ -364,7 +372,8 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
                 if r is not None:
                     cs, _, _ = _fk(r.centre, r.axis, r.tangent, r.bends,
                                    [geo.pitch] * (len(r.bends) - 1) + [geo.pitch + ext])
-                    gap_ = space.nearest(layer_centres(cs), tag)
+                    # a branch's chains leave their pages side by side: their first layers are the branch's
+                    gap_ = space.nearest(layer_centres(cs)[BRANCH_LAYERS if start is not tap else 0:], tag)
                     if gap_ > best[0]:
                         best = (gap_, r, plane)
                     if gap_ >= space_clear:

@@ -49,6 +49,8 @@ class Lane:
     z_run: float         # height of its run along x
     x_in: float          # where it leaves the plane for the pin
     z_in: float          # height at which it passes the nearest plane on its way to the pin
+    x_end: float | None = None    # where it then heads, under the pin (x, z)
+    z_end: float | None = None
 
     def polyline(self) -> np.ndarray:
         return np.array([[self.x_r, self.z_a], [self.x_r, self.z_run], [self.x_in, self.z_run],
@@ -56,7 +58,8 @@ class Lane:
 
     def crossings(self) -> list[np.ndarray]:
         return [np.array([[self.x_r, self.z_a - CROSS_BELOW], [self.x_r, self.z_a + CROSS_ABOVE]]),
-                np.array([[self.x_in, self.z_in - CROSS_BELOW], [self.x_in, self.z_in + CROSS_ABOVE]])]
+                np.array([[self.x_in, self.z_in - CROSS_BELOW], [self.x_in, self.z_in + CROSS_ABOVE]]
+                         + ([[self.x_end, self.z_end]] if self.x_end is not None else []))]
 
 
 def _seg_dist(p1, q1, p2, q2) -> float:

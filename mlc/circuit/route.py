@@ -130,8 +130,9 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
     guide curve through the waypoints, then refined by inverse kinematics.  ``extras``:
     the chain lengths tried, in half units beyond the steered guess (fewer: faster failure).
     ``wp_weight``: weight of the waypoints against the exact equations (10).
-    ``end_bends = (m, b)``: the last ``m`` junctions bend at most ``b`` (rad), leaving room
-    for the consumer's lever to move the chain's end between rows."""
+    ``end_bends = (m, b)``: the ``m`` junctions after the first and the last ``m`` bend at
+    most ``b`` (rad), leaving room for the levers at both ends to move the chain between
+    rows."""
     c0, u0 = np.asarray(c0, float), np.asarray(u0, float) / np.linalg.norm(u0)
     P, a = np.asarray(target_c, float), np.asarray(target_a, float) / np.linalg.norm(target_a)
     e1, e2 = _perp_basis(a)
@@ -233,9 +234,10 @@ def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=(
              wp_weight=0.3) -> Route:
     lo = np.full(n, -bmax)
     hi = np.full(n, bmax)
-    if end_bends is not None:                  # (count, bound): the last junctions bend less
+    if end_bends is not None:                  # (count, bound): the first and last junctions bend less
         m, eb = end_bends
         lo[-m:], hi[-m:] = -eb, eb
+        lo[1:1 + m], hi[1:1 + m] = -eb, eb
     lim0 = float(free_start) if free_start else 1e-12      # free_start: the first bend's bound (rad)
     lo[0], hi[0] = -lim0, lim0
 
