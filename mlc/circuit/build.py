@@ -54,8 +54,8 @@ PLANE_TRIES = 6             # routing planes tried per chain before keeping the 
 LANE_BEND = 0.6             # bends of a routed chain stay within this fraction of the largest (floppy slack)
 TURN_RADIUS = 5.0           # sigma: lane corners are rounded to this radius (a chain turns 90 degrees in ~6 sigma)
 WAYPOINT_STEP = 2.0         # sigma between the lane points a chain is pulled towards
-WAYPOINT_WEIGHT = 0.5       # their weight in the inverse kinematics
-END_JUNCTIONS, END_BEND = 4, 0.4   # the 4 junctions at either end bend at most 0.4 of the largest (lever travel)
+WAYPOINT_WEIGHT = 1.0       # their weight in the inverse kinematics
+END_JUNCTIONS, END_BEND = 4, 0.2   # the 4 junctions at either end bend at most 0.2 of the largest (lever travel)
 LANE_EXTRAS = (0, 4, 8)     # chain lengths (half units beyond the steered guess) tried in a plane before the next
 BRANCH_LAYERS = 3           # layers of a chain next to its branch page, left out of the keep-apart test
 LAYER_RADIUS = 0.9          # sigma: bounds a half unit's layer with its posts (reach 0.75, half pitch 0.5)
@@ -356,7 +356,7 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
             z_in = zp - 8.0 - (PIN_STAGGER if yp > other.centre[1] else 0.0)
             x_end = xp + side * PIN_END
             lane = Lane(x_rise, start.centre[2] + 3.0, z_run, x_in, z_in, x_end, zp - 6.0)
-            sbm = math.radians(50.0) if len(starts) == 1 else LANE_BEND * max_bend(geo)
+            sbm = math.radians(50.0) if len(starts) == 1 else END_BEND * max_bend(geo)
             plane = lanes.assign(lane)
             route = None
             best = (-math.inf, None, plane)

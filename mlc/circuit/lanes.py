@@ -30,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 PLANE_Y0 = -5.0         # sigma: the plane nearest the gates (y)
-PLANE_PITCH = 3.0       # sigma between routing planes
+PLANE_PITCH = 4.0       # sigma between routing planes
 SEP = 3.0               # sigma: lanes of two chains keep this far apart in the x-z view
 CROSS_BELOW = 2.0       # sigma: a tap crossing occupies z_a - CROSS_BELOW .. z_a + CROSS_ABOVE
 CROSS_ABOVE = 1.0
