@@ -941,3 +941,17 @@ def test_generated_bad_output_locations(what, where, scene_text, hinge_scene, tm
     assert listing(tmp_path) == before_top or where == "the_input" and pre[0] == "stl"
     if where == "the_input":
         assert "is an input" in err or f"must end in {sfx}" in err, err
+
+
+@pytest.mark.parametrize("seeds", ["0", "-3", "1000000000"])
+def test_verify_and_compile_refuse_absurd_seed_counts(seeds, tmp_path, capsys):
+    """--dynamic --seeds 1e9 used to start a run of years; now one error before any work."""
+    scene = tmp_path / "nand.yaml"
+    assert main(["gate", "NAND", "-o", str(scene)]) == 0
+    capsys.readouterr()
+    before = listing(tmp_path)
+    code, _, err = run(capsys, "verify", scene, "--dynamic", "--seeds", seeds)
+    assert_clean_failure(code, err, before, tmp_path, "--seeds")
+    code, _, err = run(capsys, "compile", "-e", "z = a & b", "-o", tmp_path / "o", "--verify", "--dynamic",
+                       "--seeds", seeds)
+    assert_clean_failure(code, err, before, tmp_path, "--seeds")

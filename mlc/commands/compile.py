@@ -138,8 +138,8 @@ def run(args) -> int:
         raise MlcError("--verify, --stl and --3mf need the circuit", "--no-circuit", "drop --no-circuit")
     if args.dynamic and not args.verify:
         raise MlcError("--dynamic only applies to --verify", "--dynamic", "add --verify")
-    if args.seeds < 1:
-        raise MlcError(f"need at least one seed, got {args.seeds}", "--seeds")
+    if not 1 <= args.seeds <= 1000:
+        raise MlcError(f"--seeds must be between 1 and 1000, got {args.seeds}", "--seeds")
     if not (args.kT >= 0 and args.kT < float("inf")):
         raise MlcError(f"kT must be finite and >= 0, got {args.kT}", "--kT")
     if getattr(args, "robot", None):
@@ -174,6 +174,9 @@ def run(args) -> int:
             scene = robot_scene
         if args.verify:
             from mlc.commands.verify import verify_scene_file
+            if args.dynamic:
+                from mlc.io.warmup import notice
+                notice(args.scheme)
             report = verify_scene_file(scene, args.dynamic, args.kT, args.seeds, args.scheme)
     with outs:
         for name, data in files.items():

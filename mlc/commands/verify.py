@@ -5,6 +5,9 @@ from __future__ import annotations
 import json
 
 
+MAX_SEEDS = 1000            # seeds per row for --dynamic
+
+
 def register(sub):
     p = sub.add_parser("verify", help="verify a scene (compiled circuit, connector, gate) on every row of its truth table",
                        description="For every row of the scene's truth table: the static equilibrium (default; with the "
@@ -47,7 +50,13 @@ def run(args) -> int:
 
     if args.dynamic and not (args.kT >= 0 and args.kT < float("inf")):
         raise MlcError(f"kT must be finite and >= 0, got {args.kT}", "--kT")
+    if args.dynamic and not 1 <= args.seeds <= MAX_SEEDS:
+        raise MlcError(f"--seeds must be between 1 and {MAX_SEEDS}, got {args.seeds} (each seed of each row is a "
+                       f"Brownian-dynamics run of minutes on a circuit)", "--seeds")
     scene = load_scene(args.scene)
+    if args.dynamic:
+        from mlc.io.warmup import notice
+        notice(args.scheme)
     rep = verify_scene_file(scene, args.dynamic, args.kT, args.seeds, args.scheme, args.rows,
                             args.require_clearance)
     if isinstance(scene.meta, dict) and scene.meta.get("element") == "robot":
