@@ -30,6 +30,8 @@ BEND_FRACTION = 0.75         # routing bends at most this fraction of the geomet
 EXACT = 1e-7                 # sigma: the last pair must land this close
 PASSES = (1.0, 1e-3)         # weights of the soft terms: shape the chain, then close it exactly
 DEBUG = False
+SHAPE_TOL = 1e-5           # relative cost change that ends the shaping pass
+STATS = None               # a list to collect (n, pass, evaluations, status, closure) per solve
 
 
 @dataclass
@@ -143,18 +145,7 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
             tangent = _perp_basis(u0)[0]
     t0 = _project_perp(tangent, u0)
     app = None if approach is None else np.asarray(approach, float) / np.linalg.norm(approach)
-    # guide: start along t0, through the waypoints, into the target along the approach
-    knots = [c0] + [np.asarray(w, float) for w in waypoints] + [P]
-    dirs = [t0]
-    def unit_or(d, fallback):
-        n = float(np.linalg.norm(d))
-        return d / n if n > 1e-9 else fallback
-
-    for i in range(1, len(knots) - 1):
-        dirs.append(unit_or(knots[i + 1] - knots[i - 1], dirs[-1]))
-    dirs.append(app if app is not None else unit_or(P - knots[-2], dirs[-1]))
-    guide = np.concatenate([_bezier(knots[i], dirs[i], knots[i + 1], dirs[i + 1])[:-1]
-                            for i in range(len(knots) - 1)] + [P[None]])
+    guide = _guide(c0, t0, waypoints, P, app)
     guess = _steer(c0, u0, t0, guide, geo.pitch, bmax, free_start and start_bend_max, max_half)
     best = None
     for extra in extras:
@@ -180,6 +171,23 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
         if best is None or r.error < best.error:
             best = r
     return None
+
+
+def _guide(c0, t0, waypoints, P, app) -> np.ndarray:
+    """A dense polyline from c0 (leaving along t0) through the waypoints into P (arriving
+    along ``app``, or straight): cubic Beziers between the knots."""
+    knots = [np.asarray(c0, float)] + [np.asarray(w, float) for w in waypoints] + [np.asarray(P, float)]
+    dirs = [np.asarray(t0, float)]
+
+    def unit_or(d, fallback):
+        n = float(np.linalg.norm(d))
+        return d / n if n > 1e-9 else fallback
+
+    for i in range(1, len(knots) - 1):
+        dirs.append(unit_or(knots[i + 1] - knots[i - 1], dirs[-1]))
+    dirs.append(app if app is not None else unit_or(knots[-1] - knots[-2], dirs[-1]))
+    return np.concatenate([_bezier(knots[i], dirs[i], knots[i + 1], dirs[i + 1])[:-1]
+                           for i in range(len(knots) - 1)] + [knots[-1][None]])
 
 
 def _rot(v, k, th):
@@ -241,34 +249,28 @@ def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=(
     lim0 = float(free_start) if free_start else 1e-12      # free_start: the first bend's bound (rad)
     lo[0], hi[0] = -lim0, lim0
 
+    wp_k = np.array([k for k, _ in wps], dtype=np.int64)
+    wp_p = np.array([p for _, p in wps], dtype=float).reshape(-1, 3)
+    has_app = app is not None
+    app_v = np.zeros(3) if app is None else np.asarray(app, float)
+    n_rows = 5 + (3 if has_app else 0) + 3 * len(wp_k) + (n - 1)
+    cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
+
+    def frames(b):
+        _fk_kernel(c0, u0, t0, np.ascontiguousarray(b, dtype=np.float64), pitches, cs, us, ts)
+
     def resid(b, w_soft):
-        cs, us, ts = _fk(c0, u0, t0, b, pitches)
-        out = [10.0 * (cs[-1] - P), [10.0 * float(us[-1] @ e1), 10.0 * float(us[-1] @ e2)]]
-        if app is not None:
-            out.append(w_soft * 2.0 * (ts[-1] - app))
-        for k, p in wps:
-            out.append(w_soft * wp_weight * (cs[k] - p))
-        out.append(w_soft * 0.05 * np.asarray(b[1:]))
-        return np.concatenate([np.ravel(x) for x in out])
+        frames(b)
+        out = np.empty(n_rows)
+        _resid_kernel(cs, us, ts, b, P, e1, e2, has_app, app_v, wp_k, wp_p, w_soft, wp_weight, out)
+        return out
 
     def jac(b, w_soft):
         # bend i turns everything downstream of junction i rigidly about (c_i, u_i)
-        cs, us, ts = _fk(c0, u0, t0, b, pitches)
-        U, C = us[:n], cs[:n]                                   # axis and point of each bend
-        rows = [10.0 * np.cross(U, cs[-1] - C).T,               # d c_n
-                10.0 * (np.cross(U, us[-1]) @ e1)[None, :],     # d (u_n . e1)
-                10.0 * (np.cross(U, us[-1]) @ e2)[None, :]]
-        if app is not None:
-            rows.append(w_soft * 2.0 * np.cross(U, ts[-1]).T)   # d t_{n-1}: every bend i <= n-1
-        idx = np.arange(n)
-        for k, _ in wps:
-            d = np.cross(U, cs[k] - C).T
-            d[:, idx >= k] = 0.0
-            rows.append(w_soft * wp_weight * d)
-        sm = np.zeros((n - 1, n))
-        sm[np.arange(n - 1), np.arange(1, n)] = w_soft * 0.05
-        rows.append(sm)
-        return np.vstack(rows)
+        frames(b)
+        J = np.empty((n_rows, n))
+        _jac_kernel(cs, us, ts, e1, e2, has_app, wp_k, w_soft, wp_weight, J)
+        return J
 
     x = np.clip(np.asarray(x0, float), lo + 1e-12, hi - 1e-12)
 
@@ -282,11 +284,75 @@ def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=(
     for i, w_soft in enumerate(PASSES + (1e-7,)):
         if i == len(PASSES) and errors(x)[0] < EXACT:
             break
-        res = least_squares(resid, x, jac=jac, bounds=(lo, hi), args=(w_soft,), method="trf", xtol=1e-15,
-                            ftol=1e-15, gtol=1e-15, max_nfev=300 if i == 0 else (200 if i < len(PASSES) else 50))
+        tol = SHAPE_TOL if i == 0 else 1e-15      # the shaping pass need not converge: the next one moves it
+        res = least_squares(resid, x, jac=jac, bounds=(lo, hi), args=(w_soft,), method="trf", xtol=tol,
+                            ftol=tol, gtol=1e-15, max_nfev=300 if i == 0 else (200 if i < len(PASSES) else 50))
         x = res.x
+        if STATS is not None:
+            STATS.append((n, i, res.nfev, res.status, errors(x)[0]))
     err, aerr = errors(x)
     return Route(c0, u0, t0, [float(v) for v in x], err, aerr)
+
+
+@njit(cache=True)
+def _resid_kernel(cs, us, ts, b, P, e1, e2, has_app, app, wp_k, wp_p, w_soft, wp_weight, out):
+    """The residuals of :func:`_solve_n` (closure, approach, waypoints, small bends) into out."""
+    n = b.shape[0]
+    N = cs.shape[0] - 1
+    r = 0
+    for j in range(3):
+        out[r] = 10.0 * (cs[N, j] - P[j])
+        r += 1
+    out[r] = 10.0 * (us[N, 0] * e1[0] + us[N, 1] * e1[1] + us[N, 2] * e1[2])
+    out[r + 1] = 10.0 * (us[N, 0] * e2[0] + us[N, 1] * e2[1] + us[N, 2] * e2[2])
+    r += 2
+    if has_app:
+        for j in range(3):
+            out[r] = w_soft * 2.0 * (ts[n - 1, j] - app[j])
+            r += 1
+    for w in range(wp_k.shape[0]):
+        for j in range(3):
+            out[r] = w_soft * wp_weight * (cs[wp_k[w], j] - wp_p[w, j])
+            r += 1
+    for i in range(1, n):
+        out[r] = w_soft * 0.05 * b[i]
+        r += 1
+
+
+@njit(cache=True)
+def _jac_kernel(cs, us, ts, e1, e2, has_app, wp_k, w_soft, wp_weight, J):
+    """Jacobian of :func:`_resid_kernel`: bend i turns everything after junction i
+    rigidly about the axis us[i] through cs[i] (d x = us[i] x (x - cs[i]))."""
+    n = ts.shape[0]
+    N = cs.shape[0] - 1
+    J[:, :] = 0.0
+    for i in range(n):
+        ux, uy, uz = us[i, 0], us[i, 1], us[i, 2]
+        dx, dy, dz = cs[N, 0] - cs[i, 0], cs[N, 1] - cs[i, 1], cs[N, 2] - cs[i, 2]
+        J[0, i] = 10.0 * (uy * dz - uz * dy)
+        J[1, i] = 10.0 * (uz * dx - ux * dz)
+        J[2, i] = 10.0 * (ux * dy - uy * dx)
+        vx, vy, vz = us[N, 0], us[N, 1], us[N, 2]
+        cx, cy, cz = uy * vz - uz * vy, uz * vx - ux * vz, ux * vy - uy * vx
+        J[3, i] = 10.0 * (cx * e1[0] + cy * e1[1] + cz * e1[2])
+        J[4, i] = 10.0 * (cx * e2[0] + cy * e2[1] + cz * e2[2])
+        r = 5
+        if has_app:
+            tx, ty, tz = ts[n - 1, 0], ts[n - 1, 1], ts[n - 1, 2]
+            J[r, i] = w_soft * 2.0 * (uy * tz - uz * ty)
+            J[r + 1, i] = w_soft * 2.0 * (uz * tx - ux * tz)
+            J[r + 2, i] = w_soft * 2.0 * (ux * ty - uy * tx)
+            r += 3
+        for w in range(wp_k.shape[0]):
+            k = wp_k[w]
+            if i < k:
+                dx, dy, dz = cs[k, 0] - cs[i, 0], cs[k, 1] - cs[i, 1], cs[k, 2] - cs[i, 2]
+                J[r, i] = w_soft * wp_weight * (uy * dz - uz * dy)
+                J[r + 1, i] = w_soft * wp_weight * (uz * dx - ux * dz)
+                J[r + 2, i] = w_soft * wp_weight * (ux * dy - uy * dx)
+            r += 3
+        if i >= 1:
+            J[r + i - 1, i] = w_soft * 0.05
 
 
 __all__ = ["BEND_FRACTION", "Route", "solve_route"]
