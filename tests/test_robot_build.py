@@ -97,3 +97,48 @@ def test_existing_scene_tools_load_the_robot(robot, capsys):
     out = robot / "out"
     assert main(["simulate", str(out / "robot.yaml"), "--time", "0.2", "--set", "a=1", "--quiet"]) == 0
     capsys.readouterr()
+
+
+def _joint_energy(sc, dm, t_deg, state, coupling=True):
+    """Energy (k0 sigma^2) of the bonds between a DOF's two bodies (and its coupling pair
+    as one spring at the output's length) with the second body turned rigidly by t_deg
+    about the hinge, from the scene's sites alone (flat-bottom law of the kernel)."""
+    import math
+    b1, b2 = dm["bodies"]
+    O = sc.site_world(f"{b1}.h_{dm['name']}_0")
+    sgn = 1.0 if dm["side"] == "up" else -1.0
+    a = sgn * math.radians(t_deg)
+    R = np.array([[math.cos(a), -math.sin(a), 0], [math.sin(a), math.cos(a), 0], [0, 0, 1.0]])
+    springs = [(b.a, b.b, b.k, b.rest, b.tolerance) for b in sc.bonds
+               if {b.a.split(".")[0], b.b.split(".")[0]} == {b1, b2}]
+    if coupling and dm["coupling"] == "lever":
+        g = sc.meta["robot"]["dof_geometry"]
+        springs.append((f"{b1}.lever_{dm['name']}", f"{b2}.lever_{dm['name']}", 1.0,
+                        (g["actuated"] if state else g["rest"]) / g["gain"], 0.0))
+    U = 0.0
+    for sa, sb, k, rest, tol in springs:
+        pa, pb = sc.site_world(sa), sc.site_world(sb)
+        pa = O + R @ (pa - O) if sa.startswith(b2 + ".") else pa
+        pb = O + R @ (pb - O) if sb.startswith(b2 + ".") else pb
+        U += 0.5 * k * max(0.0, abs(float(np.linalg.norm(pb - pa)) - rest) - tol) ** 2
+    return U
+
+
+def test_joint_stops_close_the_mirror_branches(robot):
+    # docs/robot.md 2.3: without stops the lever triangle's actuated pair length recurs at a
+    # 180-degree turn (barrier k0/2 (p + q - L1)^2 = 0.0035); the two stop bonds leave the
+    # joint free over [-15, 105] degrees and put >= 0.5 k0 sigma^2 at 180 and at -90
+    sc = load_scene(robot / "out" / "robot.yaml")
+    dm = next(d for d in sc.meta["robot"]["dofs"] if d["name"] == "u1_up")
+    assert dm["coupling"] == "lever"
+    stops = [b for b in sc.bonds if b.name.startswith("skel_stop_") and b.name.endswith("_u1_up")]
+    assert len(stops) == 2 and all(b.tolerance > 0 for b in stops)
+    free = [_joint_energy(sc, dm, t, 0, coupling=False) for t in (-14, 0, 45, 90, 104)]
+    assert max(free) < 1e-20                      # hinge and stops alone: free in the band
+    assert _joint_energy(sc, dm, 90, 1) < 1e-20 and _joint_energy(sc, dm, 0, 0) < 1e-20
+    assert _joint_energy(sc, dm, 180, 1) > 0.5 and _joint_energy(sc, dm, -90, 0) > 0.5
+    scan = [_joint_energy(sc, dm, t, 1) for t in np.arange(90, 181, 2.0)]
+    assert scan[-1] == max(scan)                   # climbs all the way from the target to 180
+    # the same bodies without the stops: the mirror minimum at 180 degrees is back
+    sc.bonds = [b for b in sc.bonds if not b.name.startswith("skel_stop_")]
+    assert _joint_energy(sc, dm, 180, 1) < 1e-12

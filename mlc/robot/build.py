@@ -51,6 +51,11 @@ POST = 0.6               # sigma: the lever sites sit this far below the skeleto
 HINGE_WIDTH = 0.5        # sigma between the two bonds of a skeleton hinge (along z)
 APPROACH_RUN = 4.0       # sigma: the chain's last stretch rises straight into the skeleton
 BACK = 4.0               # sigma behind the circuit (+y) where a chain from inside the circuit rises
+STOP_MARGIN = math.radians(15.0)   # rad: a DOF swings freely from -15 to 90 + 15 degrees (its stops)
+STOP_R_OVER = (1.8, 1.2)           # sigma: the over-turn stop's sites, on both bodies along one ray
+STOP_R_UNDER = 1.2                 # sigma: the under-turn stop's sites
+STOP_UNDER_LOW = math.radians(52.5)  # rad: the under-turn stop's arms this far apart at its lower limit
+STOP_K = 4.0                       # k0: the stops' stiffness once engaged (a wire joint's is 1)
 
 
 @dataclass
@@ -97,6 +102,59 @@ def dof_geometry(L0: float, L1: float, d0: float, turn: float = math.pi / 2,
 
 
 @dataclass
+class DofStop:
+    """A joint stop: a flat-bottom bond (``U = k/2 max(0, |d - rest| - tol)^2``) between a
+    site on each body of a DOF, at ``r1`` and ``r2`` sigma from the hinge, on rays at
+    ``beta1`` and ``beta2`` (rad from +x, up hinge; mirrored for dn).  The rays are
+    ``psi0 = beta2 - beta1`` apart when straight and ``psi0 + t`` at a turn t, so the
+    bond's length is ``sqrt(r1^2 + r2^2 - 2 r1 r2 cos(psi0 + t))``; it is force-free while
+    t lies in [t_lo, t_hi] (and in that band's mirror psi -> -psi, which the other stop
+    closes; docs/robot.md section 2.3)."""
+
+    name: str
+    r1: float
+    r2: float
+    beta1: float
+    beta2: float
+    t_lo: float
+    t_hi: float
+
+    def length(self, t: float) -> float:
+        psi = self.beta2 - self.beta1 + t
+        return math.sqrt(max(0.0, self.r1 ** 2 + self.r2 ** 2 - 2 * self.r1 * self.r2 * math.cos(psi)))
+
+    @property
+    def band(self) -> tuple[float, float]:
+        """(rest, tol) of the flat-bottom bond: free between its lengths at t_lo and t_hi."""
+        a, b = sorted((self.length(self.t_lo), self.length(self.t_hi)))
+        if self.t_lo < -(self.beta2 - self.beta1) < self.t_hi:   # the rays cross inside the band
+            a = self.length(-(self.beta2 - self.beta1))
+        return 0.5 * (a + b), 0.5 * (b - a)
+
+
+def dof_stops(margin: float = STOP_MARGIN) -> list[DofStop]:
+    """The two stops of every DOF hinge (docs/robot.md section 2.3): the DOF swings freely
+    over [-margin, 90 deg + margin].
+
+    * ``over``: both rays straight into the bodies (beta = -90 deg, psi0 = 0), so the bond
+      length grows with |t|; free for |t| <= 90 deg + margin.  It closes the lever
+      triangle's mirror equilibrium at t = 180 deg (and everything past 90 + margin).
+    * ``under``: rays psi0 = a + margin apart (a = ``STOP_UNDER_LOW``), free for psi in
+      [a, a + 90 deg + 2 margin], a band of increasing length inside (0, 180 deg).  It
+      closes t < -margin, in particular the triangle's other mirror at t = -90 deg.  Its
+      own mirror band, t in [-2a - 90 - 3 margin, -2a - margin] = [120, 240] deg for
+      a = 52.5, margin = 15 deg, lies beyond the over-turn stop's limit of 105 deg, so
+      the two stops together leave exactly [-margin, 90 deg + margin]."""
+    h = math.pi / 2
+    psi0 = STOP_UNDER_LOW + margin
+    if not (h / 2 < STOP_UNDER_LOW < h - 2 * margin):
+        raise MlcError(f"stop margin {math.degrees(margin):.1f} deg leaves no under-turn stop", "STOP_MARGIN")
+    r1, r2 = STOP_R_OVER
+    return [DofStop("over", r1, r2, -h, -h, -(h + margin), h + margin),
+            DofStop("under", STOP_R_UNDER, STOP_R_UNDER, -h - psi0 / 2, -h + psi0 / 2, -margin, h + margin)]
+
+
+@dataclass
 class Robot:
     scene: Scene
     chains: int
@@ -139,6 +197,7 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
                        f"use dof_stroke: {need:g} with dof_rest: {spec.dof_rest:g}" if need > 0 else
                        "compile with --signal expand")
     dg = dof_geometry(geo.L0, geo.L1, spec.dof_rest)
+    stops = dof_stops()
     l, w, s, th = spec.unit_length, spec.width, JOINT_LENGTH, spec.thickness
     tip1 = dg.gain * dg.p * np.array([math.cos(dg.alpha1), math.sin(dg.alpha1)])
     if w + tip1[1] < 0.1:
@@ -191,6 +250,12 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
             sites[b1].update(axis_sites(f"h_{name}", W(*O), ez, hw))
             sites[b2].update(axis_sites(f"h_{name}", W(*O), ez, hw))
             bonds += hinge(f"skel_h_{name}", b1, b2, f"h_{name}", f"h_{name}")
+            for st in stops:                        # the joint's range of motion (section 2.3)
+                for b, r, beta in ((b1, st.r1, st.beta1), (b2, st.r2, st.beta2)):
+                    sites[b][f"stop_{st.name}_{name}"] = W(*(O + r * np.array([math.cos(beta), sgn * math.sin(beta)])))
+                rest, tol = st.band
+                bonds.append(Bond(f"skel_stop_{st.name}_{name}", f"{b1}.stop_{st.name}_{name}",
+                                  f"{b2}.stop_{st.name}_{name}", STOP_K * geo.k, rest, tol, "bond", None))
             sites[b1][f"tip_{name}"] = W(*(O + dg.gain * dg.p * dir1))
             sites[b2][f"tip_{name}"] = W(*(O + dg.gain * dg.q * dir2))
             ds = spec.dof(i, side)
@@ -304,6 +369,8 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
                   "dof_geometry": {"rest": dg.d0, "actuated": dg.d1, "p": dg.p, "q": dg.q, "gain": dg.gain,
                                    "theta0_deg": math.degrees(dg.theta0),
                                    "alpha1_deg": math.degrees(dg.alpha1)},
+                  "stops": {"margin_deg": math.degrees(STOP_MARGIN),
+                            "free_turn_deg": [-math.degrees(STOP_MARGIN), 90 + math.degrees(STOP_MARGIN)]},
                   "dofs": dofs_meta, "chains": n_chains, "half_units": n_half})
     scene = Scene(name=f"robot_{spec.name}", bodies=list(circuit.bodies) + bodies + parts_bodies,
                   bonds=list(circuit.bonds) + bonds + parts_bonds, muscles=list(circuit.muscles),
@@ -314,4 +381,4 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
     return Robot(scene, n_chains, n_half, time.perf_counter() - t0)
 
 
-__all__ = ["DofGeometry", "Robot", "build_robot", "dof_geometry"]
+__all__ = ["DofGeometry", "DofStop", "Robot", "build_robot", "dof_geometry", "dof_stops"]
