@@ -32,7 +32,7 @@ sys.path.insert(0, str(ROOT))
 
 RESULTS = ROOT / "benchmarks" / "results"
 CASES = {"tetris": ("examples/tetris.tt", None), "full_adder": ("examples/full_adder.tt", None),
-         "expr": (None, "(a & b) | c")}
+         "expr": (None, "(a & b) | c"), "ab": (None, "a & b")}
 
 
 def run_case(name: str, profile: str, queue, keep: str | None = None) -> None:
@@ -97,7 +97,39 @@ def run_case(name: str, profile: str, queue, keep: str | None = None) -> None:
                         "report_volume_mm3": round(float(sum(p["volume_mm3"] for p in rep.parts)), 2),
                         "smallest_part_mm3": round(float(np.min([m.volume for _, m in vols])), 4)},
            "finished": True}
+    import resource
+    row["peak_rss_mb"] = round(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024, 1)
+    cg = getattr(asm, "congruence", None)
+    if cg is not None:
+        row["reuse"] = {"hits": cg.hits, "misses": cg.misses}
+    row["report"] = {c.name: {"ok": c.ok, "blocking": c.blocking, "detail": c.detail[:300],
+                              "failures": len(c.failures)} for c in rep.checks}
     queue.put(row)
+
+
+def plot(rows, path: Path) -> None:
+    """Time and peak memory against bodies, one point per finished case."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    done = sorted((r for r in rows if r.get("finished")), key=lambda r: r["bodies"])
+    if not done:
+        return
+    fig, ax = plt.subplots(1, 2, figsize=(9, 3.6))
+    x = [r["bodies"] for r in done]
+    ax[0].loglog(x, [r["total_s"] for r in done], "o-", label="mesh + files")
+    ax[0].loglog(x, [r["poses_s"] for r in done], "s--", label="static poses")
+    ax[0].set_xlabel("bodies")
+    ax[0].set_ylabel("wall-clock s (shared 2-core machine)")
+    ax[0].legend()
+    ax[1].loglog(x, [r["peak_rss_mb"] for r in done], "o-")
+    ax[1].set_xlabel("bodies")
+    ax[1].set_ylabel("peak resident memory, MB")
+    for a in ax:
+        for r in done:
+            a.annotate(r["case"], (r["bodies"], a.get_lines()[0].get_ydata()[done.index(r)]), fontsize=8)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
 
 
 def main() -> int:
@@ -131,6 +163,7 @@ def main() -> int:
                    "export_assembly (poses + build + report), write_s = STL + 3MF", "rows": rows}
     Path(args.out).parent.mkdir(parents=True, exist_ok=True)
     Path(args.out).write_text(json.dumps(out, indent=2) + "\n")
+    plot(rows, Path(args.out).with_suffix(".png"))
     return 0 if all(r.get("finished") for r in rows) else 1
 
 

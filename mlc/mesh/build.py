@@ -55,11 +55,14 @@ import numpy as np
 
 from mlc.errors import MlcError
 from mlc.geometry.rotation import quat_to_matrix
+from mlc.mesh.congruence import Congruence, points_key, pose_key, shape_key
 from mlc.mesh.profiles import PAPER_SLAB_MM, Profile
 from mlc.mesh.spatial import box_pairs, local_boxes, obb_overlap, part_frames, posed_boxes, solid_boxes
 from mlc.scene.model import Scene
 
 _TOL = 1e-3  # sigma: tolerance for "same point / same line"
+#: assemblies with at least this many parts reuse results across congruent parts by default
+REUSE_MIN_PARTS = 64
 
 
 # --------------------------------------------------------------------------- primitives
@@ -205,6 +208,7 @@ class Assembly:
     slab_thickness: float
     poses: dict | None = None  # state -> (pos (N,3), quat (N,4)) in sigma, as given to build()
     orient: np.ndarray = field(default_factory=lambda: np.eye(4))  # world -> print frame (mm)
+    congruence: Congruence | None = None   # shape keys and cached exact results (large assemblies)
 
     def part(self, name: str) -> Part:
         for p in self.parts:
@@ -261,11 +265,14 @@ def transform_solid(solid: mf.Manifold, T) -> mf.Manifold:
 
 # --------------------------------------------------------------------------- build
 def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
-                   resolve: bool = True) -> Assembly:
+                   resolve: bool = True, reuse: bool | None = None) -> Assembly:
     """Build the printable parts of ``scene`` (rest pose) for ``profile``.
 
     ``poses`` maps logic states to body poses ``(pos, quat)`` (sigma); hinge trim radii
-    are chosen so that slabs clear each other in every one of them."""
+    are chosen so that slabs clear each other in every one of them.  ``reuse``: test and trim
+    each pair of congruent parts once per relative pose (:mod:`mlc.mesh.congruence`); by
+    default on for assemblies of at least :data:`REUSE_MIN_PARTS` parts (compiled circuits),
+    off for the library gates, whose meshes stay exactly as they were."""
     prof = profile
     s = prof.sigma_mm
     n = prof.circular_segments
@@ -387,6 +394,10 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                          f"the slabs are widened to the knuckle span there")
 
     state_T = _state_transforms(scene, prof, poses)
+    if reuse is None:
+        n_uj = sum(1 for bonds in joints.values() if bonds[0].kind == "universal")
+        reuse = len(scene.bodies) + n_uj >= REUSE_MIN_PARTS
+    memo: dict | None = {} if reuse else None      # sampled trim radii of congruent joints
     h = _sample_step(t, c, s)
 
     # -- universal joints: a hub with two crossed pins; each body a yoke --------------
@@ -426,7 +437,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
             for side, bn in enumerate(uj.bodies):
                 smp[bn] = np.concatenate([smp[bn], _slab_samples(
                     _yoke_plates(slabs[bn], center, uj.axes[side], [lays[side].plate], uj.rho[side] + reach, t), h)])
-            need = _ujoint_trim(uj, smp, state_T, t, c, h)
+            need = _ujoint_trim_memo(memo, uj, smp, state_T, t, c, h)
             rho = (max(uj.rho[0], need[0]), max(uj.rho[1], need[1]))
             score = (rho[0] + rho[1], modes != ("both", "both"))
             if best is None or score < best[0]:
@@ -458,7 +469,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     # -- trim radii: in every logic state, slabs of the bodies at an axis clear each other
     #    outside the radius inside which only the knuckle's own body has material
     for ax in axes:
-        ax.rho = _trim_radius(ax, samples, state_T, t, c, h, s, notes)
+        ax.rho = _trim_radius_memo(memo, ax, samples, state_T, t, c, h, s, notes)
 
     # -- muscle and probe attachment holes -------------------------------------------
     lug_hole = max(prof.min_feature, 0.08 * s) / 2
@@ -586,8 +597,10 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         notes.append("pin: cone pins on the hinges; the universal joint keeps straight pins in its yokes")
 
     asm = Assembly(scene, prof, parts, axes, ujoints, notes, features, t, poses)
+    if reuse:
+        asm.congruence = Congruence(part_frames(asm))
     if resolve:
-        _resolve(asm, protected, soft, state_T)
+        _resolve(asm, protected, soft, state_T, asm.congruence)
     _drill(asm, lugs, lug_hole, lug_out, t)
     asm.orient = _orientation(asm)
     return asm
@@ -783,6 +796,54 @@ def _trim_radius(ax: HingeAxis, samples, state_T, t, c, h, s, notes) -> float:
                      f"{cap:.3g} mm (needs {rho:.3g} mm)")
         rho = cap
     return float(rho)
+
+
+def _frame(origin, R) -> np.ndarray:
+    F = np.eye(4)
+    F[:3, :3] = R
+    F[:3, 3] = origin
+    return F
+
+
+def _rel_keys(F, A, B, state_T) -> tuple:
+    """Pose keys of B's motion relative to A in every state, seen in the frame ``F``."""
+    Fi = np.linalg.inv(F)
+    return tuple(pose_key(Fi @ np.linalg.inv(Ts[A]) @ Ts[B] @ F) for _, Ts in state_T)
+
+
+def _trim_radius_memo(memo, ax: HingeAxis, samples, state_T, t, c, h, s, notes) -> float:
+    """:func:`_trim_radius`, computed once per congruent hinge (``memo``: a dict, or None): the
+    same knuckle layout, the same slab samples in the axis frame and the same relative poses."""
+    if memo is None:
+        return _trim_radius(ax, samples, state_T, t, c, h, s, notes)
+    F = _frame(ax.origin, _perp_frame(ax.direction))
+    key = ("hinge", round(ax.span, 9), round(ax.R, 9), t, c, h, s,
+           tuple((tuple(np.round(np.asarray(ax.intervals[bn], float).ravel(), 9).tolist()),
+                  points_key(samples[bn], F)) for bn in ax.bodies),
+           tuple(_rel_keys(F, A, B, state_T) for i, A in enumerate(ax.bodies) for B in ax.bodies[i + 1:]))
+    if key not in memo:
+        mine: list = []
+        rho = _trim_radius(ax, samples, state_T, t, c, h, s, mine)
+        memo[key] = (rho, [x.replace(ax.name, "\0") for x in mine])
+    rho, extra = memo[key]
+    notes += [x.replace("\0", ax.name) for x in extra]
+    return rho
+
+
+def _ujoint_trim_memo(memo, uj: UJoint, samples, state_T, t, c, h):
+    """:func:`_ujoint_trim`, computed once per congruent universal joint (``memo``: a dict, or None)."""
+    if memo is None:
+        return _ujoint_trim(uj, samples, state_T, t, c, h)
+    F = _frame(uj.center, _ortho(uj.axes[0], uj.axes[1]))
+    lay = tuple((x.mode, tuple(np.round(np.asarray(x.own + x.caps + [x.pin, x.cut, x.plate], float).ravel(),
+                                        9).tolist())) for x in uj.layouts)
+    C, O = uj.bodies
+    key = ("ujoint", lay, round(uj.hub, 9), round(uj.R, 9), tuple(round(r, 9) for r in uj.rho), t, c, h,
+           points_key(samples[C], F), points_key(samples[O], F),
+           _rel_keys(F, C, O, state_T or [("rest", {C: np.eye(4), O: np.eye(4)})]))
+    if key not in memo:
+        memo[key] = _ujoint_trim(uj, samples, state_T, t, c, h)
+    return memo[key]
 
 
 def _yoke_layout(mode, hub, g, k, cap, W, s) -> YokeLayout:
@@ -989,7 +1050,7 @@ def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t) -> None:
                     asm.features.append((f"room for the attachment hole of {label}", 0.0, 2 * lug_out))
 
 
-def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T) -> None:
+def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, cong=None) -> None:
     """Trim slabs that still come closer than the clearance (as printed) or intersect (in a
     logic state): from one of the two parts, cut the other part grown by the clearance, in
     every state where they meet, never touching knuckles, pins or attachment rings.  The part
@@ -1002,7 +1063,10 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T) ->
     dirs = [np.array(v, float) / np.linalg.norm(v) for v in itertools.product((-1, 0, 1), repeat=3) if any(v)]
     poses = asm.poses or {}
     parts = asm.parts
-    Ts = [asm.part_transforms(pos, quat) for pos, quat in poses.values()]
+    # with reuse (compiled circuits) only what is too close as printed is trimmed here: the
+    # sampled trim radii already clear the hinges in every pose, and the ``states`` check reports
+    # what still meets in a pose (trimming every pose of thousands of parts took hours)
+    Ts = [] if cong is not None else [asm.part_transforms(pos, quat) for pos, quat in poses.values()]
 
     def conflicts_of(filters):
         # the pairs of parts that can meet (bounding boxes, spatial.box_pairs) instead of all
@@ -1013,22 +1077,40 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T) ->
         out: dict = {}
         lo, hi = solid_boxes([p.solid for p in parts])
         for i, j in box_pairs(lo, hi, 2 * c):
-            if wanted(i, j) and parts[i].solid.min_gap(parts[j].solid, c) < c - 1e-6:
+            if not wanted(i, j):
+                continue
+            if cong is None:
+                near = parts[i].solid.min_gap(parts[j].solid, c) < c - 1e-6
+            else:     # one exact test per pair of shapes in one relative pose
+                near = cong.lookup(("gap", c, cong.key(i, parts[i].solid), cong.key(j, parts[j].solid),
+                                    cong.rel(i, j)),
+                                   lambda: parts[i].solid.min_gap(parts[j].solid, c) < c - 1e-6)
+            if near:
                 out.setdefault((i, j), []).append(None)
         llo, lhi = local_boxes([p.solid for p in parts], frames)
         for T in Ts:
             Tp = [T[p.name] for p in parts]
             plo, phi = posed_boxes(lo, hi, Tp)
             posed = {}
+
+            def meet(i, j):
+                for k in (i, j):
+                    if k not in posed:
+                        posed[k] = transform_solid(parts[k].solid, Tp[k])
+                bi, bj = np.asarray(posed[i].bounding_box()), np.asarray(posed[j].bounding_box())
+                return bool(_bb_near(bi, bj, 0.0) and (posed[i] ^ posed[j]).volume() > 1e-6)
+
             for i, j in obb_overlap(box_pairs(plo, phi, 0.0), [t @ f for t, f in zip(Tp, frames)], llo, lhi):
                 if not wanted(i, j):
                     continue
-                for k in (i, j):
-                    if k not in posed:
-                        posed[k] = transform_solid(parts[k].solid, T[parts[k].name])
-                bi, bj = np.asarray(posed[i].bounding_box()), np.asarray(posed[j].bounding_box())
-                if _bb_near(bi, bj, 0.0) and (posed[i] ^ posed[j]).volume() > 1e-6:
+                if cong is None:
+                    hit = meet(i, j)
+                else:
+                    hit = cong.lookup(("meet", cong.key(i, parts[i].solid), cong.key(j, parts[j].solid),
+                                       cong.rel(i, j, Tp[i], Tp[j])), lambda: meet(i, j))
+                if hit:
                     out.setdefault((i, j), []).append(T)
+            del posed
         return out
 
     def settled(X, Xs, Y, sts):
@@ -1043,7 +1125,16 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T) ->
         return True
 
     filters: list[set] = []
-    frames = part_frames(asm)
+    frames = part_frames(asm) if cong is None else cong.frames
+    guard_keys: dict = {}
+
+    def guard_key(k, name, table):
+        g = table.get(name)
+        if g is None:
+            return None
+        if (id(table), name) not in guard_keys:
+            guard_keys[(id(table), name)] = shape_key(g, frames[k])
+        return guard_keys[(id(table), name)]
     for _ in range(4):
         conflicts = conflicts_of(filters)
         if not conflicts:
@@ -1051,6 +1142,27 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T) ->
         changed = set()
         for (i, j), sts in conflicts.items():
             A, B = parts[i], parts[j]
+            if cong is not None:
+                # the same two shapes in the same relative poses: the same trim (moved along)
+                ck = ("trim", cong.key(i, A.solid), cong.key(j, B.solid),
+                      guard_key(i, A.name, protected), guard_key(i, A.name, soft_protected),
+                      guard_key(j, B.name, protected), guard_key(j, B.name, soft_protected),
+                      tuple(cong.rel(i, j) if T is None else cong.rel(i, j, T[A.name], T[B.name]) for T in sts))
+                got = cong.results.get(ck)
+                if got is not None:
+                    cong.hits += 1
+                    if got == "none":
+                        continue
+                    side, local, removed = got
+                    k = (i, j)[side]
+                    X, Y = parts[k], parts[(j, i)[side]]
+                    X.solid = transform_solid(local, frames[k])
+                    changed.add(k)
+                    asm.notes.append(f"trimmed {removed:.3g} mm^3 from {X.name} to clear {Y.name}"
+                                     + (f" in {len([s for s in sts if s is not None])} logic state(s)"
+                                        if any(s is not None for s in sts) else " as printed"))
+                    continue
+                cong.misses += 1
             cands = []
             for X, Y in ((A, B), (B, A)):
                 if X.kind == "joint":
@@ -1063,7 +1175,7 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T) ->
                         continue
                     keep = X.solid ^ guard
                     for g_ in (grow, 2.0 * c, 2.5 * c):
-                        trimmed = _trim_by(X, Y, sts, g_, dirs, keep, 0.5 * c)
+                        trimmed = _trim_by(X, Y, sts, g_, dirs, keep, 0.5 * c, merged=cong is not None)
                         if trimmed is None:
                             break
                         ok = settled(X, trimmed, Y, sts)
@@ -1078,10 +1190,15 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T) ->
                     if ok:
                         break
             if not cands:
+                if cong is not None:
+                    cong.results[ck] = "none"
                 continue
             unsettled, split, lost, removed, X, trimmed, Y = min(cands, key=lambda x: x[:4])
             X.solid = trimmed
             changed.add(parts.index(X))
+            if cong is not None:
+                k = parts.index(X)
+                cong.results[ck] = (0 if k == i else 1, transform_solid(trimmed, np.linalg.inv(frames[k])), removed)
             asm.notes.append(f"trimmed {removed:.3g} mm^3 from {X.name} to clear {Y.name}"
                              + (f" in {len([s for s in sts if s is not None])} logic state(s)"
                                 if any(s is not None for s in sts) else " as printed"))
@@ -1090,10 +1207,16 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T) ->
         filters.append(changed)
 
 
-def _trim_by(X, Y, sts, grow, dirs, keep, state_grow):
+def _trim_by(X, Y, sts, grow, dirs, keep, state_grow, merged=False):
     """X less Y grown (union of translated copies) in each of the states ``sts`` -- by ``grow``
     as printed (None), by a third of it in a logic state -- restricted to where the two meet;
-    X's protected material ``keep`` stays."""
+    X's protected material ``keep`` stays.
+
+    ``merged``: the same set, built with bounded memory -- Y's cropped copies of all logic states
+    are united first and that union is grown (27 copies in all instead of 27 per state: a compiled
+    circuit has up to 50 poses, and 27 x 50 meshes in one boolean took gigabytes)."""
+    if merged:
+        groups: dict = {}
     ks = []
     xb = np.asarray(X.solid.bounding_box())
     for T in sts:
@@ -1114,7 +1237,37 @@ def _trim_by(X, Y, sts, grow, dirs, keep, state_grow):
             continue
         # as printed the gap must reach the clearance; in a logic state it need only be positive
         g_ = grow if T is None else state_grow
-        ks += [Yc] + [Yc.translate((g_ * d).tolist()) for d in dirs]
+        if merged:
+            groups.setdefault(g_, []).append(Yc)
+        else:
+            ks += [Yc] + [Yc.translate((g_ * d).tolist()) for d in dirs]
+    if merged:
+        # bounded cost and memory: X less, state by state, the convex hull of each piece of Y's
+        # cropped copy and its 26 translates (a superset of their union), each boolean evaluated
+        # at once.  The union of the 27 copies themselves is one boolean of near-coincident
+        # surfaces: for a gate body against a connector slab in 23 poses it took 18 GB and
+        # minutes (the memory growth of issue 13).
+        res = X.solid
+        hit = False
+        off = np.array([np.zeros(3)] + list(dirs))
+        for g_, ys in groups.items():
+            for Yc in ys:
+                yb = np.asarray(Yc.bounding_box())
+                if not _bb_near(np.asarray(res.bounding_box()), yb, 1.01 * g_):
+                    continue
+                hulls = []
+                for piece in Yc.decompose():
+                    V = np.asarray(piece.to_mesh().vert_properties, float)[:, :3]
+                    if len(V) >= 4:
+                        hulls.append(mf.Manifold.hull_points((V[None, :, :] + g_ * off[:, None, :]).reshape(-1, 3)))
+                if not hulls:
+                    continue
+                res = res - union(hulls)
+                res.num_tri()             # evaluate now (no deferred n-ary boolean)
+                hit = True
+        if not hit:
+            return None
+        return _clean(union([res, keep]))
     if not ks:
         return None
     return _clean(union([X.solid - union(ks), keep]))
@@ -1198,7 +1351,9 @@ def _orientation(asm: Assembly) -> np.ndarray:
     for p in asm.parts:
         if p.solid.is_empty():
             continue
-        bb = np.asarray(transform_solid(p.solid, _h(Rm, np.zeros(3))).bounding_box())
+        # (no transform when the rotation is the identity: the same box, without copying the mesh)
+        bb = np.asarray((p.solid if np.array_equal(Rm, np.eye(3)) else
+                         transform_solid(p.solid, _h(Rm, np.zeros(3)))).bounding_box())
         lo = np.minimum(lo, bb[:3])
         hi = np.maximum(hi, bb[3:])
     if not np.all(np.isfinite(lo)):

@@ -157,13 +157,18 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
 
     # -- min gap at rest -------------------------------------------------------------
     boxes = [_bbox(p.solid) for p in parts]
+    cong = getattr(asm, "congruence", None)
     gmin, gpair = np.inf, None
     fails = []
     for i, j in _pairs(boxes, 2 * c + 1e-3):
         if parts[i].solid.is_empty() or parts[j].solid.is_empty():
             continue
         search = max(2 * c, 1e-3)
-        gap = float(parts[i].solid.min_gap(parts[j].solid, search))
+        if cong is None:
+            gap = float(parts[i].solid.min_gap(parts[j].solid, search))
+        else:       # once per pair of shapes in one relative pose (mlc.mesh.congruence)
+            gap = cong.lookup(("min_gap", search, cong.key(i, parts[i].solid), cong.key(j, parts[j].solid),
+                               cong.rel(i, j)), lambda: float(parts[i].solid.min_gap(parts[j].solid, search)))
         if gap < gmin:
             gmin, gpair = gap, (parts[i].name, parts[j].name)
         if gap < c - GAP_EPS or gap <= GAP_EPS:     # touching parts print fused, whatever the profile says
@@ -191,11 +196,19 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
             plo, phi = posed_boxes(rlo, rhi, Tp)
             cand = obb_overlap(box_pairs(plo, phi, 0.0), [t @ f for t, f in zip(Tp, frames)], llo, lhi)
             posed = {}
-            for i, j in cand:
+
+            def vol(i, j):
                 for k in (i, j):
                     if k not in posed:
                         posed[k] = transform_solid(parts[k].solid, Tp[k])
-                v = float((posed[i] ^ posed[j]).volume())
+                return float((posed[i] ^ posed[j]).volume())
+
+            for i, j in cand:
+                if cong is None:
+                    v = vol(i, j)
+                else:
+                    v = cong.lookup(("volume", cong.key(i, parts[i].solid), cong.key(j, parts[j].solid),
+                                     cong.rel(i, j, Tp[i], Tp[j])), lambda: vol(i, j))
                 worst = max(worst, v)
                 if v > VOL_EPS:
                     fails.append(f"state {st}: {parts[i].name} intersects {parts[j].name} ({v:.4g} mm^3)")
@@ -234,7 +247,22 @@ def wall_check(asm: Assembly) -> Check:
     """Measured wall thickness of every finished part against the profile's minimum wall."""
     from mlc.mesh.walls import thin_walls
     mw = asm.profile.min_wall
-    thin = [w for p in asm.parts if not p.solid.is_empty() for w in thin_walls(p.name, p.solid, mw)]
+    cong = getattr(asm, "congruence", None)
+    if cong is None:
+        thin = [w for p in asm.parts if not p.solid.is_empty() for w in thin_walls(p.name, p.solid, mw)]
+    else:
+        # once per congruent shape, on a grid aligned with the part's own frame (the same solid,
+        # measured in the frame it shares with its copies), the places moved back to the part
+        from dataclasses import replace
+        thin = []
+        for i, p in enumerate(asm.parts):
+            if p.solid.is_empty():
+                continue
+            F = cong.frames[i]
+            local = cong.lookup(("walls", mw, cong.key(i, p.solid)),
+                                lambda: thin_walls("", transform_solid(p.solid, np.linalg.inv(F)), mw))
+            thin += [replace(w, part=p.name, where_mm=tuple(float(x) for x in F[:3, :3] @ np.asarray(w.where_mm)
+                                                            + F[:3, 3])) for w in local]
     val = round(min(w.thickness_mm for w in thin), 3) if thin else None
     detail = (f"{len(thin)} regions thinner than the minimum wall {mw:g} mm (thinnest {val} mm, measured on a "
               f"{mw / 8:.3g} mm voxel grid)" if thin else
@@ -324,15 +352,36 @@ def _retention(asm: Assembly) -> Check:
     n = 0
     if step <= 0:
         return Check("retention", False, 0, 0, "clearance 0: retention not testable", ["clearance is zero"])
-    for name, partners, d, jn, centre, Fc, size in tests:
+    cong = getattr(asm, "congruence", None)
+    index = {p.name: i for i, p in enumerate(asm.parts)}
+
+    def free_moves(name, partners, d, centre, Fc, size):
         F = _perp_frame(d)
         # only the joint's neighbourhood can stop a part: crop both sides there (much faster)
         other = union([by[o].solid for o in partners]) ^ box(centre, Fc, size)
         mine = by[name].solid ^ box(centre, Fc, [x + 4 * step for x in size])
+        out = []
         for k, v in enumerate((F[:, 2], -F[:, 2], F[:, 0], -F[:, 0], F[:, 1], -F[:, 1])):
-            n += 1
             moved = mine.translate((step * v).tolist())
-            if float((moved ^ other).volume()) <= VOL_EPS:
+            out.append(float((moved ^ other).volume()) <= VOL_EPS)
+        return out
+
+    for name, partners, d, jn, centre, Fc, size in tests:
+        if cong is None:
+            free = free_moves(name, partners, d, centre, Fc, size)
+        else:       # once per congruent joint: the part, its partners where they are, the test box
+            i = index[name]
+            Fi = np.linalg.inv(cong.frames[i])
+            T = np.eye(4)
+            T[:3, :3], T[:3, 3] = Fc, centre
+            key = ("retention", step, cong.key(i, by[name].solid),
+                   tuple((cong.key(index[o], by[o].solid), cong.rel(i, index[o])) for o in partners),
+                   np.round(Fi[:3, :3] @ _perp_frame(d) / 1e-7).astype(np.int64).tobytes(),
+                   cong.rel(i, i, None, T @ np.linalg.inv(cong.frames[i])), tuple(np.round(size, 6).tolist()))
+            free = cong.lookup(key, lambda: free_moves(name, partners, d, centre, Fc, size))
+        for k, f in enumerate(free):
+            n += 1
+            if f:
                 what = ["+axis", "-axis", "+radial", "-radial", "+radial2", "-radial2"][k]
                 fails.append(f"{name} at joint {jn} moves {step:.3g} mm {what} freely")
     return Check("retention", not fails, n - len(fails), n,
