@@ -1,0 +1,71 @@
+"""Reuse across congruent parts (mlc.mesh.congruence): keys see shape and pose, cached checks
+answer as the exact ones do."""
+import numpy as np
+
+from mlc.geometry.rotation import quat_to_matrix
+from mlc.mesh.build import box, build_assembly, cylinder, transform_solid, union
+from mlc.mesh.checks import check_assembly
+from mlc.mesh.congruence import Congruence, pose_key, shape_key
+from mlc.mesh.profiles import load_profile
+from mlc.mesh.spatial import part_frames
+
+
+def _frame(q, t):
+    F = np.eye(4)
+    F[:3, :3] = quat_to_matrix(q)
+    F[:3, 3] = t
+    return F
+
+
+def _part():
+    return union([box([0, 0, 0], np.eye(3), [4.0, 2.0, 0.6]),
+                  cylinder([2.0, 0, 0], [0, 1, 0], -1.0, 1.0, 0.8, 32)])
+
+
+def test_shape_key_is_congruence():
+    a = _part()
+    F = _frame(np.array([0.9, 0.1, -0.3, 0.2]) / np.linalg.norm([0.9, 0.1, -0.3, 0.2]), [3.0, -7.0, 11.0])
+    moved = transform_solid(a, F)
+    assert shape_key(moved, F) == shape_key(a, np.eye(4))
+    # a part 0.01 mm longer, or the same part in another place of its frame, is another shape
+    longer = union([box([0, 0, 0], np.eye(3), [4.01, 2.0, 0.6]), cylinder([2.0, 0, 0], [0, 1, 0], -1.0, 1.0, 0.8, 32)])
+    assert shape_key(longer, np.eye(4)) != shape_key(a, np.eye(4))
+    assert shape_key(a.translate([0.01, 0, 0]), np.eye(4)) != shape_key(a, np.eye(4))
+    assert pose_key(F) != pose_key(F @ _frame([1, 0, 0, 0], [1e-4, 0, 0]))
+
+
+def test_cached_checks_equal_exact_checks():
+    """A connector chain (16 bodies, congruent slabs): every check value with the cache equals the
+    one computed pair by pair without it, and the cache did reuse results."""
+    from mlc.gates.connector import chain_scene
+    from mlc.mesh.pipeline import state_poses
+    scene = chain_scene(2, "expand")
+    poses, _ = state_poses(scene, path_steps=1)
+    asm = build_assembly(scene, load_profile("mjp"), poses, resolve=False, reuse=False)
+    exact = check_assembly(asm, walls=False)
+    asm.congruence = Congruence(part_frames(asm))
+    cached = check_assembly(asm, walls=False)
+    for a, b in zip(exact.checks, cached.checks):
+        assert (a.name, a.ok, a.value, a.failures) == (b.name, b.ok, b.value, b.failures)
+    assert asm.congruence.hits > 0 and asm.congruence.misses > 0
+
+
+def test_state_by_state_trim_clears_the_other_part():
+    """The bounded trim of large assemblies (hulls of the grown copies, state by state) leaves X
+    clear of Y by about the grow as printed and apart from Y in a posed state, and keeps X's
+    protected material."""
+    from mlc.mesh.build import Part, _trim_by
+    import itertools
+    dirs = [np.array(v, float) / np.linalg.norm(v) for v in itertools.product((-1, 0, 1), repeat=3) if any(v)]
+    X = Part("x", "body", box([0, 0, 0], np.eye(3), [10.0, 2.0, 0.6]))
+    Y = Part("y", "body", box([4.0, 0, 0], np.eye(3), [1.0, 1.0, 3.0]))
+    keep = box([-4.0, 0, 0], np.eye(3), [1.0, 1.0, 0.6])
+    T = {"x": np.eye(4), "y": np.eye(4)}
+    T["y"][:3, 3] = [-3.0, 0, 0]                 # a pose where Y sits at x = 1
+    out = _trim_by(X, Y, [None, T], 0.3, dirs, X.solid ^ keep, 0.1, merged=True)
+    assert out is not None and len(out.decompose()) >= 1
+    # the 26 directions are a polyhedral stand-in for a ball (the final trims retry a larger grow)
+    assert out.min_gap(Y.solid, 1.0) >= 0.85 * 0.3
+    assert (out ^ Y.solid.translate([-3.0, 0, 0])).volume() <= 1e-9
+    assert abs((out ^ keep).volume() - keep.volume()) < 1e-9
+    assert out.volume() > 0.5 * X.solid.volume()
