@@ -691,6 +691,33 @@ def _aig_to_expr(s: AIG, leaf_lits: list[int]):
     return _neg(ex[lit >> 1], lit & 1)
 
 
+def _dag_expr(g: AIG, s: AIG, leaf_lits: list[int], incone: set[int], touched, refs):
+    """Expression of the single output of scratch AIG ``s`` over ``leaf_lits`` of
+    ``g``, reusing the nodes of ``g`` that already compute a sub-expression (structural
+    hashing, outside the cone being replaced); also the number of new nodes needed."""
+    n = s.num_inputs
+    ex: dict[int, object] = {0: 0}
+    for i in range(n):
+        ex[i + 1] = leaf_lits[i]
+    new = 0
+    for k, (a, b) in enumerate(s.ands):
+        ea = _neg(ex[a >> 1], a & 1)
+        eb = _neg(ex[b >> 1], b & 1)
+        r = None
+        if isinstance(ea, int) and isinstance(eb, int):
+            r = g.lookup(ea, eb)
+            if r is not None and r > 1 and ((r >> 1) in incone or touched[r >> 1]
+                                            or refs[r >> 1] == 0):
+                r = None
+        if r is None:
+            new += 1
+            ex[n + 1 + k] = ("and", ea, eb, 0)
+        else:
+            ex[n + 1 + k] = r
+    lit = s.output_lits[0]
+    return _neg(ex[lit >> 1], lit & 1), new
+
+
 def refactor(g: AIG, max_leaves: int = 8, zero_gain: bool = False,
              deadline: float | None = None) -> AIG:
     """Collapse the cone of each node over a reconvergence-driven cut of up to
@@ -725,10 +752,9 @@ def refactor(g: AIG, max_leaves: int = 8, zero_gain: bool = False,
         s = AIG([f"l{i}" for i in range(k)])
         s.add_output("f", d.build(s, plan))
         s = s.cleanup()
-        new = s.num_ands()
+        e, new = _dag_expr(g, s, [2 * y for y in leaves], set(cone), touched, refs)
         if new > len(cone) or (new == len(cone) and not zero_gain):
             continue
-        e = _aig_to_expr(s, [2 * y for y in leaves])
         if new == len(cone):
             lev = g.levels()
             if _expr_depth(e, lev) >= lev[x]:
@@ -949,10 +975,18 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
     """Iterate the passes until a round brings no improvement."""
     best = g
     rounds = {0: 0, 1: 2, 2: 6, 3: 20}[effort]
+    big = effort >= 2 and g.num_inputs > TT_LIMIT
+    if big:
+        rounds = 12
+    stale = 0
+    walk = g
+    # big networks: zero-gain moves from the start on small ones, else once the plain
+    # rounds stall (measured: router 228 -> 212, priority 552 -> 443)
+    explore = big and g.num_ands() < 500
     for r in range(rounds):
         if work.now(best.num_nodes) > deadline:
             break
-        cur = best
+        cur = walk if big else best
         cur = sweep(cur)
         if cur.num_inputs > TT_LIMIT:
             cur = resub_window(cur, max_new=1 if effort == 1 else 2, deadline=deadline)
@@ -966,15 +1000,32 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
             od = resub_odc(cur, care, deadline=deadline, max_moves=10 if effort == 2 else 50)
             if cost(od) < cost(cur):
                 cur = resub(od, care, max_new=2, deadline=deadline)
-            if effort >= 3:
+            if effort >= 3 or explore:
                 cur = rewrite(cur, zero_gain=True, deadline=deadline)
                 cur = resub(cur, care, max_new=2, deadline=deadline)
+            if explore:
+                # compress2rs-like: zero-gain restructuring over wider cuts opens
+                # moves for the next round (router 242 -> 231)
+                cur = refactor(cur, max_leaves=10, zero_gain=True, deadline=deadline)
+                cur = resub_window(cur, max_new=2, deadline=deadline)
+                cur = rewrite(cur, zero_gain=True, deadline=deadline)
         b = balance(cur)
         if cost(b) <= cost(cur):
             cur = b
         b = balance(balance_xor(cur))
         if cost(b) <= cost(cur):
             cur = b
+        if big:
+            # keep walking from the zero-gain result; stop after 2 rounds without gain
+            walk = cur
+            if cost(cur) < cost(best):
+                best, stale = cur, 0
+            else:
+                stale += 1
+                if stale >= 2 + (not explore):
+                    break
+                explore = True
+            continue
         if cost(cur) < cost(best):
             best = cur
         else:
