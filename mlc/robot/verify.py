@@ -38,6 +38,7 @@ from mlc.verify.circuit import Report, select_rows
 STEPS = 12                # continuation steps of the static check
 TOL_STRETCH = 1e-3        # sigma
 TOL_LENGTH = 0.05         # sigma: static probe lengths within this of the ideal
+FOLD_TIME = 1800.0        # t0: the paper's fold time, a dynamic run's default limit
 
 
 def robot_meta(scene: Scene) -> dict:
@@ -176,10 +177,13 @@ def verify_robot_static(scene: Scene, rows=None, steps: int = STEPS, progress=No
 
 def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
                          max_time: float | None = None, progress=None, keep_poses: bool = False,
-                         tau: float | None = None) -> Report:
+                         tau: float | None = None, dt: float | None = None) -> Report:
     """Brownian dynamics from rest into each row, ``seeds`` seeds, until every probe has
-    relaxed (at least 3 slowest relaxation times) or ``max_time`` t0; the shape is read
-    from each seed's final poses (see the module doc)."""
+    relaxed (at least 3 slowest relaxation times) or ``max_time`` t0 (default the paper's
+    1800 t0); the shape is read from each seed's final poses (see the module doc).
+    ``dt`` (t0): the scheme's step (default that of :mod:`mlc.verify.dynamic`); ``tau``
+    (t0): the slowest relaxation time if known (computing it takes minutes for a
+    2000-body robot)."""
     from mlc.io.progress import Progress
     from mlc.sim.drive import Drive
     from mlc.sim.integrator import SimOptions, Simulation
@@ -207,10 +211,11 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
             want = scene.truth_table.get(state)
             drives = {inp: Drive.constant(int(b)) for inp, b in zip(scene.inputs, state)}
             t_min = TAU_FACTOR * tau if state != rest else 0.0
-            t_max = float(max_time) if max_time is not None else max(MAX_TIME, MAX_TAUS * tau)
+            t_max = float(max_time) if max_time is not None else min(FOLD_TIME, max(MAX_TIME, MAX_TAUS * tau))
             per = []
             for seed in range(int(seeds)):
-                sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed, dt=DT.get(scheme)))
+                sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed,
+                                                     dt=DT.get(scheme) if dt is None else float(dt)))
                 means, t_rel, relaxed = relax_all(sim, names, kT, t_min, window, t_max, None, tau)
                 shape = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy(), means)
                 per.append((means, t_rel, relaxed, shape))
