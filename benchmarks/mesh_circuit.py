@@ -146,14 +146,23 @@ def main() -> int:
         t = time.perf_counter()
         p = mp.get_context("fork").Process(target=run_case, args=(name, args.profile, q, args.keep))
         p.start()
-        p.join(args.limit)
+        peak = 0        # resident memory of the case's process, polled every second (MB)
+        while p.is_alive() and time.perf_counter() - t < args.limit:
+            try:
+                for line in open(f"/proc/{p.pid}/status"):
+                    if line.startswith("VmRSS"):
+                        peak = max(peak, int(line.split()[1]) // 1024)
+            except OSError:
+                pass
+            p.join(1.0)
         if p.is_alive():
             p.terminate()
             p.join()
             row = {"case": name, "profile": args.profile, "finished": False,
-                   "note": f"stopped after {args.limit:g} s"}
+                   "note": f"stopped after {args.limit:g} s", "peak_rss_polled_mb": peak}
         else:
             row = q.get() if not q.empty() else {"case": name, "finished": False, "note": f"exit {p.exitcode}"}
+            row["peak_rss_polled_mb"] = peak
         row["wall_s"] = round(time.perf_counter() - t, 1)
         rows.append(row)
         print(json.dumps(row), flush=True)

@@ -452,6 +452,9 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         features.append((f"yoke knuckle length ({jname})", min(ks), prof.min_feature))
         features.append((f"hub length ({jname})", hub, prof.min_feature))
 
+    if memo is not None:
+        _share_ujoint_radii(ujoints, base_samples, slabs)
+
     # -- yoke plates: widen slabs to the knuckle span near an axis ------------------
     plates: dict[str, list[SlabBox]] = {b.name: [] for b in scene.bodies}
     for ax in axes:
@@ -469,7 +472,9 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     # -- trim radii: in every logic state, slabs of the bodies at an axis clear each other
     #    outside the radius inside which only the knuckle's own body has material
     for ax in axes:
-        ax.rho = _trim_radius_memo(memo, ax, samples, state_T, t, c, h, s, notes)
+        ax.rho = _trim_radius_memo(memo, ax, samples, state_T, t, c, h, s, notes, slabs)
+    if memo is not None:
+        _share_hinge_radii(axes, samples, slabs)
 
     # -- muscle and probe attachment holes -------------------------------------------
     lug_hole = max(prof.min_feature, 0.08 * s) / 2
@@ -598,7 +603,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
 
     asm = Assembly(scene, prof, parts, axes, ujoints, notes, features, t, poses)
     if reuse:
-        asm.congruence = Congruence(part_frames(asm))
+        asm.congruence = Congruence(_congruence_frames(asm, slabs))
     if resolve:
         _resolve(asm, protected, soft, state_T, asm.congruence)
     _drill(asm, lugs, lug_hole, lug_out, t)
@@ -798,6 +803,20 @@ def _trim_radius(ax: HingeAxis, samples, state_T, t, c, h, s, notes) -> float:
     return float(rho)
 
 
+def _axis_frame(ax: HingeAxis, slabs) -> np.ndarray:
+    """A frame on a hinge axis that turns with its bodies: z along the axis, x the owner's first
+    slab's first in-plane direction made perpendicular to it (the same for congruent hinges,
+    whatever their orientation in the world)."""
+    d = ax.direction
+    R0 = slabs[ax.owner][0].R
+    for k in range(3):
+        x = R0[:, k] - np.dot(R0[:, k], d) * d
+        if np.linalg.norm(x) > 0.1:
+            break
+    x = x / np.linalg.norm(x)
+    return _frame(ax.origin, np.column_stack([x, np.cross(d, x), d]))
+
+
 def _frame(origin, R) -> np.ndarray:
     F = np.eye(4)
     F[:3, :3] = R
@@ -811,12 +830,24 @@ def _rel_keys(F, A, B, state_T) -> tuple:
     return tuple(pose_key(Fi @ np.linalg.inv(Ts[A]) @ Ts[B] @ F) for _, Ts in state_T)
 
 
-def _trim_radius_memo(memo, ax: HingeAxis, samples, state_T, t, c, h, s, notes) -> float:
+def _congruence_frames(asm: "Assembly", slabs) -> list:
+    """A frame per part that congruent parts share: a body's first slab (its world orientation
+    and centre; the body's own frame is arbitrary with respect to its slabs), a joint part's
+    frame of its two pin axes."""
+    out = part_frames(asm)
+    for k, p in enumerate(asm.parts):
+        if p.kind == "body" and slabs.get(p.name):
+            sb = slabs[p.name][0]
+            out[k] = _frame(sb.center, sb.R)
+    return out
+
+
+def _trim_radius_memo(memo, ax: HingeAxis, samples, state_T, t, c, h, s, notes, slabs=None) -> float:
     """:func:`_trim_radius`, computed once per congruent hinge (``memo``: a dict, or None): the
     same knuckle layout, the same slab samples in the axis frame and the same relative poses."""
     if memo is None:
         return _trim_radius(ax, samples, state_T, t, c, h, s, notes)
-    F = _frame(ax.origin, _perp_frame(ax.direction))
+    F = _axis_frame(ax, slabs)
     key = ("hinge", round(ax.span, 9), round(ax.R, 9), t, c, h, s,
            tuple((tuple(np.round(np.asarray(ax.intervals[bn], float).ravel(), 9).tolist()),
                   points_key(samples[bn], F)) for bn in ax.bodies),
@@ -828,6 +859,45 @@ def _trim_radius_memo(memo, ax: HingeAxis, samples, state_T, t, c, h, s, notes) 
     rho, extra = memo[key]
     notes += [x.replace("\0", ax.name) for x in extra]
     return rho
+
+
+def _share_hinge_radii(axes, samples, slabs) -> None:
+    """Congruent hinges (the same knuckles and the same slabs about the axis, as built) get the
+    largest trim radius any of them needs: a larger radius only trims more, and the parts of
+    congruent connector half units stay congruent, so their exact tests are shared."""
+    groups: dict = {}
+    for ax in axes:
+        F = _axis_frame(ax, slabs)
+        key = (round(ax.span, 9), round(ax.R, 9),
+               tuple((tuple(np.round(np.asarray(ax.intervals[bn], float).ravel(), 9).tolist()),
+                      points_key(samples[bn], F)) for bn in ax.bodies))
+        groups.setdefault(key, []).append(ax)
+    for members in groups.values():
+        rho = max(ax.rho for ax in members)
+        for ax in members:
+            ax.rho = rho
+
+
+def _share_ujoint_radii(ujoints, samples, slabs) -> None:
+    """Each side of congruent universal joints (the same yoke layouts and the same slabs of that
+    side's body about the joint, as built) gets the largest trim radius any of them needs on that
+    side.  The other body does not enter the key: the bends of a routed chain differ from
+    junction to junction, and a larger radius only trims more."""
+    for side in (0, 1):
+        groups: dict = {}
+        for uj in ujoints:
+            bn = uj.bodies[side]
+            R = slabs[bn][0].R
+            F = _frame(uj.center, R)
+            lay = tuple((x.mode, tuple(np.round(np.asarray(x.own + x.caps + [x.pin, x.cut, x.plate], float).ravel(),
+                                                9).tolist())) for x in uj.layouts)
+            key = (side, lay, round(uj.hub, 9), round(uj.R, 9), points_key(samples[bn], F),
+                   tuple(np.round(R.T @ uj.axes[side] / 1e-7).astype(np.int64).tolist()))
+            groups.setdefault(key, []).append(uj)
+        for members in groups.values():
+            r = max(u.rho[side] for u in members)
+            for uj in members:
+                uj.rho = (r, uj.rho[1]) if side == 0 else (uj.rho[0], r)
 
 
 def _ujoint_trim_memo(memo, uj: UJoint, samples, state_T, t, c, h):
