@@ -75,6 +75,23 @@ def canon(f: int) -> tuple[int, tuple[int, ...], int, int]:
     return best, perm, neg, bo
 
 
+@lru_cache(maxsize=1 << 16)
+def canon_all(f: int) -> tuple[tuple[int, tuple[int, ...], int, int], ...]:
+    """Every ``(R, perm, neg, out)`` as in :func:`canon` (all transforms of ``f`` onto
+    its class representative): the class circuit on each gives a different structure,
+    so rewriting can pick the one that shares most nodes with the network."""
+    luts = _luts()
+    lo8, hi8 = f & 0xFF, f >> 8
+    R = canon(f)[0]
+    res = []
+    for idx, (lo, hi) in enumerate(luts):
+        g = lo[lo8] | hi[hi8]
+        if g == R or g ^ 0xFFFF == R:
+            perm, neg, _ = _TRANSFORMS[idx]
+            res.append((R, perm, neg, int(g != R)))
+    return tuple(res)
+
+
 def classes() -> list[int]:
     """The representatives (least member) of all 222 NPN classes."""
     seen = bytearray(1 << 16)

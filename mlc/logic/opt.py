@@ -540,6 +540,10 @@ def cut_table(g: AIG, node: int, leaves: tuple[int, ...]) -> int:
     return cone_table(g, node, list(leaves), 4)
 
 
+CUT_LIMIT = 10
+STRUCT_VARIANTS = True
+
+
 def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> AIG:
     """One pass of DAG-aware exact 4-cut rewriting."""
     from mlc.logic import npn
@@ -548,7 +552,7 @@ def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> A
         return g
     tab = npn.table()
     refs = refcounts(g)
-    cuts = enumerate_cuts(g)
+    cuts = enumerate_cuts(g, limit=CUT_LIMIT)
     lev = g.levels()
     touched = bytearray(g.num_nodes)
     repl: dict[int, tuple] = {}
@@ -568,45 +572,51 @@ def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> A
             if any(touched[y] for y in cone):
                 continue
             f = cut_table(g, x, c)
-            R, perm, neg, out = npn.canon(f)
+            R = npn.canon(f)[0]
             ent = tab[R]
             if ent["ands"] > len(cone) or (ent["ands"] == len(cone) and not zero_gain):
                 continue
             leaves = [2 * y for y in c] + [0] * (4 - len(c))
             incone = set(cone)
-            lits: list = [leaves[perm[i]] ^ ((neg >> i) & 1) for i in range(4)]
-            exprs: list = list(lits)
-            new = 0
-            for j, l, fj, fl, fo in ent["gates"]:
-                a, b = lits[j], lits[l]
-                r = None
-                if a is not None and b is not None:
-                    r = g.lookup(a ^ fj, b ^ fl)
-                    if r is not None and ((r >> 1) in incone or touched[r >> 1]
-                                          or refs[r >> 1] == 0):
-                        r = None
-                if r is None:
-                    new += 1
-                    lits.append(None)
-                    exprs.append(("and", exprs[j] ^ fj if isinstance(exprs[j], int) else
-                                  _neg(exprs[j], fj), exprs[l] ^ fl if isinstance(exprs[l], int)
-                                  else _neg(exprs[l], fl), fo))
-                else:
-                    lits.append(r ^ fo)
-                    exprs.append(r ^ fo)
-            gain = len(cone) - new
-            if gain < 0 or (gain == 0 and not zero_gain):
-                continue
-            node, c_out = ent["out"]
-            if node < 0:
-                e = c_out ^ out
-            else:
-                e = exprs[node]
-                e = e ^ c_out ^ out if isinstance(e, int) else _neg(e, c_out ^ out)
-            # depth estimate as a tie-breaker
-            key = (gain, -_expr_depth(e, lev))
-            if best is None or key > best[0]:
-                best = (key, e, cone)
+            seen_lits = set()
+            for _R, perm, neg, out in (npn.canon_all(f) if STRUCT_VARIANTS else [npn.canon(f)]):
+              lits: list = [leaves[perm[i]] ^ ((neg >> i) & 1) for i in range(4)]
+              key = (tuple(lits), out)
+              if key in seen_lits:
+                  continue
+              seen_lits.add(key)
+              exprs: list = list(lits)
+              new = 0
+              for j, l, fj, fl, fo in ent["gates"]:
+                  a, b = lits[j], lits[l]
+                  r = None
+                  if a is not None and b is not None:
+                      r = g.lookup(a ^ fj, b ^ fl)
+                      if r is not None and ((r >> 1) in incone or touched[r >> 1]
+                                            or refs[r >> 1] == 0):
+                          r = None
+                  if r is None:
+                      new += 1
+                      lits.append(None)
+                      exprs.append(("and", exprs[j] ^ fj if isinstance(exprs[j], int) else
+                                    _neg(exprs[j], fj), exprs[l] ^ fl if isinstance(exprs[l], int)
+                                    else _neg(exprs[l], fl), fo))
+                  else:
+                      lits.append(r ^ fo)
+                      exprs.append(r ^ fo)
+              gain = len(cone) - new
+              if gain < 0 or (gain == 0 and not zero_gain):
+                  continue
+              node, c_out = ent["out"]
+              if node < 0:
+                  e = c_out ^ out
+              else:
+                  e = exprs[node]
+                  e = e ^ c_out ^ out if isinstance(e, int) else _neg(e, c_out ^ out)
+              # depth estimate as a tie-breaker
+              key = (gain, -_expr_depth(e, lev))
+              if best is None or key > best[0]:
+                  best = (key, e, cone)
         if best is None:
             continue
         if best[0][0] == 0 and best[0][1] <= -lev[x]:
