@@ -28,6 +28,10 @@ gain d0/L0 = 2.  The sites sit ``POST`` sigma below the skeleton plane, so the c
 last layer stays under the skeleton.  "lock": a constant output (its probe spans one
 rigid slab) holds its DOF with a plain bond between the tips at its constant length.
 
+**Joint stops** (docs/robot.md section 2.3).  Every DOF hinge also gets two flat-bottom
+bonds (:func:`dof_stops`) that leave it free over [-15, 105] degrees of turn and close
+the lever triangle's mirror equilibria at 180 and -90 degrees.
+
 Every DOF has a probe across its tips, named ``dof_u{i}_{side}``, reading the DOF's
 own output (rest d0, actuated d1): the circuit verifier checks the DOF lengths like any
 output, and :mod:`mlc.robot.verify` reads the shape.  Units: sigma, k0, radians.

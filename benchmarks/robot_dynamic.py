@@ -1,0 +1,137 @@
+"""Dynamic verification of the Tetris robot (issue 10, item 3): every row, several seeds,
+Brownian dynamics at kT = 1e-5 from rest until relaxed or the paper's 1800 t0.
+
+One (row, seed) at a time, one process (the machine is shared).  Each run is the same
+as ``mlc verify ROBOT --dynamic`` (:func:`mlc.robot.verify.verify_robot_dynamic`): the
+inputs switch to the row at t = 0 from the rest pose, the stiff scheme advances in
+windows of ``tau/20`` t0, and the run stops when
+
+* it has lasted at least ``3 tau`` (the time floor of :mod:`mlc.verify.dynamic`) and the
+  three block means of every probe (circuit outputs and DOF lengths) over the last third
+  agree within :func:`mlc.verify.dynamic.plateau_tol` (relaxed), or
+* it reaches ``--max-time`` (1800 t0, the paper's fold time; not relaxed).
+
+The shape is read from the final body poses (:func:`mlc.robot.verify.read_shape`).  The
+turns are also read every ``--every`` t0, so the JSON holds each fold's history.
+
+    python benchmarks/robot_dynamic.py OUT/robot.yaml [--rows 11] [--seeds 0 1 2]
+        [--dt 0.2] [--tau 100] [--max-time 1800] [-o benchmarks/results/robot_dynamic.json]
+
+Results are merged into the JSON (keyed by row and seed), so runs can be made one at a
+time.  Units: t0 (times), degrees (angles), sigma, seconds (wall).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import platform
+import sys
+import time
+
+import numpy as np
+
+
+def run_one(scene, state: str, seed: int, dt: float, tau: float, max_time: float, kT: float = 1e-5,
+            every: float = 100.0, scheme: str = "stiff") -> dict:
+    from mlc.robot.verify import _shape_row, robot_meta
+    from mlc.sim.drive import Drive
+    from mlc.sim.integrator import SimOptions, Simulation
+    from mlc.verify.dynamic import MIN_WINDOWS, PLATEAU, TAU_FACTOR, plateau_tol
+
+    rm = robot_meta(scene)
+    names = [p.name for p in scene.probes]
+    drives = {inp: Drive.constant(int(b)) for inp, b in zip(scene.inputs, state)}
+    sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed, dt=dt))
+    window = max(0.05, tau / 20.0)
+    t_min = TAU_FACTOR * tau if state != "0" * len(scene.inputs) else 0.0
+    ends, means, hist = [], {p: [] for p in names}, []
+    wall = time.perf_counter()
+    t, relaxed, next_rec = 0.0, False, every
+    while True:
+        res = sim.run(window, record_interval=window / 10, quiet=True)
+        t = res.time
+        ends.append(t)
+        for p in names:
+            v = res.probes[p]
+            means[p].append(float(np.mean(v[1:] if len(v) > 1 else v)))
+        if t >= next_rec - 1e-9:
+            sh = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy())
+            hist.append({"t": round(t, 3), "turns": sh["turns_read"], "shape": sh["shape_read"]})
+            next_rec += every
+        first = len(ends) - MIN_WINDOWS
+        cut = (1.0 - PLATEAU) * t
+        while first > 0 and ends[first - 1] - window >= cut - 1e-12:
+            first -= 1
+        if first >= 0 and t >= t_min - 1e-12:
+            block = (len(ends) - first) * window / MIN_WINDOWS
+            if all(np.ptp([np.mean(b) for b in np.array_split(means[p][first:], MIN_WINDOWS)])
+                   < plateau_tol(kT, sim.k0, 0.0, tau, block) for p in names):
+                relaxed = True
+                break
+        if t >= max_time - 1e-9:
+            break
+    k = max(first, 0) if relaxed else max(len(ends) - MIN_WINDOWS, 0)
+    pm = {p: float(np.mean(means[p][k:])) for p in names}
+    sh = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy(), pm)
+    want = scene.truth_table.get(state)
+    bad = []
+    for pr in scene.probes:
+        b = want[scene.outputs.index(pr.output)]
+        if b in "01" and pr.bit(pm[pr.name]) != int(b):
+            bad.append(pr.name)
+    return {"row": state, "seed": seed, "shape_read": sh["shape_read"], "shape_expected": sh["shape_expected"],
+            "shape_ok": sh["shape_ok"], "probes_ok": not bad, "wrong_probes": bad,
+            "ok": bool(sh["shape_ok"] and not bad), "turns_read": sh["turns_read"],
+            "turns_expected": sh["turns_expected"], "max_dof_error_deg": round(sh["max_dof_error_deg"], 3),
+            "max_dof_mean_error_deg": round(sh.get("max_dof_mean_error_deg", float("nan")), 3),
+            "dof_angles": [{k2: (round(v, 3) if isinstance(v, float) else v) for k2, v in d.items()}
+                           for d in sh["dof_angles"]],
+            "relaxed": relaxed, "time_t0": round(t, 3), "wall_s": round(time.perf_counter() - wall, 1),
+            "history": hist}
+
+
+def main(argv=None) -> int:
+    from mlc.scene.io import load_scene
+
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("scene")
+    ap.add_argument("--rows", nargs="*")
+    ap.add_argument("--seeds", nargs="*", type=int, default=[0, 1, 2])
+    ap.add_argument("--dt", type=float, default=0.2, help="t0, stiff scheme's step")
+    ap.add_argument("--tau", type=float, default=100.0, help="t0, slowest relaxation time (time floor 3 tau)")
+    ap.add_argument("--max-time", type=float, default=1800.0)
+    ap.add_argument("--every", type=float, default=100.0)
+    ap.add_argument("--kT", type=float, default=1e-5)
+    ap.add_argument("-o", "--out", default="benchmarks/results/robot_dynamic.json")
+    a = ap.parse_args(argv)
+    sc = load_scene(a.scene)
+    rows = a.rows or sorted(sc.truth_table)
+    data = {}
+    if os.path.exists(a.out):
+        with open(a.out) as f:
+            data = json.load(f)
+    runs = {(r["row"], r["seed"]): r for r in data.get("runs", [])}
+    for state in rows:
+        for seed in a.seeds:
+            r = run_one(sc, state, seed, a.dt, a.tau, a.max_time, a.kT, a.every)
+            r.update({"dt": a.dt, "tau": a.tau, "kT": a.kT, "max_time": a.max_time, "scheme": "stiff",
+                      "bodies": len(sc.bodies), "load_1min": round(os.getloadavg()[0], 2)})
+            runs[(state, seed)] = r
+            print(f"row {state} seed {seed}: {r['shape_read']} (expected {r['shape_expected']}) "
+                  f"turns {r['turns_read']}  relaxed {r['relaxed']} at {r['time_t0']} t0, "
+                  f"wall {r['wall_s']} s  {'ok' if r['ok'] else 'WRONG'}", flush=True)
+            data = {"what": "Tetris robot, dynamic verification per row and seed (benchmarks/robot_dynamic.py)",
+                    "scene": a.scene, "machine": f"{platform.machine()}, {os.cpu_count()} cores, shared",
+                    "units": "t0, degrees, seconds wall",
+                    "runs": sorted(runs.values(), key=lambda r: (r["row"], r["seed"]))}
+            data["all_ok"] = all(r["ok"] for r in data["runs"])
+            with open(a.out + ".tmp", "w") as f:
+                json.dump(data, f, indent=1)
+            os.replace(a.out + ".tmp", a.out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
