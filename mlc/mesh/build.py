@@ -1237,6 +1237,8 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
             for X, Y in ((A, B), (B, A)):
                 if X.kind == "joint":
                     continue
+                if cong is not None and cands and cands[0][:3] == (False, False, False):
+                    break     # large assemblies: the first trim that settles, in one piece, is taken
                 hard = protected.get(X.name)
                 soft = soft_protected.get(X.name)
                 # first keep the spot of the attachment hole too (soft), then only the joints (hard)
