@@ -542,6 +542,8 @@ def cut_table(g: AIG, node: int, leaves: tuple[int, ...]) -> int:
 
 CUT_LIMIT = 10
 STRUCT_VARIANTS = True
+ROUNDS_BIG = 30
+STALE_BIG = 4
 
 
 def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> AIG:
@@ -987,7 +989,7 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
     rounds = {0: 0, 1: 2, 2: 6, 3: 20}[effort]
     big = effort >= 2 and g.num_inputs > TT_LIMIT
     if big:
-        rounds = 12
+        rounds = ROUNDS_BIG
     stale = 0
     walk = g
     # big networks: zero-gain moves from the start on small ones, else once the plain
@@ -1032,7 +1034,7 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
                 best, stale = cur, 0
             else:
                 stale += 1
-                if stale >= 2 + (not explore):
+                if stale >= STALE_BIG + (not explore):
                     break
                 explore = True
             continue
