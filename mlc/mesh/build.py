@@ -1266,6 +1266,8 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
                     cong.results[ck] = "none"
                 continue
             unsettled, split, lost, removed, X, trimmed, Y = min(cands, key=lambda x: x[:4])
+            if cong is not None:
+                trimmed = _flat(trimmed)
             X.solid = trimmed
             changed.add(parts.index(X))
             if cong is not None:
@@ -1277,6 +1279,18 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
         if not changed:
             return
         filters.append(changed)
+
+
+def _flat(solid: mf.Manifold) -> mf.Manifold:
+    """The same solid as a fresh mesh (double precision): no boolean history kept with it, and
+    the memory freed by the booleans handed back to the system (glibc ``malloc_trim``)."""
+    out = mf.Manifold(solid.to_mesh64()) if hasattr(solid, "to_mesh64") else solid
+    try:
+        import ctypes
+        ctypes.CDLL("libc.so.6").malloc_trim(0)
+    except (OSError, AttributeError):
+        pass
+    return out
 
 
 def _trim_by(X, Y, sts, grow, dirs, keep, state_grow, merged=False):
