@@ -42,6 +42,34 @@ def test_canon_and_build_random():
         assert g.cleanup().num_ands() <= npn.cost4(f)
 
 
+def _eval_transform(R, perm, neg, out):
+    """The table x -> R(y) ^ out with y_i = x[perm[i]] ^ neg_i, evaluated minterm by minterm."""
+    f = 0
+    for x in range(16):
+        y = 0
+        for i in range(4):
+            if ((x >> perm[i]) & 1) ^ ((neg >> i) & 1):
+                y |= 1 << i
+        f |= (((R >> y) & 1) ^ out) << x
+    return f
+
+
+def test_canon_all_lists_exactly_the_transforms_onto_the_representative():
+    # every listed transform maps f onto its class representative (checked minterm
+    # by minterm, not through the LUTs), and their number is the size of f's
+    # stabiliser: 768 transforms (24 permutations x 16 negations x 2) / its orbit size
+    rng = random.Random(5)
+    a, b, c, d = (T.var(4, i) for i in range(4))
+    for f in [a & b, a ^ b ^ c ^ d, (a & b) | (c & d)] + [rng.getrandbits(16) for _ in range(20)]:
+        R = npn.canon(f)[0]
+        ts = npn.canon_all(f)
+        assert npn.canon(f) in ts
+        for R2, perm, neg, out in ts:
+            assert R2 == R and _eval_transform(R, perm, neg, out) == f
+        orbit = {_eval_transform(f, p, n, o) for p, n, _ in npn._TRANSFORMS for o in (0, 1)}
+        assert len(ts) * len(orbit) == 768
+
+
 def test_sat_proves_small_minima():
     """The exact engine proves the full adder (7) and majority-3 (4) minimal and its
     circuits simulate correctly."""

@@ -540,6 +540,34 @@ def cut_table(g: AIG, node: int, leaves: tuple[int, ...]) -> int:
     return cone_table(g, node, list(leaves), 4)
 
 
+def _place_class_circuit(g: AIG, ent: dict, lits: list, out: int, incone: set[int],
+                         touched, refs):
+    """Expression of the NPN class circuit ``ent`` on leaf literals ``lits`` (output
+    complemented by ``out``), reusing nodes of ``g`` outside ``incone``; also the
+    number of new nodes it needs."""
+    lits = list(lits)
+    exprs: list = list(lits)
+    new = 0
+    for j, l, fj, fl, fo in ent["gates"]:
+        a, b = lits[j], lits[l]
+        r = None
+        if a is not None and b is not None:
+            r = g.lookup(a ^ fj, b ^ fl)
+            if r is not None and ((r >> 1) in incone or touched[r >> 1] or refs[r >> 1] == 0):
+                r = None
+        if r is None:
+            new += 1
+            lits.append(None)
+            exprs.append(("and", _neg(exprs[j], fj), _neg(exprs[l], fl), fo))
+        else:
+            lits.append(r ^ fo)
+            exprs.append(r ^ fo)
+    node, c_out = ent["out"]
+    if node < 0:
+        return c_out ^ out, new
+    return _neg(exprs[node], c_out ^ out), new
+
+
 CUT_LIMIT = 10
 STRUCT_VARIANTS = True
 ROUNDS_BIG = 30
@@ -582,43 +610,17 @@ def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> A
             incone = set(cone)
             seen_lits = set()
             for _R, perm, neg, out in (npn.canon_all(f) if STRUCT_VARIANTS else [npn.canon(f)]):
-              lits: list = [leaves[perm[i]] ^ ((neg >> i) & 1) for i in range(4)]
-              key = (tuple(lits), out)
-              if key in seen_lits:
-                  continue
-              seen_lits.add(key)
-              exprs: list = list(lits)
-              new = 0
-              for j, l, fj, fl, fo in ent["gates"]:
-                  a, b = lits[j], lits[l]
-                  r = None
-                  if a is not None and b is not None:
-                      r = g.lookup(a ^ fj, b ^ fl)
-                      if r is not None and ((r >> 1) in incone or touched[r >> 1]
-                                            or refs[r >> 1] == 0):
-                          r = None
-                  if r is None:
-                      new += 1
-                      lits.append(None)
-                      exprs.append(("and", exprs[j] ^ fj if isinstance(exprs[j], int) else
-                                    _neg(exprs[j], fj), exprs[l] ^ fl if isinstance(exprs[l], int)
-                                    else _neg(exprs[l], fl), fo))
-                  else:
-                      lits.append(r ^ fo)
-                      exprs.append(r ^ fo)
-              gain = len(cone) - new
-              if gain < 0 or (gain == 0 and not zero_gain):
-                  continue
-              node, c_out = ent["out"]
-              if node < 0:
-                  e = c_out ^ out
-              else:
-                  e = exprs[node]
-                  e = e ^ c_out ^ out if isinstance(e, int) else _neg(e, c_out ^ out)
-              # depth estimate as a tie-breaker
-              key = (gain, -_expr_depth(e, lev))
-              if best is None or key > best[0]:
-                  best = (key, e, cone)
+                lits = [leaves[perm[i]] ^ ((neg >> i) & 1) for i in range(4)]
+                if (tuple(lits), out) in seen_lits:
+                    continue
+                seen_lits.add((tuple(lits), out))
+                e, new = _place_class_circuit(g, ent, lits, out, incone, touched, refs)
+                gain = len(cone) - new
+                if gain < 0 or (gain == 0 and not zero_gain):
+                    continue
+                key = (gain, -_expr_depth(e, lev))      # depth estimate as a tie-breaker
+                if best is None or key > best[0]:
+                    best = (key, e, cone)
         if best is None:
             continue
         if best[0][0] == 0 and best[0][1] <= -lev[x]:
