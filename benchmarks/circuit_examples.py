@@ -1,0 +1,85 @@
+"""Every example as a circuit: size, build time, static verification of every row.
+
+For each logic file in ``examples/`` (the same set as ``tests/test_circuit_examples.py``):
+compile (synthesis, mapping, proof), build the circuit scene, verify it statically on
+every row of its truth table, and record gates, bodies, chains, half units, the chains
+the router flagged tight, the build and verification wall times, the rows read right,
+the largest joint stretch and the smallest slab clearance per row (exact oriented-box
+test) with the pair of bodies that sets it.
+
+    python benchmarks/circuit_examples.py [--only tetris.tt ...]
+
+Writes benchmarks/results/circuit_examples.json.  Wall seconds on this machine in one
+run (shared, noisy): compare ratios, not absolute numbers across machines.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import subprocess
+import time
+from pathlib import Path
+
+from mlc.pipeline import build, compile_spec, load
+from mlc.verify.circuit import verify_static
+
+ROOT = Path(__file__).resolve().parents[1]
+OUT = ROOT / "benchmarks" / "results"
+SUFFIXES = (".tt", ".pla", ".expr", ".blif", ".aag")
+
+
+def example_point(path: Path) -> dict:
+    t0 = time.perf_counter()
+    compiled = compile_spec(load(str(path)))
+    t1 = time.perf_counter()
+    compiled = build(compiled)
+    t2 = time.perf_counter()
+    circ = compiled.circuit
+    sc = circ.scene
+    rep = verify_static(sc)
+    t3 = time.perf_counter()
+    rows = [{"state": r["state"], "ok": r["ok"], "clearance": r.get("clearance"),
+             "clearance_pair": r.get("clearance_pair"), "joint_stretch": r["joint_stretch"]} for r in rep.rows]
+    return {"example": path.name, "inputs": len(sc.inputs), "outputs": len(sc.outputs),
+            "gates": len(compiled.netlist.gates), "bodies": len(sc.bodies), "chains": circ.chains,
+            "half_units": circ.half_units, "tight_chains": sc.meta["connector"]["tight_chains"],
+            "compile_s": t1 - t0, "build_s": t2 - t1, "verify_all_rows_s": t3 - t2,
+            "rows": len(rows), "rows_ok": sum(r["ok"] for r in rows), "ok": rep.ok,
+            "max_joint_stretch": max(r["joint_stretch"] for r in rows),
+            "min_clearance": min(r["clearance"] for r in rows), "rows_clear": sum(r["clearance"] > 0 for r in rows),
+            "per_row": rows}
+
+
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--only", nargs="*", help="example file names (default: all)")
+    args = ap.parse_args()
+    paths = sorted(p for p in (ROOT / "examples").iterdir() if p.suffix in SUFFIXES)
+    if args.only:
+        paths = [p for p in paths if p.name in args.only]
+    try:
+        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                                text=True).stdout.strip()
+    except OSError:
+        commit = "?"
+    points = []
+    OUT.mkdir(parents=True, exist_ok=True)
+    for p in paths:
+        pt = example_point(p)
+        points.append(pt)
+        print(f"{pt['example']:>18}: {pt['gates']} gates, {pt['bodies']} bodies, build {pt['build_s']:.1f} s, "
+              f"{pt['rows_ok']}/{pt['rows']} rows right in {pt['verify_all_rows_s']:.1f} s, "
+              f"clear in {pt['rows_clear']}/{pt['rows']} rows, smallest clearance {pt['min_clearance']:+.4f} sigma",
+              flush=True)
+        res = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
+                           "load_after": list(os.getloadavg())}, "commit": commit,
+               "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "examples": points,
+               "complete": len(points) == len(paths)}
+        (OUT / "circuit_examples.json").write_text(json.dumps(res, indent=1))     # after each example
+    print(f"wrote {OUT / 'circuit_examples.json'}")
+
+
+if __name__ == "__main__":
+    main()
