@@ -955,3 +955,20 @@ def test_verify_and_compile_refuse_absurd_seed_counts(seeds, tmp_path, capsys):
     code, _, err = run(capsys, "compile", "-e", "z = a & b", "-o", tmp_path / "o", "--verify", "--dynamic",
                        "--seeds", seeds)
     assert_clean_failure(code, err, before, tmp_path, "--seeds")
+
+
+def test_stl_refuses_a_mechanism_too_large_to_mesh(tmp_path, capsys):
+    """A 40-unit connector chain (one mechanism of more than 150 bodies, like a compiled
+    circuit) is refused before any work: the circuit trims can exhaust the memory."""
+    from mlc.gates.connector import chain_scene
+    from mlc.mesh.profiles import MAX_MECHANISM_BODIES
+    from mlc.scene.io import write_scene
+    sc = chain_scene(40)
+    assert len(sc.bodies) > MAX_MECHANISM_BODIES
+    path = tmp_path / "chain.yaml"
+    write_scene(sc, path)
+    out = tmp_path / "out"
+    out.mkdir()
+    code, stdout, err = run(capsys, "stl", str(path), "-o", str(out / "x.stl"))
+    assert_clean_failure(code, err, {}, out, f"{len(sc.bodies)} bodies", f"at most {MAX_MECHANISM_BODIES}",
+                         "mlc stl NAND")

@@ -171,6 +171,7 @@ def _plain(v):
 MAX_SIGMA_MM = 1000.0
 #: most polygon segments per circle (a 3 mm pin at 256 segments is within 0.0001 mm of a circle)
 MAX_SEGMENTS = 256
+MAX_MECHANISM_BODIES = 150   # larger mechanisms (compiled circuits) are refused: see check_against_scene
 #: memory an export may always plan to use (bytes); see :func:`memory_budget`
 MEMORY_BUDGET = 2 * 2 ** 30
 
@@ -375,6 +376,13 @@ def check_against_scene(prof: Profile, scene, where: str = "--profile", options:
                        f"(every knuckle would be trimmed: a single hinge then takes 20 s instead of 2 s)", opt(f),
                        f"use knuckle_gap >= {prof.clearance:g} mm" if f == "knuckle_gap" else
                        f"use clearance <= {prof.knuckle_gap:g} mm, or raise knuckle_gap with it")
+    reps, _ = _mechanisms(scene)
+    largest = max((len(b) for b in reps), default=0)
+    if largest > MAX_MECHANISM_BODIES:
+        raise MlcError(f"one mechanism of this scene has {largest} bodies; mlc meshes mechanisms of at most "
+                       f"{MAX_MECHANISM_BODIES} (a compiled circuit's final trims can exhaust the memory: the Tetris "
+                       f"circuit, 1631 bodies, was killed at 24 GB; docs/printing.md, 'Compiled circuits')",
+                       "TARGET", "mesh the library gates on their own (mlc stl NAND), or a circuit of fewer gates")
     est = estimate_memory(prof, scene)
     budget = memory_budget()
     if est["bytes"] > budget:
