@@ -142,3 +142,35 @@ def test_joint_stops_close_the_mirror_branches(robot):
     # the same bodies without the stops: the mirror minimum at 180 degrees is back
     sc.bonds = [b for b in sc.bonds if not b.name.startswith("skel_stop_")]
     assert _joint_energy(sc, dm, 180, 1) < 1e-12
+
+
+@pytest.mark.parametrize("opts, words", [
+    (["--tau", "0"], "--tau must be a finite time > 0"),
+    (["--tau", "-5"], "--tau must be a finite time > 0"),
+    (["--tau", "nan"], "--tau must be a finite time > 0"),
+    (["--dt", "inf"], "--dt must be a finite time > 0"),
+    (["--dt", "0"], "--dt must be a finite time > 0"),
+])
+def test_verify_tau_dt_are_validated(robot, capsys, opts, words):
+    rc = main(["verify", str(robot / "out" / "robot.yaml"), "--dynamic", *opts])
+    err = capsys.readouterr().err
+    assert rc == 2 and words in err and "Traceback" not in err
+
+
+def test_verify_tau_dt_need_dynamic_and_a_robot(robot, capsys):
+    rc = main(["verify", str(robot / "out" / "robot.yaml"), "--tau", "100"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "--tau needs --dynamic" in err
+    # a circuit's dynamic check computes its own tau and step (mlc.verify.circuit.verify_dynamic)
+    rc = main(["verify", str(robot / "out" / "circuit.yaml"), "--dynamic", "--dt", "0.1"])
+    err = capsys.readouterr().err
+    assert rc == 2 and "--dt applies to robot scenes only" in err and "Traceback" not in err
+
+
+def test_verify_tau_dt_reach_the_robot_run(robot, capsys):
+    # given tau and dt are used as given (no relaxation-time computation): the report says so
+    rc = main(["verify", str(robot / "out" / "robot.yaml"), "--dynamic", "--seeds", "1", "--rows", "0",
+               "--tau", "2", "--dt", "0.1", "--json"])
+    rep = json.loads(capsys.readouterr().out)
+    assert rc == 0 and rep["params"]["tau"] == 2.0 and rep["params"]["dt"] == 0.1
+    assert rep["rows"][0]["shape_read"] == "I"

@@ -19,6 +19,13 @@ def register(sub):
     p.add_argument("--kT", type=float, default=1e-5, help="thermal energy for --dynamic (k0 sigma^2, default 1e-5)")
     p.add_argument("--seeds", type=int, default=3, help="seeds per row for --dynamic (default 3)")
     p.add_argument("--scheme", choices=("stiff", "euler"), default="stiff", help="integrator for --dynamic")
+    p.add_argument("--tau", type=float, metavar="T",
+                   help="--dynamic, robot scenes only: the slowest relaxation time (t0); a run lasts at least 3 T and "
+                        "ends at the first plateau or the fold time. Default for a robot: mlc.robot.verify.ROBOT_TAU "
+                        "(docs/robot.md section 3); circuits always compute it")
+    p.add_argument("--dt", type=float, metavar="DT",
+                   help="--dynamic, robot scenes only: the integrator's step (t0). Default for a robot: "
+                        "mlc.robot.verify.ROBOT_DT; circuits use the verifier's own step")
     p.add_argument("--rows", metavar="BITS", nargs="+", help="verify only these rows (bit strings in input order)")
     p.add_argument("--require-clearance", action="store_true",
                    help="static: also fail a row whose slabs interpenetrate (reported as a warning otherwise)")
@@ -27,14 +34,21 @@ def register(sub):
 
 
 def verify_scene_file(scene, dynamic: bool = False, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
-                      rows=None, require_clearance: bool = False):
-    """The report for an already loaded scene (used by ``mlc compile --verify`` too)."""
+                      rows=None, require_clearance: bool = False, tau: float | None = None, dt: float | None = None):
+    """The report for an already loaded scene (used by ``mlc compile --verify`` too).  ``tau``
+    and ``dt`` (t0) apply to robot scenes only (mlc.verify.circuit.verify_dynamic takes
+    neither): given for a circuit, they are refused."""
+    from mlc.errors import MlcError
     from mlc.io.progress import Progress
     from mlc.verify.circuit import select_rows, verify_dynamic, verify_static
 
     if isinstance(scene.meta, dict) and scene.meta.get("element") == "robot":     # docs/robot.md
         from mlc.robot.verify import verify_robot
-        return verify_robot(scene, dynamic, kT, seeds, scheme, rows)
+        return verify_robot(scene, dynamic, kT, seeds, scheme, rows, tau=tau, dt=dt)
+    for opt, v in (("--tau", tau), ("--dt", dt)):
+        if v is not None:
+            raise MlcError(f"{opt} applies to robot scenes only; {scene.name} is not a robot scene", opt,
+                           f"leave {opt} out (a circuit's dynamic check computes its own relaxation time and step)")
     n = len(select_rows(scene, rows))
     if dynamic:
         return verify_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme)
@@ -53,12 +67,20 @@ def run(args) -> int:
     if args.dynamic and not 1 <= args.seeds <= MAX_SEEDS:
         raise MlcError(f"--seeds must be between 1 and {MAX_SEEDS}, got {args.seeds} (each seed of each row is a "
                        f"Brownian-dynamics run of minutes on a circuit)", "--seeds")
+    for opt, v in (("--tau", args.tau), ("--dt", args.dt)):
+        if v is None:
+            continue
+        if not args.dynamic:
+            raise MlcError(f"{opt} needs --dynamic (it sets the Brownian-dynamics run)", opt, f"add --dynamic or leave {opt} out")
+        if not (v > 0 and v < float("inf")):
+            raise MlcError(f"{opt} must be a finite time > 0 (t0), got {v}", opt,
+                           "e.g. --tau 100 --dt 0.2 for the Tetris robot (docs/robot.md section 3)")
     scene = load_scene(args.scene)
     if args.dynamic:
         from mlc.io.warmup import notice
         notice(args.scheme)
     rep = verify_scene_file(scene, args.dynamic, args.kT, args.seeds, args.scheme, args.rows,
-                            args.require_clearance)
+                            args.require_clearance, tau=args.tau, dt=args.dt)
     if isinstance(scene.meta, dict) and scene.meta.get("element") == "robot":
         from mlc.robot.verify import format_robot_report as format_report
     print(json.dumps(rep.as_dict()) if args.json else format_report(rep))

@@ -39,6 +39,8 @@ STEPS = 12                # continuation steps of the static check
 TOL_STRETCH = 1e-3        # sigma
 TOL_LENGTH = 0.05         # sigma: static probe lengths within this of the ideal
 FOLD_TIME = 1800.0        # t0: the paper's fold time, a dynamic run's default limit
+ROBOT_TAU = 100.0         # t0: a robot's slowest relaxation time, measured, not computed (docs/robot.md section 3)
+ROBOT_DT = 0.05           # t0: the stiff scheme's largest documented step (mlc.sim.integrator.STIFF_DT_DEFAULT)
 
 
 def robot_meta(scene: Scene) -> dict:
@@ -181,13 +183,14 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
     """Brownian dynamics from rest into each row, ``seeds`` seeds, until every probe has
     relaxed (at least 3 slowest relaxation times) or ``max_time`` t0 (default the paper's
     1800 t0); the shape is read from each seed's final poses (see the module doc).
-    ``dt`` (t0): the scheme's step (default that of :mod:`mlc.verify.dynamic`); ``tau``
-    (t0): the slowest relaxation time if known (computing it takes minutes for a
-    2000-body robot)."""
+    ``dt`` (t0): the scheme's step (default ``ROBOT_DT``); ``tau`` (t0): the slowest
+    relaxation time (default ``ROBOT_TAU``, measured on the robots' folds, docs/robot.md
+    section 3; ``"compute"`` runs :func:`mlc.verify.dynamic.relaxation_time`, which takes
+    more than 8 min for a 2000-body robot)."""
     from mlc.io.progress import Progress
     from mlc.sim.drive import Drive
     from mlc.sim.integrator import SimOptions, Simulation
-    from mlc.verify.dynamic import DT, MAX_TAUS, MAX_TIME, TAU_FACTOR, WINDOW, relax_all, relaxation_time
+    from mlc.verify.dynamic import MAX_TAUS, MAX_TIME, TAU_FACTOR, WINDOW, relax_all, relaxation_time
 
     rm = robot_meta(scene)
     states = select_rows(scene, rows)
@@ -195,12 +198,19 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
         raise MlcError(f"need at least one seed, got {seeds}", "--seeds")
     if not (math.isfinite(kT) and kT >= 0):
         raise MlcError(f"kT must be finite and >= 0, got {kT}", "--kT")
+    for opt, v in (("--tau", tau), ("--dt", dt)):
+        if v is not None and not (isinstance(v, str) and v == "compute" and opt == "--tau") \
+                and not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
+            raise MlcError(f"{opt} must be a finite time > 0 (t0), got {v}", opt)
     t0 = time.perf_counter()
     opt0 = SimOptions(scheme=scheme)
-    tau = relaxation_time(scene, gamma_r=opt0.gamma_r) if tau is None else float(tau)
+    if tau == "compute":
+        tau = relaxation_time(scene, gamma_r=opt0.gamma_r)
+    tau = ROBOT_TAU if tau is None else float(tau)
+    dt = ROBOT_DT if (dt is None and scheme == "stiff") else dt
     window = max(WINDOW, tau / 20.0)
     rep = Report(scene.name, "dynamic", params={"kT": kT, "seeds": int(seeds), "scheme": scheme, "tau": tau,
-                                                "robot": True})
+                                                "dt": dt, "robot": True})
     names = [p.name for p in scene.probes]
     rest = "0" * len(scene.inputs)
     poses = {}
@@ -215,7 +225,7 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
             per = []
             for seed in range(int(seeds)):
                 sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed,
-                                                     dt=DT.get(scheme) if dt is None else float(dt)))
+                                                     dt=None if dt is None else float(dt)))
                 means, t_rel, relaxed = relax_all(sim, names, kT, t_min, window, t_max, None, tau)
                 shape = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy(), means)
                 per.append((means, t_rel, relaxed, shape))
@@ -258,13 +268,14 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
 
 
 def verify_robot(scene: Scene, dynamic: bool = False, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
-                 rows=None) -> Report:
-    """``mlc verify`` of a robot scene: static (default) or by Brownian dynamics."""
+                 rows=None, tau: float | None = None, dt: float | None = None) -> Report:
+    """``mlc verify`` of a robot scene: static (default) or by Brownian dynamics (``tau``
+    and ``dt`` in t0, defaults ``ROBOT_TAU`` and ``ROBOT_DT``)."""
     from mlc.io.progress import Progress
 
     robot_meta(scene)
     if dynamic:
-        return verify_robot_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme)
+        return verify_robot_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme, tau=tau, dt=dt)
     n = len(select_rows(scene, rows))
     with Progress(f"static verification of {scene.name}", total=n) as bar:
         return verify_robot_static(scene, rows, progress=lambda done, total: bar.update(done))
@@ -311,4 +322,4 @@ def format_any(rep: Report) -> str:
     return format_report(rep)
 
 
-__all__ = ["format_any", "format_robot_report", "read_shape", "robot_meta", "verify_robot_dynamic", "verify_robot_static"]
+__all__ = ["FOLD_TIME", "ROBOT_DT", "ROBOT_TAU", "format_any", "format_robot_report", "read_shape", "robot_meta", "verify_robot_dynamic", "verify_robot_static"]
