@@ -29,7 +29,9 @@ def test_scene_is_posed_consistently_and_round_trips(tetris):
     A = sc.arrays()
     p = np.array([b.world(s) for b in sc.bodies for s in b.sites])
     d = np.linalg.norm(p[A.bond_i] - p[A.bond_j], axis=1)
-    assert np.max(np.abs(d - A.bond_rest)) < 1e-6
+    # (joint stops are flat-bottom bonds: free within rest +- tol, and none engaged at build)
+    assert np.max(np.maximum(0.0, np.abs(d - A.bond_rest) - A.bond_tol)) < 1e-6
+    assert any(b.name.startswith("w_") and b.tolerance > 0 for b in sc.bonds)      # the chains have stops
     dm = np.linalg.norm(p[A.muscle_i] - p[A.muscle_j], axis=1)
     assert np.max(np.abs(dm - A.muscle_rest)) < 1e-6
     # one muscle per circuit input

@@ -186,6 +186,44 @@ def test_largest_bend_is_the_gap_formula(signal):
         chain_scene(2, signal, 1.01 * mb)
 
 
+@pytest.mark.parametrize("signal", SIGNALS)
+def test_junction_stop_distance_is_the_bend_formula(signal):
+    """A junction stop's two sites sit on the layers' centre lines through the joint, so
+    they are 2 m cos(beta/2) apart (falling monotonically to 180 degrees, independent of
+    the wire's state); the stop is free up to STOP_FRACTION of max_bend and engaged past it."""
+    from mlc.gates.connector import STOP_ARM, STOP_FRACTION
+    geo = connector_geometry(signal)
+    mb = max_bend(geo)
+    for frac in (0.0, 0.5, 0.85, 0.95, 1.0):
+        sc = chain_scene(2, signal, frac * mb, stops=True)      # junction 2 (between the units) bent
+        stops = {b.name: b for b in sc.bonds if b.tolerance > 0}
+        assert sorted(stops) == ["c_s1", "c_s2", "c_s3"]        # one stop per junction
+        b = stops["c_s2"]
+        body = {x.name: x for x in sc.bodies}
+        pa = body[b.a.split(".")[0]].world(b.a.split(".")[1])
+        pb = body[b.b.split(".")[0]].world(b.b.split(".")[1])
+        d = float(np.linalg.norm(pa - pb))
+        assert d == pytest.approx(2 * STOP_ARM * math.cos(0.5 * frac * mb), abs=1e-9)
+        assert (d < b.rest - b.tolerance) == (frac > STOP_FRACTION)
+
+
+@pytest.mark.parametrize("signal", SIGNALS)
+def test_junction_stop_holds_the_layers_apart(signal):
+    """Independent check of the stop against the slab geometry: a 2-unit chain built bent to
+    the layers' contact (max_bend) at its middle junction, with stops, relaxes statically along its floppy mode to
+    the stop and the oriented-box test then finds the layers clear in both states; without
+    stops the same pose stays in contact."""
+    mb = max_bend(connector_geometry(signal))
+    for stops in (True, False):
+        sc = chain_scene(2, signal, mb, stops=stops)
+        worst = min(clearance(sc, eq.pos, eq.quat).min_clearance
+                    for eq in (equilibrium(sc, "0"), equilibrium(sc, "1")))
+        if stops:
+            assert worst > 0.0
+        else:
+            assert worst < 0.0
+
+
 # -- the floppy mode --------------------------------------------------------------
 
 @pytest.mark.parametrize("state", ["0", "1"])

@@ -37,7 +37,7 @@ import numpy as np
 
 from mlc.errors import MlcError
 from mlc.gates.connector import (POST_WIDTH, ConnectorGeometry, Pair, Parts, branch_angles, chain_parts, connector_geometry,
-                                 half_unit_parts, join, max_bend, rotate)
+                                 half_unit_parts, half_unit_prefix, join, junction_stops, max_bend, rotate)
 from mlc.gates.parts import slab_body
 from mlc.scene.model import Body, Bond, Muscle, Probe, Scene
 
@@ -332,6 +332,8 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
                     parts, pin, pout = half_unit_parts(f"{tag}_stub", start.centre, start.axis, t0, sstate, geo,
                                                        in_stop=stop_at_tap if start is tap else POST_WIDTH)
                     parts.bonds += join(f"{tag}_stub_j", start, pin, geo.k)
+                    if start is not tap and half_unit_prefix(start):     # a page: stop its junction
+                        parts.bonds += junction_stops(f"{tag}_stub_s", half_unit_prefix(start), f"{tag}_stub", geo, geo.k)
                     add(parts)
                     n_half += 1
                     end = pout
@@ -394,7 +396,7 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
             if gap_ < space_clear:
                 tight.append((tag, round(float(gap_), 3)))
             parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, sstate, geo,
-                                       in_stop=stop_at_tap if start is tap else POST_WIDTH)
+                                       in_stop=stop_at_tap if start is tap else POST_WIDTH, stops=True)
             # the last half unit's output post is longer so its layer clears the lever plane:
             last = len(route.bends) - 1
             for b in list(parts.bodies):
@@ -408,6 +410,8 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
                                             out_stop=LEVER_STOP)
             parts.add(lp)
             parts.bonds += join(f"{tag}_j0", start, pairs[0], geo.k)
+            if start is not tap and half_unit_prefix(start):     # the junction after a branch page
+                parts.bonds += junction_stops(f"{tag}_s0", half_unit_prefix(start), f"{tag}_0", geo, geo.k)
             add(parts)
             n_chains += 1
             n_half += len(route.bends)

@@ -58,6 +58,8 @@ _EZ = np.array([0.0, 0.0, 1.0])
 
 DEFAULT_GAP = 0.5          # sigma: gap between two layers at a junction (posts of gap/2 each)
 POST_WIDTH = 0.08          # sigma: cross-section of the posts that carry the joint sites
+STOP_FRACTION = 0.9        # a junction stop engages at this fraction of the largest bend (max_bend)
+STOP_ARM = 1.5             # sigma: its sites sit this far from the junction's joint, one on each layer's centre line
 
 
 def wire_lengths(signal: str, design: Design | None = None) -> tuple[float, float]:
@@ -204,6 +206,10 @@ def half_unit_parts(prefix: str, centre, axis, tangent, state: int, geo: Connect
         name = f"{prefix}_{x}{y}"
         post = carrier[x + y]
         sites = {**axis_sites(x, V[x], t, w), **axis_sites(y, V[y], t, w), post: J[post]}
+        if x + y == "DA":                  # junction_stops: on the line through D along t, STOP_ARM below its joint
+            sites["stop_out"] = J["D"] - STOP_ARM * t
+        if x + y == "AB":                  # ... and through A, STOP_ARM above its joint
+            sites["stop_in"] = J["A"] + STOP_ARM * t
         body = slab_body(name, [(V[x], V[y])], sites, t, w, geo.thickness)
         # the post: a thin rod from the layer face to the joint site (body frame)
         # (it stops POST_WIDTH short of the joint site, where the joint part sits)
@@ -228,6 +234,32 @@ def join(name: str, a: Pair, b: Pair, k: float = 1.0, tolerance: float = 0.0) ->
             universal_joint(f"{name}_hi", a.hi, b.hi, k, tolerance)]
 
 
+def junction_stops(name: str, lower: str, upper: str, geo: "ConnectorGeometry", k: float = 1.0) -> list[Bond]:
+    """A flat-bottom bond that stops the junction between half units ``lower`` and
+    ``upper`` (prefixes; ``upper`` hangs on ``lower``'s output pair) before their layers
+    touch (docs/circuits.md section 1.2, "Junction stops").
+
+    The line through ``lower``'s output vertex D along its tangent t0 and the line through
+    ``upper``'s input vertex A along t1 both pass through the joint that joins them.  A
+    site on each line, ``STOP_ARM`` from the joint (into each layer), is therefore
+    2 m cos(beta/2) apart when the junction bends by beta (either way): a distance that
+    falls monotonically all the way to beta = 180 degrees and does not depend on the
+    rhombi's opening (the wire's state), so no solver step can jump past the stop.  The
+    bond (U = k/2 max(0, |d - rest| - tol)^2) is free down to the distance at
+    ``STOP_FRACTION`` of :func:`max_bend` (the closing side's contact at the larger half
+    diagonal) and stiff below.  Units: sigma, k0."""
+    m = STOP_ARM
+    d_stop = 2.0 * m * math.cos(0.5 * STOP_FRACTION * max_bend(geo))
+    d_free = 2.0 * m + 0.5                          # never reached (d <= 2 m)
+    rest, tol = 0.5 * (d_stop + d_free), 0.5 * (d_free - d_stop)
+    return [Bond(f"{name}", f"{lower}_DA.stop_out", f"{upper}_AB.stop_in", k, rest, tol, "bond", None)]
+
+
+def half_unit_prefix(pair: Pair) -> str | None:
+    """The prefix of the half unit whose output pair is ``pair`` (None: not a half unit's)."""
+    return pair.lo[:-len("_DA.D")] if pair.lo.endswith("_DA.D") and pair.hi.endswith("_BC.B") else None
+
+
 def chain_frames(centre, axis, tangent, bends, pitch: float):
     """Forward kinematics of a chain of ``len(bends)`` half units.
 
@@ -249,9 +281,10 @@ def chain_frames(centre, axis, tangent, bends, pitch: float):
 
 def chain_parts(prefix: str, centre, axis, tangent, bends, state: int, geo: ConnectorGeometry,
                 k: float | None = None, tolerance: float = 0.0,
-                in_stop: float = POST_WIDTH) -> tuple[Parts, list[Pair]]:
+                in_stop: float = POST_WIDTH, stops: bool = False) -> tuple[Parts, list[Pair]]:
     """A chain of ``len(bends)`` half units (see :func:`chain_frames`), the first input pair
-    carrying ``state``.  Consecutive half units are joined by two universal joints.
+    carrying ``state``.  Consecutive half units are joined by two universal joints, and
+    with ``stops`` by the two :func:`junction_stops` that keep their layers apart.
     ``in_stop``: how far the first half unit's input posts stop short of their joints (see
     :func:`half_unit_parts`).  Returns (parts, pairs) with pairs[0] the chain's input and
     pairs[-1] its output."""
@@ -264,6 +297,8 @@ def chain_parts(prefix: str, centre, axis, tangent, bends, state: int, geo: Conn
         parts.add(p)
         if pairs:
             parts.bonds += join(f"{prefix}_j{i}", pairs[-1], pin, k)
+            if stops:
+                parts.bonds += junction_stops(f"{prefix}_s{i}", f"{prefix}_{i - 1}", f"{prefix}_{i}", geo, k)
         else:
             pairs.append(pin)
         pairs.append(pout)
@@ -297,12 +332,14 @@ def half_unit_scene(signal: str = "expand", design: Design | None = None) -> Sce
 
 
 def chain_scene(units: int, signal: str = "expand", bend: float = 0.0, design: Design | None = None,
-                tolerance: float = 0.0, gap: float = DEFAULT_GAP, probe_every_unit: bool = False) -> Scene:
+                tolerance: float = 0.0, gap: float = DEFAULT_GAP, probe_every_unit: bool = False,
+                stops: bool = False) -> Scene:
     """A chain of ``units`` full units (2 units half units) driven by a muscle across its
     first pair; the output probe ``out`` reads the far end (a buffer).  ``bend`` (rad) bends
     every other junction (the ones about the same axis), so the chain lies on a planar arc.
     With ``probe_every_unit`` the pair after each full unit is probed too (outputs
-    ``u1 .. u{units}``; ``out`` is the last).  ``tolerance`` (sigma) loosens every joint."""
+    ``u1 .. u{units}``; ``out`` is the last).  ``tolerance`` (sigma) loosens every joint;
+    ``stops`` adds the :func:`junction_stops` (as compiled circuits have them)."""
     if units < 1:
         raise ValueError("a chain has at least one unit")
     geo = connector_geometry(signal, design, gap)
@@ -312,7 +349,7 @@ def chain_scene(units: int, signal: str = "expand", bend: float = 0.0, design: D
     if abs(bend) > max_bend(geo) + 1e-12:
         raise ValueError(f"bend {bend:.3f} rad exceeds the junction's largest bend {max_bend(geo):.3f} rad "
                          f"at gap {gap} sigma")
-    parts, pairs = chain_parts("c", np.zeros(3), _EX, _EZ, bends, 0, geo, tolerance=tolerance)
+    parts, pairs = chain_parts("c", np.zeros(3), _EX, _EZ, bends, 0, geo, tolerance=tolerance, stops=stops)
     muscles = [muscle("muscle_in", "a", pairs[0].lo, pairs[0].hi, geo.L0, geo.L1, geo.k)]
     outputs, probes = [], []
     if probe_every_unit:
@@ -405,4 +442,4 @@ def branch_scene(k: int = 3, signal: str = "expand", units: int = 1, design: Des
 
 __all__ = ["SIGNALS", "ConnectorGeometry", "Pair", "Parts", "branch_angles", "branch_parts", "branch_scene",
            "chain_frames", "chain_parts", "chain_scene", "connector_geometry", "full_unit_scene", "half_unit_out",
-           "half_unit_parts", "half_unit_scene", "half_unit_side", "join", "max_bend", "rotate", "wire_lengths"]
+           "half_unit_parts", "half_unit_prefix", "half_unit_scene", "half_unit_side", "join", "junction_stops", "max_bend", "rotate", "wire_lengths"]
