@@ -62,3 +62,15 @@ def test_property_solutions_satisfy_kinematics(lin, lout, fin, fout, sin, sout, 
     assert s.output_length(lin + s.dlin) == pytest.approx(lout + s.dlout, abs=1e-9)
     for a in (s.theta1, s.theta2, s.theta1 + s.dtheta, s.theta2 + s.sign * s.dtheta):
         assert 0 < a < np.pi / 2
+
+
+def test_too_long_lever_gets_the_right_hint():
+    """A lever so long that its angles fall below the scan's T_MIN is refused with a hint
+    to shorten it (not to lengthen it); one just inside the bound is solved exactly."""
+    with pytest.raises(MlcError, match=r"too long.*at most 5000 sigma"):
+        solve_lever(1, 1, 0.5, 0.5, 1e300)
+    s = solve_lever(1, 1, 0.5, 0.5, 4000.0)
+    assert s.output_length(1.0) == pytest.approx(1.0, abs=1e-9)
+    assert s.output_length(1.5) == pytest.approx(1.5, abs=1e-9)
+    with pytest.raises(MlcError, match="longer lever"):            # too short: the other hint
+        solve_lever(1, 1, 0.5, 0.5, 0.3)

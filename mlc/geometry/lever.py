@@ -94,6 +94,9 @@ def lever_type_for(dlin: float, dlout: float) -> str:
     return "crossed" if dlin * dlout > 0 else "open"
 
 
+T_MIN = 1e-4          # rad: the smallest half-angle the lever scan considers
+
+
 def solve_lever(lin: float, lout: float, dlin: float, dlout: float, l: float,
                 type: str | None = None) -> LeverSolution:
     """Solve Eq. 2 (half-length form) for a lever of the given type.
@@ -141,11 +144,12 @@ def solve_lever(lin: float, lout: float, dlin: float, dlout: float, l: float,
         l1, l2, t2, dt = p
         return l2 * np.sin(t2 + sign * dt) - lout1 / 2
 
-    ts = np.linspace(1e-4, np.pi / 2 - 1e-4, 2000)
+    # log-spaced near 0 (long levers have small angles), linear beyond
+    ts = np.unique(np.concatenate([np.geomspace(T_MIN, 0.05, 400), np.linspace(0.05, np.pi / 2 - T_MIN, 2000)]))
     vs = np.array([g(t) for t in ts])
     sols = []
     for i in range(len(ts) - 1):
-        if np.isfinite(vs[i]) and np.isfinite(vs[i + 1]) and vs[i] * vs[i + 1] < 0:
+        if np.isfinite(vs[i]) and np.isfinite(vs[i + 1]) and np.sign(vs[i]) * np.sign(vs[i + 1]) < 0:
             t1 = brentq(g, ts[i], ts[i + 1], xtol=1e-15, maxiter=200)
             l1, l2, t2, dt = parts(t1)
             angles = (t1, t2, t1 + dt, t2 + sign * dt)
@@ -153,7 +157,13 @@ def solve_lever(lin: float, lout: float, dlin: float, dlout: float, l: float,
                 margin = min(min(a, np.pi / 2 - a) for a in angles)
                 sols.append((margin, LeverSolution(type, lin, lout, dlin, dlout, l, t1, t2, l1, l2, dt)))
     if not sols:
+        # the scan covers half-angles from T_MIN: a lever so long that its angles (~ length / l)
+        # fall below that is not solved, and a longer one would not help
+        l_max = min(lin, lin1, lout, lout1) / (2.0 * np.tan(T_MIN))
+        fix = (f"--l is too long for these lengths (its angles would fall below {T_MIN:g} rad): use --l of at "
+               f"most {l_max:.4g} sigma" if l > l_max else "a longer lever (larger --l) or smaller signals make it "
+               "feasible")
         raise MlcError(
             f"no {type}-hinge lever maps {lin}->{lin1} onto {lout}->{lout1} with horizontal length l={l}",
-            "--l", "a longer lever (larger --l) or smaller signals make it feasible")
+            "--l", fix)
     return max(sols, key=lambda ms: ms[0])[1]
