@@ -9,6 +9,8 @@ test) with the pair of bodies that sets it.
 
     python benchmarks/circuit_examples.py [--only tetris.tt ...]
 
+With ``--only`` the other examples' last entries are kept (each entry names its commit).
+
 Writes benchmarks/results/circuit_examples.json.  Wall seconds on this machine in one
 run (shared, noisy): compare ratios, not absolute numbers across machines.
 """
@@ -66,8 +68,13 @@ def main():
         commit = "?"
     points = []
     OUT.mkdir(parents=True, exist_ok=True)
+    old = {}
+    if args.only and (OUT / "circuit_examples.json").exists():      # keep the other examples' last results
+        prev = json.loads((OUT / "circuit_examples.json").read_text())
+        old = {e["example"]: e for e in prev.get("examples", []) if e["example"] not in args.only}
     for p in paths:
         pt = example_point(p)
+        pt["commit"] = commit
         points.append(pt)
         print(f"{pt['example']:>18}: {pt['gates']} gates, {pt['bodies']} bodies, build {pt['build_s']:.1f} s, "
               f"{pt['rows_ok']}/{pt['rows']} rows right in {pt['verify_all_rows_s']:.1f} s, "
@@ -75,7 +82,8 @@ def main():
               flush=True)
         res = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
                            "load_after": list(os.getloadavg())}, "commit": commit,
-               "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()), "examples": points,
+               "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+               "examples": sorted(points + list(old.values()), key=lambda e: e["example"]),
                "complete": len(points) == len(paths)}
         (OUT / "circuit_examples.json").write_text(json.dumps(res, indent=1))     # after each example
     print(f"wrote {OUT / 'circuit_examples.json'}")

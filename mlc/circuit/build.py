@@ -62,6 +62,10 @@ LAYER_RADIUS = 0.9          # sigma: bounds a half unit's layer with its posts (
 PIN_SPREAD = 2.5            # sigma: a gate's two input chains arrive this far apart in x
 PIN_STAGGER = 2.5           # sigma: the far input's chain crosses under the gate this much lower than the near one's
 PIN_END = 1.5               # sigma: and rises to its lever this far to its side of the gate (x)
+TAP_LEAN = math.radians(45.0)   # a single chain leaves a gate's output pair this far from up, towards -y
+TAP_TURN = math.radians(50.0)   # ... turned by at most this much about the pair's axis by the router
+TAP_CONTACT = math.radians(85.0)   # its first layer meets the output lever's slabs about 90 deg from up
+TAP_FREE = (math.radians(10.0), math.radians(70.0))   # the tap stop's free swing about the built direction
 RISER_PITCH = 3.5           # sigma between the risers of the routes from one tap (x)
 # Gates are turned by +90 degrees about z (gate x -> world y): every output pair's axis is
 # then along world x, so branch pages (turned about that axis) fan out towards -y, where
@@ -99,6 +103,28 @@ def _posed_gate(gtype: str, signal: str, state: str):
         return sc, A.pos.copy(), A.quat.copy()
     eq = equilibrium(sc, state)
     return sc, eq.pos, eq.quat
+
+
+def _tap_stop(name: str, lever: Body, site: str, t_up, t_first, first: str, k: float) -> list[Bond]:
+    """A flat-bottom bond that keeps a chain's first half unit ``first``, hung on a gate's
+    output pair and built along ``t_first``, off the output lever's slabs, which it meets
+    about TAP_CONTACT from the pair's upward normal ``t_up`` (docs/circuits.md, "Junction
+    stops").  One site on the lever body, STOP_ARM behind the joint ``site`` along
+    ``t_first``; the other is the half unit's ``stop_in`` (STOP_ARM beyond the same joint
+    along its tangent): they are 2 m cos(phi/2) apart for a swing phi from the built
+    direction, free up to TAP_CONTACT minus the built lean (within TAP_FREE).  The swing
+    takes no lever motion (the lever turns the pair about the vertical, which the next
+    junction takes), only the chain's slack.  Units: sigma, k0."""
+    from mlc.gates.connector import STOP_ARM
+    m = STOP_ARM
+    t_first = np.asarray(t_first, float) / np.linalg.norm(t_first)
+    lean = math.acos(float(np.clip(t_first @ np.asarray(t_up, float), -1.0, 1.0)))
+    free = min(max(TAP_CONTACT - lean, TAP_FREE[0]), TAP_FREE[1])
+    p = lever.world(site) - m * t_first
+    lever.sites["stop_tap"] = lever.rotation().T @ (p - lever.position)
+    d_stop, d_free = 2.0 * m * math.cos(0.5 * free), 2.0 * m + 0.5
+    return [Bond(name, f"{lever.name}.stop_tap", f"{first}_AB.stop_in", k, 0.5 * (d_stop + d_free),
+                 0.5 * (d_free - d_stop), "bond", None)]
 
 
 def _wire_values(netlist, bits: dict) -> dict:
@@ -307,7 +333,7 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
         if not cons:
             continue
         if len(cons) == 1:
-            starts = [(tap, pol, True, rotate(t_up, tap.axis, sgn * math.radians(45.0)), None)]
+            starts = [(tap, pol, True, rotate(t_up, tap.axis, sgn * TAP_LEAN), None)]
         else:
             starts = []
             angs = branch_angles(len(cons))
@@ -358,7 +384,7 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
             z_in = zp - 8.0 - (PIN_STAGGER if yp > other.centre[1] else 0.0)
             x_end = xp + side * PIN_END
             lane = Lane(x_rise, start.centre[2] + 3.0, z_run, x_in, z_in, x_end, zp - 6.0)
-            sbm = math.radians(50.0) if len(starts) == 1 else END_BEND * max_bend(geo)
+            sbm = TAP_TURN if len(starts) == 1 else END_BEND * max_bend(geo)
             plane = lanes.assign(lane)
             route = None
             best = (-math.inf, None, plane)
@@ -412,6 +438,9 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
             parts.bonds += join(f"{tag}_j0", start, pairs[0], geo.k)
             if start is not tap and half_unit_prefix(start):     # the junction after a branch page
                 parts.bonds += junction_stops(f"{tag}_s0", half_unit_prefix(start), f"{tag}_0", geo, geo.k)
+            if start is tap and wire[0] == "gate":            # the chain hangs on the lever: its stop
+                parts.bonds += _tap_stop(f"{tag}_s0", by_name[tap.lo.split(".")[0]], tap.lo.split(".")[1],
+                                         t_up, pairs[1].centre - pairs[0].centre, f"{tag}_0", geo.k)
             add(parts)
             n_chains += 1
             n_half += len(route.bends)
