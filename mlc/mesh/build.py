@@ -48,6 +48,9 @@ clearance.
 from __future__ import annotations
 
 import itertools
+import os
+import sys
+import time
 from dataclasses import dataclass, field
 
 import manifold3d as mf
@@ -63,6 +66,7 @@ from mlc.scene.model import Scene
 _TOL = 1e-3  # sigma: tolerance for "same point / same line"
 #: assemblies with at least this many parts reuse results across congruent parts by default
 REUSE_MIN_PARTS = 64
+GUARD_PAD = 0.005  # mm: protected material grown by this much for the final trims of large assemblies
 
 
 # --------------------------------------------------------------------------- primitives
@@ -500,6 +504,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     parts: list[Part] = []
     protected: dict[str, mf.Manifold] = {}
     soft: dict[str, mf.Manifold] = {}
+    fat_guard: dict[str, tuple] = {}     # reuse only: (hard, soft or None) guards grown by GUARD_PAD
     for b in scene.bodies:
         bn = b.name
         solid = union([box(sb.center, sb.R, sb.size) for sb in shapes[bn]])
@@ -581,6 +586,20 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         # the spot where the attachment hole would go (0.85 mm in from the site), kept if possible
         spots = [cylinder(_spot(x[4], x[0], lug_out), x[1], -t, t, lug_out + c, n) for x in lugs[bn] if not x[2]]
         soft[bn] = union([protected[bn]] + spots)
+        if reuse:
+            # the same protected material grown by GUARD_PAD: the final trims of large assemblies
+            # subtract (cutter less guard), and a guard whose faces lie on the part's own faces
+            # made one boolean of two 1000-vertex parts take minutes and gigabytes (issue 13)
+            e = GUARD_PAD
+            fat = [cylinder(ax.origin, ax.direction, a0 - e, a1 + e, R + e, n)
+                   for ax in my_axes for a0, a1 in ax.intervals[bn]]
+            fat += [cylinder(uj.center, uj.axes[side], a0 - e, a1 + e, R + e, n)
+                    for uj, side in my_uj for a0, a1 in uj.layouts[side].own]
+            fat += [cylinder(ax.origin, ax.direction, -ax.span / 2 - e, ax.span / 2 + e, r_pin + e, n)
+                    for ax in my_axes if ax.owner == bn and not cones]
+            fat += [cylinder(x[0], x[1], -t / 2 - e, t / 2 + e, lug_out + e, n) for x in lugs[bn] if x[2]]
+            fat += male
+            fat_guard[bn] = (union(fat), union(fat + spots) if spots else None)
         partners = sorted({o for ax in my_axes for o in ax.bodies if o != bn}
                           | {uj.part for uj, _ in my_uj})
         parts.append(Part(bn, "body", solid, partners))
@@ -604,10 +623,13 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     asm = Assembly(scene, prof, parts, axes, ujoints, notes, features, t, poses)
     if reuse:
         asm.congruence = Congruence(_congruence_frames(asm, slabs))
+    _log(f"{len(parts)} parts built ({sum(p.solid.num_vert() for p in parts)} vertices)")
     if resolve:
-        _resolve(asm, protected, soft, state_T, asm.congruence)
+        _resolve(asm, protected, soft, state_T, asm.congruence, fat_guard)
+    _log("final trims done; drilling")
     _drill(asm, lugs, lug_hole, lug_out, t)
     asm.orient = _orientation(asm)
+    _log("assembly done")
     return asm
 
 
@@ -1120,7 +1142,7 @@ def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t) -> None:
                     asm.features.append((f"room for the attachment hole of {label}", 0.0, 2 * lug_out))
 
 
-def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, cong=None) -> None:
+def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, cong=None, fat=None) -> None:
     """Trim slabs that still come closer than the clearance (as printed) or intersect (in a
     logic state): from one of the two parts, cut the other part grown by the clearance, in
     every state where they meet, never touching knuckles, pins or attachment rings.  The part
@@ -1205,8 +1227,10 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
         if (id(table), name) not in guard_keys:
             guard_keys[(id(table), name)] = shape_key(g, frames[k])
         return guard_keys[(id(table), name)]
-    for _ in range(4):
+    for _round in range(4):
+        _log(f"final trims round {_round}: finding conflicts")
         conflicts = conflicts_of(filters)
+        _log(f"final trims round {_round}: {len(conflicts)} conflicting pair(s)")
         if not conflicts:
             return
         changed = set()
@@ -1233,7 +1257,19 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
                                         if any(s is not None for s in sts) else " as printed"))
                     continue
                 cong.misses += 1
+            _t0 = time.perf_counter()
+            _log(f"trim {A.name} ({A.solid.num_vert()} v) / {B.name} ({B.solid.num_vert()} v), "
+                 f"{len(sts)} state(s)")
             cands = []
+            if fat is not None and all(T is None for T in sts) and _locked(A, B, protected, fat):
+                # they overlap only where both must keep their material (knuckles, pins): no trim
+                # can settle it, and every try costs booleans; the checks report the overlap
+                asm.notes.append(f"{A.name} and {B.name} overlap inside their knuckles or pins as printed: "
+                                 "not trimmed")
+                _log("  locked: both keep the overlap")
+                if cong is not None:
+                    cong.results[ck] = "none"
+                continue
             for X, Y in ((A, B), (B, A)):
                 if X.kind == "joint":
                     continue
@@ -1241,16 +1277,24 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
                     break     # large assemblies: the first trim that settles, in one piece, is taken
                 hard = protected.get(X.name)
                 soft = soft_protected.get(X.name)
+                guards = ((False, soft), (True, hard))
+                if fat is not None and X.name in fat:
+                    # large assemblies: the grown guards, each used as is (no intersection with X)
+                    fh, fs = fat[X.name]
+                    guards = ((False, fs), (True, fh)) if fs is not None else ((False, fh),)
                 # first keep the spot of the attachment hole too (soft), then only the joints (hard)
-                for lost, guard in ((False, soft), (True, hard)):
+                for lost, guard in guards:
                     if guard is None:
                         continue
-                    keep = X.solid ^ guard
+                    keep = guard if fat is not None and X.name in fat else X.solid ^ guard
+                    _log(f"  {X.name}: keep {keep.num_vert()} v")
                     for g_ in (grow, 2.0 * c, 2.5 * c):
                         trimmed = _trim_by(X, Y, sts, g_, dirs, keep, 0.5 * c, merged=cong is not None)
                         if trimmed is None:
                             break
+                        _log(f"  trimmed by {g_:.3g}: {trimmed.num_vert()} v")
                         ok = settled(X, trimmed, Y, sts)
+                        _log(f"  settled: {ok}")
                         if ok:
                             break
                     if trimmed is None:
@@ -1259,8 +1303,10 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
                     if removed <= 1e-9:
                         continue
                     cands.append((not ok, len(trimmed.decompose()) != 1, lost, removed, X, trimmed, Y))
+                    _log("  decomposed")
                     if ok:
                         break
+            _log(f"  done in {time.perf_counter() - _t0:.2f} s, {len(cands)} candidate(s)")
             if not cands:
                 if cong is not None:
                     cong.results[ck] = "none"
@@ -1279,6 +1325,42 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
         if not changed:
             return
         filters.append(changed)
+
+
+def _locked(A, B, protected: dict, fat: dict) -> bool:
+    """True if parts ``A`` and ``B`` overlap (as printed) only inside the material both must keep:
+    their grown guards (``fat``) or, for a joint part, the whole part."""
+    inter = A.solid ^ B.solid
+    if inter.volume() <= 1e-6:
+        return False
+    for P in (A, B):
+        g = fat[P.name][0] if P.name in fat else protected.get(P.name)
+        if g is None or (inter - g).volume() > 1e-6:
+            return False
+    return True
+
+
+def _rss_gb() -> float:
+    """Resident memory of this process now and at its peak (GB, from /proc/self/status)."""
+    out = {}
+    try:
+        for ln in open("/proc/self/status"):
+            if ln.startswith(("VmRSS", "VmHWM")):
+                out[ln.split(":")[0]] = int(ln.split()[1]) / 2 ** 20
+    except OSError:
+        pass
+    return out.get("VmRSS", 0.0), out.get("VmHWM", 0.0)
+
+
+_T0 = time.perf_counter()
+
+
+def _log(msg: str) -> None:
+    """Progress of the build and its final trims on stderr when the environment variable
+    ``MLC_MESH_LOG`` is set (diagnostics): seconds since import, resident and peak memory (GB)."""
+    if os.environ.get("MLC_MESH_LOG"):
+        r, p = _rss_gb()
+        print(f"[mesh {time.perf_counter() - _T0:7.1f} s {r:.2f}/{p:.2f} GB] {msg}", file=sys.stderr, flush=True)
 
 
 def _flat(solid: mf.Manifold) -> mf.Manifold:
@@ -1300,7 +1382,9 @@ def _trim_by(X, Y, sts, grow, dirs, keep, state_grow, merged=False):
 
     ``merged``: the same set, built with bounded memory -- Y's cropped copies of all logic states
     are united first and that union is grown (27 copies in all instead of 27 per state: a compiled
-    circuit has up to 50 poses, and 27 x 50 meshes in one boolean took gigabytes)."""
+    circuit has up to 50 poses, and 27 x 50 meshes in one boolean took gigabytes).  There
+    ``keep`` may be any region (a guard grown around X's knuckles): X's material inside it stays,
+    as X less (tool less keep) -- the same set as (X less tool) united with X's part of keep."""
     if merged:
         groups: dict = {}
     ks = []
@@ -1348,12 +1432,16 @@ def _trim_by(X, Y, sts, grow, dirs, keep, state_grow, merged=False):
                         hulls.append(mf.Manifold.hull_points((V[None, :, :] + g_ * off[:, None, :]).reshape(-1, 3)))
                 if not hulls:
                     continue
-                res = res - union(hulls)
+                _log(f"    hull {sum(h.num_vert() for h in hulls)} v, X {res.num_vert()} v")
+                # ``keep`` (X's material to keep, or a guard around it) is taken out of the tool
+                # rather than united back: one subtraction, no faces shared with X's own
+                res = res - (union(hulls) - keep)
                 res.num_tri()             # evaluate now (no deferred n-ary boolean)
+                _log(f"    subtracted: {res.num_vert()} v")
                 hit = True
         if not hit:
             return None
-        return _clean(union([res, keep]))
+        return _clean(res)
     if not ks:
         return None
     return _clean(union([X.solid - union(ks), keep]))

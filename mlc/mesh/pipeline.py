@@ -18,7 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from mlc.mesh.build import Assembly, Part, build_assembly, transform_solid, _orientation
+from mlc.mesh.build import Assembly, Part, _log, _orientation, build_assembly, transform_solid
 from mlc.mesh.checks import (GAP_EPS, VOL_EPS, Check, Report, _bbox, _pairs, bed_checks, check_assembly,
                              print_size)
 from mlc.mesh.profiles import Profile
@@ -150,13 +150,17 @@ def export_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     if poses is not None or len(mechs) == 1:
         notes = []
         if poses is None and solve:
+            _log("static verification: posing every logic state")
             poses, note = state_poses(scene)
             if note:
                 notes.append(note)
+        _log("building parts")
         asm = build_assembly(scene, profile, poses)
         asm.notes[:0] = notes
+        _log("printability checks")
         rep = check_assembly(asm)
         rep.seconds = time.perf_counter() - t0
+        _log("checks done")
         return asm, rep
 
     # many mechanisms: build each distinct one once
