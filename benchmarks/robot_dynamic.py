@@ -6,9 +6,11 @@ as ``mlc verify ROBOT --dynamic`` (:func:`mlc.robot.verify.verify_robot_dynamic`
 inputs switch to the row at t = 0 from the rest pose, the stiff scheme advances in
 windows of ``tau/20`` t0, and the run stops when
 
-* it has lasted at least ``3 tau`` (the time floor of :mod:`mlc.verify.dynamic`) and the
-  three block means of every probe (circuit outputs and DOF lengths) over the last third
-  agree within :func:`mlc.verify.dynamic.plateau_tol` (relaxed), or
+* it has lasted at least ``3 tau`` (the time floor of :mod:`mlc.verify.dynamic`), the
+  three block means of every circuit output over the last third agree within
+  :func:`mlc.verify.dynamic.plateau_tol`, and the DOF angles' block means agree within
+  their own thermal noise (:func:`mlc.robot.verify.angles_relaxed`, docs/robot.md 3.2)
+  (relaxed), or
 * it reaches ``--max-time`` (1800 t0, the paper's fold time; not relaxed).
 
 The shape is read from the final body poses (:func:`mlc.robot.verify.read_shape`).  The
@@ -35,45 +37,15 @@ import numpy as np
 
 def run_one(scene, state: str, seed: int, dt: float, tau: float, max_time: float, kT: float = 1e-5,
             every: float = 100.0, scheme: str = "stiff") -> dict:
-    from mlc.robot.verify import _shape_row, robot_meta
+    from mlc.robot.verify import _shape_row, robot_meta, run_fold
     from mlc.sim.drive import Drive
     from mlc.sim.integrator import SimOptions, Simulation
-    from mlc.verify.dynamic import MIN_WINDOWS, PLATEAU, TAU_FACTOR, plateau_tol
 
     rm = robot_meta(scene)
-    names = [p.name for p in scene.probes]
     drives = {inp: Drive.constant(int(b)) for inp, b in zip(scene.inputs, state)}
     sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed, dt=dt))
-    window = max(0.05, tau / 20.0)
-    t_min = TAU_FACTOR * tau if state != "0" * len(scene.inputs) else 0.0
-    ends, means, hist = [], {p: [] for p in names}, []
     wall = time.perf_counter()
-    t, relaxed, next_rec = 0.0, False, every
-    while True:
-        res = sim.run(window, record_interval=window / 10, quiet=True)
-        t = res.time
-        ends.append(t)
-        for p in names:
-            v = res.probes[p]
-            means[p].append(float(np.mean(v[1:] if len(v) > 1 else v)))
-        if t >= next_rec - 1e-9:
-            sh = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy())
-            hist.append({"t": round(t, 3), "turns": sh["turns_read"], "shape": sh["shape_read"]})
-            next_rec += every
-        first = len(ends) - MIN_WINDOWS
-        cut = (1.0 - PLATEAU) * t
-        while first > 0 and ends[first - 1] - window >= cut - 1e-12:
-            first -= 1
-        if first >= 0 and t >= t_min - 1e-12:
-            block = (len(ends) - first) * window / MIN_WINDOWS
-            if all(np.ptp([np.mean(b) for b in np.array_split(means[p][first:], MIN_WINDOWS)])
-                   < plateau_tol(kT, sim.k0, 0.0, tau, block) for p in names):
-                relaxed = True
-                break
-        if t >= max_time - 1e-9:
-            break
-    k = max(first, 0) if relaxed else max(len(ends) - MIN_WINDOWS, 0)
-    pm = {p: float(np.mean(means[p][k:])) for p in names}
+    pm, t, relaxed, detail, hist = run_fold(sim, scene, state, kT, tau, max_time, every)
     sh = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy(), pm)
     want = scene.truth_table.get(state)
     bad = []
@@ -81,6 +53,7 @@ def run_one(scene, state: str, seed: int, dt: float, tau: float, max_time: float
         b = want[scene.outputs.index(pr.output)]
         if b in "01" and pr.bit(pm[pr.name]) != int(b):
             bad.append(pr.name)
+    noise = detail.get("noise_deg", [])
     return {"row": state, "seed": seed, "shape_read": sh["shape_read"], "shape_expected": sh["shape_expected"],
             "shape_ok": sh["shape_ok"], "probes_ok": not bad, "wrong_probes": bad,
             "ok": bool(sh["shape_ok"] and not bad), "turns_read": sh["turns_read"],
@@ -89,6 +62,11 @@ def run_one(scene, state: str, seed: int, dt: float, tau: float, max_time: float
             "dof_angles": [{k2: (round(v, 3) if isinstance(v, float) else v) for k2, v in d.items()}
                            for d in sh["dof_angles"]],
             "relaxed": relaxed, "time_t0": round(t, 3), "wall_s": round(time.perf_counter() - wall, 1),
+            "relax_test": {"drift_deg": [round(v, 2) for v in detail.get("drift_deg", [])],
+                           "tol_deg": [round(v, 2) for v in detail.get("tol_deg", [])],
+                           "noise_deg": [round(v, 2) for v in noise],
+                           "kappa_est_k0sigma2": [round(kT / math.radians(v) ** 2, 6) if v > 0 else None
+                                                  for v in noise]},
             "history": hist}
 
 

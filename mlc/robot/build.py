@@ -54,6 +54,9 @@ JOINT_LENGTH = 2.0       # sigma: length of a unit's joint piece (between its up
 POST = 0.6               # sigma: the lever sites sit this far below the skeleton plane
 HINGE_WIDTH = 0.5        # sigma between the two bonds of a skeleton hinge (along z)
 APPROACH_RUN = 4.0       # sigma: the chain's last stretch rises straight into the skeleton
+FAN_ANGLES = (0.0, 70.0, -70.0, 140.0, -140.0, 180.0)   # deg: a chain's first tangent turned about its output pair
+CLEAR = 0.3              # sigma: a chain's body centres keep this far from every body placed before
+SLACK = 0.0              # sigma: a sideways bulge half way up each chain (tried 4: no faster, docs/robot.md 3.1)
 BACK = 4.0               # sigma behind the circuit (+y) where a chain from inside the circuit rises
 STOP_MARGIN = math.radians(15.0)   # rad: a DOF swings freely from -15 to 90 + 15 degrees (its stops)
 STOP_R_OVER = (1.8, 1.2)           # sigma: the over-turn stop's sites, on both bodies along one ray
@@ -328,6 +331,7 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
     n_chains = n_half = 0
     cbyname = {b.name: b for b in circuit.bodies}
     sbyname = {b.name: b for b in bodies}
+    placed = np.array([b.position for b in list(circuit.bodies) + bodies])
     for ds, name, target, pr in targets:
         pa = cbyname[pr.a.split(".")[0]].world(pr.a.split(".", 1)[1])
         pb = cbyname[pr.b.split(".")[0]].world(pr.b.split(".", 1)[1])
@@ -343,18 +347,37 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
         if start.centre[2] < hi_c[2] - 3.0:          # an output inside the circuit: out at the back, then up
             yb = float(hi_c[1]) + BACK
             wps = [(start.centre[0], yb, start.centre[2] + 2.0), (start.centre[0], yb, hi_c[2] + 2.0)]
-        route = None
-        tr = time.perf_counter()
-        for wp in (wps, []):
-            route = solve_route(start.centre, start.axis, tc, tax, geo, 0, waypoints=wp, tangent=t0v,
-                                free_start=True, approach=ez)
-            if route is not None:
-                break
-        if route is None:
-            raise MlcError(f"cannot route output {ds.output} to dof {name}: no connector chain reaches it",
-                           ds.loc, "this is a placement limit of mlc; try a larger skeleton height")
+        if SLACK > 0:                                 # a bulge to the DOF's own side: slack (docs/robot.md 2.4)
+            a0 = wps[-1] if wps else start.centre
+            mid = 0.5 * (np.asarray(a0, float) + tc)
+            side = (1.0 if name.endswith("_up") else -1.0) * ey
+            wps = wps + [tuple(mid + SLACK * side - np.array([0.0, 0.0, 0.0]))]
         tag = f"rc_{name}"
-        parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, sstate, geo)
+        tr = time.perf_counter()
+        found = None
+        # the first start that leaves every new body clear of those placed (a chain on an output pair
+        # that already carries one fans out about the pair's axis, like a branch's pages)
+        for fan in FAN_ANGLES:
+            from mlc.geometry.rotation import expmap
+            tv = expmap(start.axis * math.radians(fan)) @ t0v
+            for wp in (wps, []):
+                route = solve_route(start.centre, start.axis, tc, tax, geo, 0, waypoints=wp, tangent=tv,
+                                    free_start=fan == 0, approach=ez)
+                if route is not None:
+                    break
+            if route is None:
+                continue
+            parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, sstate, geo)
+            new_c = np.array([b.position for b in parts.bodies])
+            d2 = ((new_c[:, None, :] - placed[None, :, :]) ** 2).sum(-1)
+            if float(d2.min()) >= CLEAR ** 2:
+                found = (route, parts, pairs)
+                break
+        if found is None:
+            raise MlcError(f"cannot route output {ds.output} to dof {name}: no connector chain reaches it "
+                           "clear of the others", ds.loc, "this is a placement limit of mlc; try a larger skeleton height")
+        route, parts, pairs = found
+        placed = np.vstack([placed, new_c])
         parts.bonds += join(f"{tag}_j0", start, pairs[0], geo.k)
         lout = pairs[-1]
         same = float(lout.axis @ tax) > 0

@@ -17,8 +17,10 @@ static check, the largest joint stretch is below ``TOL_STRETCH``.
   pose in ``STEPS`` continuation steps (the skeleton folds far, so more than the
   circuit verifier's four);
 * **dynamic**: Brownian dynamics from rest into each row, over several seeds, until
-  every probe has relaxed (:func:`mlc.verify.dynamic.relax_all`, with the time floor of
-  3 slowest relaxation times) or ``max_time``; the shape is read from the final poses.
+  relaxed (:func:`run_fold`: the time floor of 3 tau, the circuit outputs on a plateau,
+  the joint angles within their own thermal noise, :func:`angles_relaxed`) or the fold
+  time; the shape is read from the final poses.  tau and dt default to ``ROBOT_TAU``
+  and ``ROBOT_DT`` (no relaxation-time computation, docs/robot.md section 3).
 
 Units: sigma, k0, t0, degrees in reports.
 """
@@ -104,6 +106,87 @@ def dof_angle_from_length(rm: dict, side: str, length: float) -> float:
     return ang if side == "up" else -ang
 
 
+def dof_angles(scene: Scene, pos, quat) -> np.ndarray:
+    """Every DOF's angle (deg, order of ``meta.robot.dofs``) in body poses ``pos``/``quat``."""
+    return np.array([d["angle"] for d in read_shape(scene, pos, quat)["dofs"]])
+
+
+def angles_relaxed(angles, block: float, tau: float, z: float = 3.0) -> tuple[bool, dict]:
+    """The skeleton's relaxation test, allowing for its thermal noise (docs/robot.md section 3.2).
+
+    ``angles``: DOF angles (deg), one row per sample, equally spaced over the run's last
+    part (the plateau); split into 3 blocks of ``block`` t0.  For a harmonic DOF of angular
+    stiffness kappa at temperature kT, equipartition gives the angle's variance
+    s^2 = kT / kappa; kappa (the coupling chain's stiffness times (dL/dtheta)^2) is not
+    known beforehand, so s is estimated from the samples about their straight-line trend
+    (a drift does not count as noise).  A block mean over B t0 of a signal with correlation
+    time tau has the variance s^2 min(1, 2 tau / B), so two relaxed block means differ by
+    at most ``z`` sqrt(2 s^2 min(1, 2 tau / B)).  Relaxed when every DOF's block means
+    lie within that.  Returns (relaxed, {"drift_deg", "tol_deg", "noise_deg"} per DOF as
+    lists)."""
+    a = np.asarray(angles, float)
+    n = a.shape[0]
+    if n < 6:
+        return False, {}
+    x = np.arange(n, dtype=float)
+    A = np.vstack([x, np.ones(n)]).T
+    coef, *_ = np.linalg.lstsq(A, a, rcond=None)
+    s = np.std(a - A @ coef, axis=0, ddof=2)
+    means = np.array([b.mean(0) for b in np.array_split(a, 3)])
+    drift = means.max(0) - means.min(0)
+    tol = z * np.sqrt(2.0 * s * s * min(1.0, 2.0 * tau / max(block, 1e-12)))
+    return bool(np.all(drift <= tol)), {"drift_deg": drift.tolist(), "tol_deg": tol.tolist(), "noise_deg": s.tolist()}
+
+
+def run_fold(sim, scene: Scene, state: str, kT: float, tau: float, max_time: float, every: float | None = None):
+    """Advance ``sim`` (inputs already set to row ``state``) in windows of max(0.05, tau/20)
+    t0 until relaxed or ``max_time`` t0.  Relaxed: at least ``TAU_FACTOR`` tau (not for the
+    rest row), the three block means of every circuit output over the last third within
+    :func:`mlc.verify.dynamic.plateau_tol`, and the DOF angles' block means within their
+    own thermal noise (:func:`angles_relaxed`).  The DOF probes are not plateau-tested:
+    the skeleton's soft joints fluctuate far more than the circuit's stiff pairs.
+    Returns (probe means over the plateau {name: sigma}, time t0, relaxed, test details,
+    history of turns every ``every`` t0 or [])."""
+    from mlc.verify.dynamic import MIN_WINDOWS, PLATEAU, TAU_FACTOR, plateau_tol
+
+    rm = robot_meta(scene)
+    names = [p.name for p in scene.probes]
+    circ = [p for p in names if not p.startswith("dof_")]
+    window = max(0.05, tau / 20.0)
+    t_min = TAU_FACTOR * tau if state != "0" * len(scene.inputs) else 0.0
+    ends, means, hist, angs = [], {p: [] for p in names}, [], []
+    t, relaxed, detail, first = 0.0, False, {}, 0
+    next_rec = every if every else float("inf")
+    while True:
+        res = sim.run(window, record_interval=window / 10, quiet=True)
+        t = res.time
+        ends.append(t)
+        angs.append(dof_angles(scene, sim.pos, sim.quat))
+        for p in names:
+            v = res.probes[p]
+            means[p].append(float(np.mean(v[1:] if len(v) > 1 else v)))
+        if t >= next_rec - 1e-9:
+            sh = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy())
+            hist.append({"t": round(t, 3), "turns": sh["turns_read"], "shape": sh["shape_read"]})
+            next_rec += every
+        first = len(ends) - MIN_WINDOWS
+        cut = (1.0 - PLATEAU) * t
+        while first > 0 and ends[first - 1] - window >= cut - 1e-12:
+            first -= 1
+        if first >= 0 and t >= t_min - 1e-12:
+            block = (len(ends) - first) * window / MIN_WINDOWS
+            circ_ok = all(np.ptp([np.mean(b) for b in np.array_split(means[p][first:], MIN_WINDOWS)])
+                          < plateau_tol(kT, sim.k0, 0.0, tau, block) for p in circ)
+            ang_ok, detail = angles_relaxed(angs[first:], block, tau)
+            if circ_ok and ang_ok:
+                relaxed = True
+                break
+        if t >= max_time - 1e-9:
+            break
+    k = max(first, 0) if relaxed else max(len(ends) - MIN_WINDOWS, 0)
+    return {p: float(np.mean(means[p][k:])) for p in names}, t, relaxed, detail, hist
+
+
 def _shape_row(scene, rm, state, pos, quat, probe_means: dict | None = None) -> dict:
     got = read_shape(scene, pos, quat, state)
     if probe_means:
@@ -180,9 +263,10 @@ def verify_robot_static(scene: Scene, rows=None, steps: int = STEPS, progress=No
 def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
                          max_time: float | None = None, progress=None, keep_poses: bool = False,
                          tau: float | None = None, dt: float | None = None) -> Report:
-    """Brownian dynamics from rest into each row, ``seeds`` seeds, until every probe has
-    relaxed (at least 3 slowest relaxation times) or ``max_time`` t0 (default the paper's
-    1800 t0); the shape is read from each seed's final poses (see the module doc).
+    """Brownian dynamics from rest into each row, ``seeds`` seeds, until relaxed
+    (:func:`run_fold`: at least 3 tau, circuit outputs on a plateau, joint angles within
+    their thermal noise) or ``max_time`` t0 (default the paper's 1800 t0); the shape is
+    read from each seed's final poses (see the module doc).
     ``dt`` (t0): the scheme's step (default ``ROBOT_DT``); ``tau`` (t0): the slowest
     relaxation time (default ``ROBOT_TAU``, measured on the robots' folds, docs/robot.md
     section 3; ``"compute"`` runs :func:`mlc.verify.dynamic.relaxation_time`, which takes
@@ -190,7 +274,7 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
     from mlc.io.progress import Progress
     from mlc.sim.drive import Drive
     from mlc.sim.integrator import SimOptions, Simulation
-    from mlc.verify.dynamic import MAX_TAUS, MAX_TIME, TAU_FACTOR, WINDOW, relax_all, relaxation_time
+    from mlc.verify.dynamic import relaxation_time
 
     rm = robot_meta(scene)
     states = select_rows(scene, rows)
@@ -208,11 +292,8 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
         tau = relaxation_time(scene, gamma_r=opt0.gamma_r)
     tau = ROBOT_TAU if tau is None else float(tau)
     dt = ROBOT_DT if (dt is None and scheme == "stiff") else dt
-    window = max(WINDOW, tau / 20.0)
     rep = Report(scene.name, "dynamic", params={"kT": kT, "seeds": int(seeds), "scheme": scheme, "tau": tau,
                                                 "dt": dt, "robot": True})
-    names = [p.name for p in scene.probes]
-    rest = "0" * len(scene.inputs)
     poses = {}
     total, done = len(states) * int(seeds), 0
     bar = Progress(f"dynamic check of {scene.name}", total=total, show=None if progress is None else False)
@@ -220,13 +301,12 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
         for state in states:
             want = scene.truth_table.get(state)
             drives = {inp: Drive.constant(int(b)) for inp, b in zip(scene.inputs, state)}
-            t_min = TAU_FACTOR * tau if state != rest else 0.0
-            t_max = float(max_time) if max_time is not None else min(FOLD_TIME, max(MAX_TIME, MAX_TAUS * tau))
+            t_max = float(max_time) if max_time is not None else FOLD_TIME
             per = []
             for seed in range(int(seeds)):
                 sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed,
                                                      dt=None if dt is None else float(dt)))
-                means, t_rel, relaxed = relax_all(sim, names, kT, t_min, window, t_max, None, tau)
+                means, t_rel, relaxed, _, _ = run_fold(sim, scene, state, kT, tau, t_max)
                 shape = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy(), means)
                 per.append((means, t_rel, relaxed, shape))
                 poses[(state, seed)] = (sim.pos.copy(), sim.quat.copy())
@@ -322,4 +402,4 @@ def format_any(rep: Report) -> str:
     return format_report(rep)
 
 
-__all__ = ["FOLD_TIME", "ROBOT_DT", "ROBOT_TAU", "format_any", "format_robot_report", "read_shape", "robot_meta", "verify_robot_dynamic", "verify_robot_static"]
+__all__ = ["FOLD_TIME", "ROBOT_DT", "ROBOT_TAU", "angles_relaxed", "dof_angles", "format_any", "run_fold", "format_robot_report", "read_shape", "robot_meta", "verify_robot_dynamic", "verify_robot_static"]
