@@ -190,3 +190,31 @@ def test_graphviz_reads_the_dot(tmp_path, capsys):
     run_json(capsys, "-e", "s = a ^ b ^ c; co = maj(a, b, c); n = !a; k = 0", "-o", str(tmp_path))
     r = subprocess.run(["dot", "-Tsvg", str(tmp_path / "netlist.dot")], capture_output=True, timeout=60)
     assert r.returncode == 0 and b"<svg" in r.stdout, r.stderr
+
+
+def test_compile_stl_failure_is_one_message_and_writes_nothing(tmp_path, capsys):
+    """compile --stl through mlc stl: a mesh the profile cannot make is one message (not a
+    nested 'mlc: error:'), exit 2, and no output directory."""
+    prof = tmp_path / "thick.yaml"
+    prof.write_text("base: mjp\nmin_wall: 1.2\nmin_feature: 1.2\n")
+    out = tmp_path / "o"
+    code = main(["compile", "-e", "a & b", "-o", str(out), "--stl", str(out / "c.stl"), "--profile", str(prof)])
+    err = capsys.readouterr().err
+    assert code == 2 and not out.exists()
+    assert "meshing the circuit failed: --profile: hinges" in err and err.count("mlc: error:") == 1
+
+
+def test_compile_force_reaches_mlc_stl(monkeypatch, tmp_path):
+    """compile --stl --force passes --force to mlc stl (write despite a failed check)."""
+    import mlc.cli
+    from mlc.commands.compile import _mesh
+
+    seen = []
+    monkeypatch.setattr(mlc.cli, "main", lambda argv: seen.append(list(argv)) or 0)
+
+    class Staged:
+        tmp = tmp_path / "c.stl"
+
+    _mesh(tmp_path / "circuit.yaml", Staged(), None, "mjp", True)
+    _mesh(tmp_path / "circuit.yaml", Staged(), None, "mjp", False)
+    assert "--force" in seen[0] and "--force" not in seen[1]

@@ -43,6 +43,8 @@ def register(sub):
     p.add_argument("--stl", metavar="STL", help="printable mesh of the whole circuit (through mlc stl)")
     p.add_argument("--3mf", dest="threemf", metavar="3MF", help="3MF of the circuit with named parts (through mlc stl)")
     p.add_argument("--profile", default="mjp", help="printer profile for --stl/--3mf (mjp, sla, fdm or a file)")
+    p.add_argument("--force", action="store_true",
+                   help="with --stl/--3mf: write the meshes even if a printability check fails (mlc stl --force)")
     p.add_argument("--robot", metavar="ROBOT.yaml",
                    help="also build the robot body the circuit drives (docs/robot.md): OUTDIR/robot.yaml, one scene; "
                         "--verify, --stl and --3mf then apply to the robot")
@@ -187,7 +189,8 @@ def run(args) -> int:
         if report is not None:
             outdir.write_text("verify.json", json.dumps(report.as_dict(), indent=1))
         if stl is not None or threemf is not None:
-            _mesh(outdir.file("robot.yaml" if args.robot else "circuit.yaml"), stl, threemf, args.profile)
+            _mesh(outdir.file("robot.yaml" if args.robot else "circuit.yaml"), stl, threemf, args.profile,
+                  args.force)
         if report is not None and not report.ok:
             from mlc.robot.verify import format_any as format_report
             sys.stdout.write(format_report(report) + "\n")
@@ -213,10 +216,11 @@ def run(args) -> int:
     return 0
 
 
-def _mesh(scene_path, stl, threemf, profile: str) -> None:
-    """Printable meshes of the circuit through ``mlc stl`` (staged paths)."""
+def _mesh(scene_path, stl, threemf, profile: str, force: bool = False) -> None:
+    """Printable meshes of the circuit through ``mlc stl`` (staged paths; its limits and
+    checks apply, ``force`` passes its ``--force``)."""
     from mlc.cli import main as cli
-    argv = ["stl", str(scene_path), "--profile", profile]
+    argv = ["stl", str(scene_path), "--profile", profile] + (["--force"] if force else [])
     if stl is not None:
         argv += ["-o", str(stl.tmp)]
     if threemf is not None:
@@ -229,5 +233,8 @@ def _mesh(scene_path, stl, threemf, profile: str) -> None:
     if rc != 0:
         from mlc.errors import MlcError
         msg = err.getvalue().strip().splitlines()
-        raise MlcError(f"meshing the circuit failed: {msg[-1] if msg else 'exit ' + str(rc)}", "--stl",
-                       "see mlc stl OUTDIR/circuit.yaml for the printability report")
+        last = msg[-1] if msg else f"exit {rc}"
+        last = last[len("mlc: error: "):] if last.startswith("mlc: error: ") else last
+        raise MlcError(f"meshing the circuit failed: {last}", "--stl",
+                       "see mlc stl OUTDIR/circuit.yaml for the printability report; --force writes the meshes "
+                       "even if a printability check fails")
