@@ -1260,7 +1260,6 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
             _t0 = time.perf_counter()
             _log(f"trim {A.name} ({A.solid.num_vert()} v) / {B.name} ({B.solid.num_vert()} v), "
                  f"{len(sts)} state(s)")
-            cands = []
             if fat is not None and all(T is None for T in sts) and _locked(A, B, protected, fat):
                 # they overlap only where both must keep their material (knuckles, pins): no trim
                 # can settle it, and every try costs booleans; the checks report the overlap
@@ -1270,42 +1269,64 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
                 if cong is not None:
                     cong.results[ck] = "none"
                 continue
-            for X, Y in ((A, B), (B, A)):
-                if X.kind == "joint":
-                    continue
-                if cong is not None and cands and cands[0][:3] == (False, False, False):
-                    break     # large assemblies: the first trim that settles, in one piece, is taken
-                hard = protected.get(X.name)
-                soft = soft_protected.get(X.name)
-                guards = ((False, soft), (True, hard))
-                if fat is not None and X.name in fat:
-                    # large assemblies: the grown guards, each used as is (no intersection with X)
-                    fh, fs = fat[X.name]
-                    guards = ((False, fs), (True, fh)) if fs is not None else ((False, fh),)
-                # first keep the spot of the attachment hole too (soft), then only the joints (hard)
-                for lost, guard in guards:
-                    if guard is None:
+            def candidates(A=A, B=B, sts=sts):
+                cands = []
+                for X, Y in ((A, B), (B, A)):
+                    if X.kind == "joint":
                         continue
-                    keep = guard if fat is not None and X.name in fat else X.solid ^ guard
-                    _log(f"  {X.name}: keep {keep.num_vert()} v")
-                    for g_ in (grow, 2.0 * c, 2.5 * c):
-                        trimmed = _trim_by(X, Y, sts, g_, dirs, keep, 0.5 * c, merged=cong is not None)
+                    if cong is not None and cands and cands[0][:3] == (False, False, False):
+                        break     # large assemblies: the first trim that settles, in one piece, is taken
+                    hard = protected.get(X.name)
+                    soft = soft_protected.get(X.name)
+                    guards = ((False, soft), (True, hard))
+                    if fat is not None and X.name in fat:
+                        # large assemblies: the grown guards, each used as is (no intersection with X)
+                        fh, fs = fat[X.name]
+                        guards = ((False, fs), (True, fh)) if fs is not None else ((False, fh),)
+                    # first keep the spot of the attachment hole too (soft), then only the joints (hard)
+                    for lost, guard in guards:
+                        if guard is None:
+                            continue
+                        keep = guard if fat is not None and X.name in fat else X.solid ^ guard
+                        _log(f"  {X.name}: keep {keep.num_vert()} v")
+                        for g_ in (grow, 2.0 * c, 2.5 * c):
+                            trimmed = _trim_by(X, Y, sts, g_, dirs, keep, 0.5 * c, merged=cong is not None)
+                            if trimmed is None:
+                                break
+                            _log(f"  trimmed by {g_:.3g}: {trimmed.num_vert()} v")
+                            ok = settled(X, trimmed, Y, sts)
+                            _log(f"  settled: {ok}")
+                            if ok:
+                                break
                         if trimmed is None:
-                            break
-                        _log(f"  trimmed by {g_:.3g}: {trimmed.num_vert()} v")
-                        ok = settled(X, trimmed, Y, sts)
-                        _log(f"  settled: {ok}")
+                            continue
+                        removed = X.solid.volume() - trimmed.volume()
+                        if removed <= 1e-9:
+                            continue
+                        cands.append((not ok, len(trimmed.decompose()) != 1, lost, removed, X, trimmed, Y))
+                        _log("  decomposed")
                         if ok:
                             break
-                    if trimmed is None:
-                        continue
-                    removed = X.solid.volume() - trimmed.volume()
-                    if removed <= 1e-9:
-                        continue
-                    cands.append((not ok, len(trimmed.decompose()) != 1, lost, removed, X, trimmed, Y))
-                    _log("  decomposed")
-                    if ok:
-                        break
+                return cands
+
+            if cong is None:
+                cands = candidates()
+            else:
+                # large assemblies: each pair trimmed in a child process with a memory and time
+                # cap (a boolean of two small parts has taken minutes and gigabytes), the result
+                # sent back as a mesh; the parent keeps no boolean garbage
+                got = _isolated(lambda: _best_mesh(candidates(), A), TRIM_SECONDS, TRIM_MEMORY)
+                if got is None or got == "none":
+                    _log(f"  done in {time.perf_counter() - _t0:.2f} s: " + ("capped" if got is None else "no trim"))
+                    if got is None:
+                        asm.notes.append(f"{A.name} and {B.name}: trim stopped (over {TRIM_SECONDS:g} s or "
+                                         f"{TRIM_MEMORY / 2 ** 30:g} GiB), not trimmed")
+                    cong.results[ck] = "none"
+                    continue
+                side, verts, tris, removed, ok = got
+                X, Y = (A, B) if side == 0 else (B, A)
+                cands = [(not ok, False, False, removed, X,
+                          mf.Manifold(mf.Mesh64(vert_properties=verts, tri_verts=tris)), Y)]
             _log(f"  done in {time.perf_counter() - _t0:.2f} s, {len(cands)} candidate(s)")
             if not cands:
                 if cong is not None:
@@ -1325,6 +1346,66 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
         if not changed:
             return
         filters.append(changed)
+
+
+TRIM_SECONDS = 30.0       # large assemblies: time cap of one pair's final trim (s)
+TRIM_MEMORY = 2 * 2 ** 30  # and its memory cap above the parent's (bytes)
+
+
+def _best_mesh(cands, A):
+    """The trim :func:`_resolve` takes among ``cands`` as plain arrays: (0 if it trims ``A`` else 1,
+    vertices, triangles, volume removed, settled), or ``"none"``."""
+    if not cands:
+        return "none"
+    unsettled, split, lost, removed, X, trimmed, Y = min(cands, key=lambda x: x[:4])
+    m = trimmed.to_mesh64() if hasattr(trimmed, "to_mesh64") else trimmed.to_mesh()
+    return (0 if X is A else 1, np.asarray(m.vert_properties, float)[:, :3].copy(),
+            np.asarray(m.tri_verts, np.uint64).copy(), removed, not unsettled)
+
+
+def _isolated(fn, seconds: float, extra_bytes: float):
+    """``fn()`` in a forked child whose address space may grow by ``extra_bytes`` and which may
+    run ``seconds``; its (picklable) result, or None if it failed, ran out of memory or time.
+    Without ``os.fork`` (not Linux) ``fn()`` runs in this process."""
+    import pickle
+    import resource
+    import signal
+    if not hasattr(os, "fork"):
+        return fn()
+    vm = 0
+    try:
+        for ln in open("/proc/self/status"):
+            if ln.startswith("VmSize"):
+                vm = int(ln.split()[1]) * 1024
+    except OSError:
+        return fn()
+    r, w = os.pipe()
+    pid = os.fork()
+    if pid == 0:       # child: never returns
+        code = 1
+        try:
+            os.close(r)
+            soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+            cap = int(vm + extra_bytes)
+            if hard != resource.RLIM_INFINITY:
+                cap = min(cap, hard)
+            resource.setrlimit(resource.RLIMIT_AS, (cap, hard))
+            signal.alarm(max(1, int(np.ceil(seconds))))
+            data = pickle.dumps(fn(), protocol=pickle.HIGHEST_PROTOCOL)
+            with os.fdopen(w, "wb") as f:
+                f.write(data)
+            code = 0
+        except BaseException:
+            pass
+        finally:
+            os._exit(code)
+    os.close(w)
+    with os.fdopen(r, "rb") as f:
+        data = f.read()
+    _, status = os.waitpid(pid, 0)
+    if not (os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0) or not data:
+        return None
+    return pickle.loads(data)
 
 
 def _locked(A, B, protected: dict, fat: dict) -> bool:
