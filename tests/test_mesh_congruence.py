@@ -69,3 +69,15 @@ def test_state_by_state_trim_clears_the_other_part():
     assert (out ^ Y.solid.translate([-3.0, 0, 0])).volume() <= 1e-9
     assert abs((out ^ keep).volume() - keep.volume()) < 1e-9
     assert out.volume() > 0.5 * X.solid.volume()
+
+
+def test_isolated_work_is_capped():
+    """The final trims of large assemblies run each pair in a child process: its result comes
+    back; running out of its memory cap or its time gives None, and this process is unharmed."""
+    import time
+    from mlc.mesh.build import _isolated
+    assert _isolated(lambda: {"v": np.arange(3)}, 5, 2 ** 30)["v"].tolist() == [0, 1, 2]
+    assert _isolated(lambda: np.ones(2 ** 28), 5, 2 ** 27) is None          # 2 GiB against 128 MiB
+    t = time.perf_counter()
+    assert _isolated(lambda: time.sleep(5), 1, 2 ** 30) is None
+    assert time.perf_counter() - t < 4
