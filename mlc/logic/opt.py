@@ -1130,6 +1130,15 @@ def _optimize(spec, effort: int, time_budget: float | None = None,
         e = exact_multi.try_exact(spec, best, t0 + time_budget)
         if e is not None and cost(e) < cost(best):
             best = e
+    if effort >= 3 and isinstance(spec, TableSpec):
+        from mlc.logic import cofexact
+        if n == cofexact.INPUTS:
+            e = cofexact.try_cofactor_exact(
+                spec, best, cofexact.TIME_LIMIT if default_budget else min(cofexact.TIME_LIMIT, time_budget))
+            if e is not None:
+                e = improve(e, effort, care, work.now() + 1.0)
+                if cost(e) < cost(best):
+                    best = e
     return best
 
 
