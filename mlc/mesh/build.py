@@ -1217,6 +1217,7 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
         return True
 
     filters: list[set] = []
+    locked: set = set()        # pairs that overlap only inside both parts' guards
     frames = part_frames(asm) if cong is None else cong.frames
     guard_keys: dict = {}
 
@@ -1260,7 +1261,10 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
             _t0 = time.perf_counter()
             _log(f"trim {A.name} ({A.solid.num_vert()} v) / {B.name} ({B.solid.num_vert()} v), "
                  f"{len(sts)} state(s)")
+            if (i, j) in locked:
+                continue          # still locked: trims never take material from the guards
             if fat is not None and all(T is None for T in sts) and _locked(A, B, protected, fat):
+                locked.add((i, j))
                 # they overlap only where both must keep their material (knuckles, pins): no trim
                 # can settle it, and every try costs booleans; the checks report the overlap
                 asm.notes.append(f"{A.name} and {B.name} overlap inside their knuckles or pins as printed: "
