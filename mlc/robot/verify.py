@@ -138,13 +138,15 @@ def angles_relaxed(angles, block: float, tau: float, z: float = 3.0) -> tuple[bo
     return bool(np.all(drift <= tol)), {"drift_deg": drift.tolist(), "tol_deg": tol.tolist(), "noise_deg": s.tolist()}
 
 
-def run_fold(sim, scene: Scene, state: str, kT: float, tau: float, max_time: float, every: float | None = None):
+def run_fold(sim, scene: Scene, state: str, kT: float, tau: float, max_time: float, every: float | None = None,
+             min_time: float | None = None):
     """Advance ``sim`` (inputs already set to row ``state``) in windows of max(0.05, tau/20)
     t0 until relaxed or ``max_time`` t0.  Relaxed: at least ``TAU_FACTOR`` tau (not for the
     rest row), the three block means of every circuit output over the last third within
     :func:`mlc.verify.dynamic.plateau_tol`, and the DOF angles' block means within their
     own thermal noise (:func:`angles_relaxed`).  The DOF probes are not plateau-tested:
     the skeleton's soft joints fluctuate far more than the circuit's stiff pairs.
+    ``min_time`` (t0): run at least this long (default ``TAU_FACTOR`` tau; the rest row 0).
     Returns (probe means over the plateau {name: sigma}, time t0, relaxed, test details,
     history of turns every ``every`` t0 or [])."""
     from mlc.verify.dynamic import MIN_WINDOWS, PLATEAU, TAU_FACTOR, plateau_tol
@@ -154,6 +156,8 @@ def run_fold(sim, scene: Scene, state: str, kT: float, tau: float, max_time: flo
     circ = [p for p in names if not p.startswith("dof_")]
     window = max(0.05, tau / 20.0)
     t_min = TAU_FACTOR * tau if state != "0" * len(scene.inputs) else 0.0
+    if min_time is not None:
+        t_min = float(min_time)
     ends, means, hist, angs = [], {p: [] for p in names}, [], []
     t, relaxed, detail, first = 0.0, False, {}, 0
     next_rec = every if every else float("inf")
