@@ -28,10 +28,12 @@ from mlc.gates.connector import ConnectorGeometry, chain_frames, max_bend, rotat
 
 BEND_FRACTION = 0.75         # routing bends at most this fraction of the geometric largest bend
 EXACT = 1e-7                 # sigma: the last pair must land this close
-PASSES = (1.0, 1e-3)         # weights of the soft terms: shape the chain, then close it exactly
+PASSES = (1.0, 1e-5)         # weights of the soft terms: shape the chain, then close it exactly
 DEBUG = False
 SHAPE_TOL = 1e-5           # relative cost change that ends the shaping pass
 STATS = None               # a list to collect (n, pass, evaluations, status, closure) per solve
+EARLY_CLOSE = True         # the closing passes stop at the first evaluation that closes to CLOSE_MARGIN * EXACT
+CLOSE_MARGIN = 0.1
 
 
 @dataclass
@@ -259,13 +261,22 @@ def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=(
     def frames(b):
         _fk_kernel(c0, u0, t0, np.ascontiguousarray(b, dtype=np.float64), pitches, cs, us, ts)
 
-    def resid(b, w_soft):
+    class _Closed(Exception):
+        """Raised from the closing passes at the first evaluation that closes exactly."""
+
+        def __init__(self, b):
+            self.b = np.array(b, float)
+
+    def resid(b, w_soft, stop=False):
         frames(b)
         out = np.empty(n_rows)
         _resid_kernel(cs, us, ts, b, P, e1, e2, has_app, app_v, wp_k, wp_p, w_soft, wp_weight, out)
+        if stop and max(abs(out[0]), abs(out[1]), abs(out[2]), abs(out[3]), abs(out[4])) < 10.0 * EXACT * CLOSE_MARGIN:
+            if np.all(b >= lo) and np.all(b <= hi):
+                raise _Closed(b)
         return out
 
-    def jac(b, w_soft):
+    def jac(b, w_soft, stop=False):
         # bend i turns everything downstream of junction i rigidly about (c_i, u_i)
         frames(b)
         J = np.empty((n_rows, n))
@@ -285,11 +296,17 @@ def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=(
         if i == len(PASSES) and errors(x)[0] < EXACT:
             break
         tol = SHAPE_TOL if i == 0 else 1e-15      # the shaping pass need not converge: the next one moves it
-        res = least_squares(resid, x, jac=jac, bounds=(lo, hi), args=(w_soft,), method="trf", xtol=tol,
-                            ftol=tol, gtol=1e-15, max_nfev=300 if i == 0 else (200 if i < len(PASSES) else 50))
-        x = res.x
+        try:
+            res = least_squares(resid, x, jac=jac, bounds=(lo, hi), args=(w_soft, EARLY_CLOSE and i > 0),
+                                method="trf", xtol=tol, ftol=tol, gtol=1e-15,
+                                max_nfev=300 if i == 0 else (200 if i < len(PASSES) else 50))
+            x, nfev, status = res.x, res.nfev, res.status
+        except _Closed as c:            # closed exactly: the soft terms are weak here, stop
+            x, nfev, status = c.b, -1, 9
         if STATS is not None:
-            STATS.append((n, i, res.nfev, res.status, errors(x)[0]))
+            STATS.append((n, i, nfev, status, errors(x)[0]))
+        if status == 9:
+            break
     err, aerr = errors(x)
     return Route(c0, u0, t0, [float(v) for v in x], err, aerr)
 
