@@ -79,3 +79,32 @@ def test_every_input_of_a_symmetric_function_gives_the_same_targets():
     on, dc = spec_tables(spec)
     keys = {tuple(cofexact._split(5, on, dc, x)[0]) for x in range(5)}
     assert len(keys) == 1
+
+
+def test_extract_and_shares_common_pairs():
+    """(The -O3 restarts' other new pass.)  Three 3-input ANDs over a, b and one more
+    input each, built so that no pair is shared: 6 ANDs; extract_and builds a & b
+    once and reuses it: 1 + 3 = 4 ANDs, same functions."""
+    from mlc.logic.aig import AIG
+    from mlc.logic.opt import extract_and
+    g = AIG(["a", "b", "c", "d", "e"])
+    a, b, c, d, e = (2 * (i + 1) for i in range(5))
+    g.add_output("x", g.and_(g.and_(a, c), b))
+    g.add_output("y", g.and_(g.and_(b, d), a))
+    g.add_output("z", g.and_(g.and_(a, e), b))
+    g = g.cleanup()
+    assert g.num_ands() == 6
+    h = extract_and(g)
+    assert h.num_ands() == 4
+    assert h.truth_tables() == g.truth_tables()
+
+
+def test_extract_and_keeps_functions_on_random_networks():
+    from mlc.logic.opt import extract_and
+    from mlc.logic.lower import from_spec
+    for seed in range(6):
+        spec = library.random_function(6, 3, 100 + seed)
+        g = from_spec(spec)
+        h = extract_and(g)
+        assert h.truth_tables() == g.truth_tables()
+        assert h.num_ands() <= g.num_ands()

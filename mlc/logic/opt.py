@@ -850,6 +850,87 @@ def balance(g: AIG) -> AIG:
     return R.finish()
 
 
+def extract_and(g: AIG, max_leaves: int = 16) -> AIG:
+    """AND-tree regrouping for sharing: collapse single-fanout, uncomplemented AND
+    trees into multi-input ANDs (as :func:`balance`), then repeatedly build first the
+    pair of operands that most of these ANDs have in common (greedy, ties broken by
+    the literals' order; deterministic), so that the pair is one shared node; the rest
+    of each AND is paired shallowest first.  Never adds nodes to the collapsed form;
+    used on restart starting points at -O3, where it opens sharing that resubstitution
+    and rewriting then exploit (3-bit comparator: 14 -> 13 ANDs)."""
+    n = g.num_inputs
+    refs = refcounts(g)
+    absorbed = bytearray(g.num_nodes)
+    uses_un = [0] * g.num_nodes
+    for a, b in g.ands:
+        for lit in (a, b):
+            if not lit & 1:
+                uses_un[lit >> 1] += 1
+    for y in range(n + 1, g.num_nodes):
+        if refs[y] == 1 and uses_un[y] == 1 and (2 * y) not in g.output_lits:
+            absorbed[y] = 1
+    roots = {}
+    for y in range(n + 1, g.num_nodes):
+        if absorbed[y]:
+            continue
+        leaves = []
+        stack = list(g.ands[y - n - 1])
+        while stack:
+            lit = stack.pop()
+            z = lit >> 1
+            if not (lit & 1) and z > n and absorbed[z] and len(leaves) + len(stack) < max_leaves:
+                stack.extend(g.ands[z - n - 1])
+            else:
+                leaves.append(lit)
+        roots[y] = set(leaves)
+    # greedy pair extraction
+    virt = []          # virt[i] = (u, v): pseudo-literal ('v', i)
+    while True:
+        cnt = {}
+        for y, s in roots.items():
+            if len(s) < 2:
+                continue
+            ls = sorted(s, key=repr)
+            for i in range(len(ls)):
+                for j in range(i + 1, len(ls)):
+                    p = (ls[i], ls[j])
+                    cnt[p] = cnt.get(p, 0) + 1
+        if not cnt:
+            break
+        p, c = max(cnt.items(), key=lambda kv: (kv[1], repr(kv[0])))
+        if c < 2:
+            break
+        v = ("v", len(virt))
+        virt.append(p)
+        for s in roots.values():
+            if p[0] in s and p[1] in s:
+                s.discard(p[0]); s.discard(p[1]); s.add(v)
+    R = _Rebuild(g)
+    memo = {}
+
+    def lit_of(l):
+        if isinstance(l, tuple):
+            if l not in memo:
+                u, w = virt[l[1]]
+                memo[l] = R.and_(lit_of(u), lit_of(w))
+            return memo[l]
+        return R.lit(l)
+
+    for y in range(n + 1, g.num_nodes):
+        if absorbed[y]:
+            continue
+        ls = [lit_of(l) for l in sorted(roots[y], key=repr)]
+        ls = list(dict.fromkeys(ls))
+        if any((l ^ 1) in ls for l in ls):
+            R.m[y] = 0
+            continue
+        while len(ls) > 1:
+            ls.sort(key=R.level)
+            ls = ls[2:] + [R.and_(ls[0], ls[1])]
+        R.m[y] = ls[0] if ls else 1
+    return R.finish()
+
+
 def _xor_gadget(g: AIG, x: int):
     """``(u, v)`` if node ``x`` computes ``u XOR v`` as ``!(u & v) & !(!u & !v)``."""
     n = g.num_inputs
@@ -1175,6 +1256,8 @@ def _restarts(spec, effort: int, care, best: AIG, end: float, time_budget: float
         ps = canon.permuted(ts, pi, po)
         c = decomp.from_table(ps, effort, rng)
         c = canon.restore(c, canon.Canon(ps, pi, po, True), ts)
+        if effort >= 3 and restarts % 2 == 0:
+            c = extract_and(c)
         step_end = min(end, work.now() + max(0.5, 0.2 * time_budget))
         c = improve(c, effort, care, step_end)
         if cost(c) < cost(best):
