@@ -108,3 +108,31 @@ def test_extract_and_keeps_functions_on_random_networks():
         h = extract_and(g)
         assert h.truth_tables() == g.truth_tables()
         assert h.num_ands() <= g.num_ands()
+
+
+def test_extract_and_wide_and_trees_past_the_leaf_limit():
+    """An AND chain over 20 inputs (more than the 16-leaf limit) and an OR chain: the
+    node where collapsing stops must become a root of its own (it was once left as a
+    constant 0)."""
+    from mlc.logic.aig import AIG
+    from mlc.logic.opt import extract_and
+    g = AIG([f"x{i}" for i in range(20)])
+    a = o = 2
+    for i in range(1, 20):
+        a = g.and_(a, 2 * (i + 1))
+        o = g.or_(o, 2 * (i + 1))
+    g.add_output("a", a)
+    g.add_output("o", o)
+    g.add_output("m", g.and_(a ^ 1, o))
+    h = extract_and(g)
+    width = 1 << 10
+    import random
+    rnd = random.Random(3)
+    words = [rnd.getrandbits(width) for _ in range(20)]
+    words[0] = words[1] = (1 << width) - 1
+    for i in range(2, 20):
+        words[i] |= rnd.getrandbits(width) | rnd.getrandbits(width)
+    assert h.simulate(words, width) == g.simulate(words, width)
+    ones = [(1 << width) - 1] * 20
+    assert h.simulate(ones, width) == g.simulate(ones, width)
+    assert h.num_ands() <= g.num_ands()

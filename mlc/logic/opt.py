@@ -870,7 +870,9 @@ def extract_and(g: AIG, max_leaves: int = 16) -> AIG:
         if refs[y] == 1 and uses_un[y] == 1 and (2 * y) not in g.output_lits:
             absorbed[y] = 1
     roots = {}
-    for y in range(n + 1, g.num_nodes):
+    # from the outputs down, so that a node left unexpanded at the leaf limit is
+    # made a root before it is reached
+    for y in range(g.num_nodes - 1, n, -1):
         if absorbed[y]:
             continue
         leaves = []
@@ -881,6 +883,8 @@ def extract_and(g: AIG, max_leaves: int = 16) -> AIG:
             if not (lit & 1) and z > n and absorbed[z] and len(leaves) + len(stack) < max_leaves:
                 stack.extend(g.ands[z - n - 1])
             else:
+                if z > n and absorbed[z]:
+                    absorbed[z] = 0
                 leaves.append(lit)
         roots[y] = set(leaves)
     # greedy pair extraction
