@@ -1086,6 +1086,10 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
         if work.now(best.num_nodes) > deadline:
             break
         cur = walk if big else best
+        if big and EXTRACT_BIG and stale > 0:
+            # regroup AND trees for sharing before the round's passes (router 189 -> 179
+            # in three rounds of sweep/resub/rewrite/refactor after it)
+            cur = extract_and(cur)
         cur = sweep(cur)
         if cur.num_inputs > TT_LIMIT:
             cur = resub_window(cur, max_new=1 if effort == 1 else 2, deadline=deadline)
@@ -1152,6 +1156,7 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
 
 
 CANON_NETWORK_INPUTS = 12
+EXTRACT_BIG = True
 
 
 def optimize(spec, effort: int, time_budget: float | None = None) -> AIG:
