@@ -957,12 +957,14 @@ def test_verify_and_compile_refuse_absurd_seed_counts(seeds, tmp_path, capsys):
     assert_clean_failure(code, err, before, tmp_path, "--seeds")
 
 
-def test_stl_refuses_a_mechanism_too_large_to_mesh(tmp_path, capsys):
-    """A 40-unit connector chain (one mechanism of more than 150 bodies, like a compiled
-    circuit) is refused before any work: the circuit trims can exhaust the memory."""
+def test_stl_refuses_a_mechanism_too_large_to_mesh(tmp_path, capsys, monkeypatch):
+    """A mechanism of more bodies than MAX_MECHANISM_BODIES is refused before any work (the
+    limit lowered to 150 here: a 40-unit connector chain stands for a larger circuit)."""
     from mlc.gates.connector import chain_scene
-    from mlc.mesh.profiles import MAX_MECHANISM_BODIES
+    from mlc.mesh import profiles
     from mlc.scene.io import write_scene
+    monkeypatch.setattr(profiles, "MAX_MECHANISM_BODIES", 150)
+    MAX_MECHANISM_BODIES = 150
     sc = chain_scene(40)
     assert len(sc.bodies) > MAX_MECHANISM_BODIES
     path = tmp_path / "chain.yaml"
