@@ -2,7 +2,8 @@
 
 For a table of 5 inputs, split on one input ``x``: every output ``f`` is
 ``x ? f1 : f0``, and the cofactors ``f0, f1`` of all outputs are functions of the
-other 4 inputs.  All the cofactors are synthesised *together* (shared gates), and each output is joined from its two cofactors with the cheapest gate pattern their
+other 4 inputs.  All the cofactors are synthesised *together* (shared gates), and
+each output is joined from its two cofactors with the cheapest gate pattern their
 realised functions allow: 0 gates (equal), 1 (one a constant), 2 (one implies the
 other: ``f = f0 | x & f1``) or 3 (a multiplexer or an XOR).  The cofactors are
 first synthesised as one 4-input table by the heuristic flow at -O2 (deterministic),
@@ -10,8 +11,9 @@ then SAT looks for smaller circuits within the time limit.
 
 Majority of 5 is the example this was written for: the cofactors are the
 at-least-3 and at-least-2 thresholds of 4 inputs, which SAT synthesises together in
-8 ANDs (the minimum: exactsat.minimum_circuit; the -O2 flow finds 8 too), and ``T3 <= T2`` joins them with
-2 more: 10 ANDs, as ABC's ``&deepsyn`` finds; the heuristic flow gives 12.
+8 ANDs (the minimum: exactsat.minimum_circuit; the -O2 flow finds 8 too), and
+``T3 <= T2`` joins them with 2 more: 10 ANDs, as ABC's ``&deepsyn`` finds; the
+heuristic flow gives 12.
 
 Every input is tried as ``x`` (inputs whose cofactor targets coincide are tried once),
 so the result does not depend on the order in which the inputs are listed, except

@@ -1223,8 +1223,8 @@ def _optimize(spec, effort: int, time_budget: float | None = None,
     if effort >= 3 and isinstance(spec, TableSpec):
         from mlc.logic import cofexact
         if n == cofexact.INPUTS:
-            e = cofexact.try_cofactor_exact(
-                spec, best, cofexact.TIME_LIMIT if default_budget else min(cofexact.TIME_LIMIT, time_budget))
+            limit = cofexact.TIME_LIMIT if default_budget else min(cofexact.TIME_LIMIT, time_budget)
+            e = cofexact.try_cofactor_exact(spec, best, limit)
             if e is not None:
                 e = improve(e, effort, care, work.now() + 1.0)
                 if cost(e) < cost(best):
