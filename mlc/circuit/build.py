@@ -90,6 +90,7 @@ class Circuit:
     chains: int = 0
     half_units: int = 0
     seconds: dict = field(default_factory=dict)
+    closest: float = float("inf")    # sigma: smallest layer-centre distance of a tight chain to another chain
 
 
 @lru_cache(maxsize=None)
@@ -195,15 +196,17 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
     """One scene of the whole circuit, posed in the all-zero input row (see module doc).
 
     When the router leaves chains it could not keep apart (``tight_chains``), the wires
-    they belong to are routed again first, in a second build (once); the build with
-    fewer tight chains is kept (the first on a tie)."""
+    they belong to are routed again first, in a second build (once); the build whose
+    tight chains come closest to another chain by the larger distance is kept (the
+    first on a tie): one chain pressed into another is worse than several just inside
+    the keep-apart distance."""
     first = _build_circuit(netlist, spec, options, progress)
     tight = first.scene.meta["connector"]["tight_chains"]
     if not tight:
         return first
     wires = tuple(dict.fromkeys(t[2:].rsplit("_", 1)[0] for t in tight))
     second = _build_circuit(netlist, spec, options, progress, first_wires=wires)
-    if len(second.scene.meta["connector"]["tight_chains"]) < len(tight):
+    if second.closest > first.closest:
         second.seconds["first_build"] = sum(first.seconds.values())
         return second
     first.seconds["second_build"] = sum(second.seconds.values())
@@ -497,7 +500,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     scene.check()
     t_end = time.perf_counter()
     return Circuit(scene, origin, n_chains, n_half,
-                   {"place": t_route - t_start, "route": t_done - t_route, "assemble": t_end - t_done})
+                   {"place": t_route - t_start, "route": t_done - t_route, "assemble": t_end - t_done},
+                   min((g for _, g in tight), default=float("inf")))
 
 
 def _stem(source: str) -> str:
