@@ -66,6 +66,7 @@ TAP_LEAN = math.radians(45.0)   # a single chain leaves a gate's output pair thi
 TAP_TURN = math.radians(50.0)   # ... turned by at most this much about the pair's axis by the router
 TAP_CONTACT = math.radians(85.0)   # its first layer meets the output lever's slabs about 90 deg from up
 TAP_FREE = (math.radians(10.0), math.radians(70.0))   # the tap stop's free swing about the built direction
+SOURCE_LEAN, SOURCE_TURN = 0.5, 0.3   # a chain or stub on a source leans 0.5 max_bend, turned by at most 0.3
 RISER_PITCH = 3.5           # sigma between the risers of the routes from one tap (x)
 # Gates are turned by +90 degrees about z (gate x -> world y): every output pair's axis is
 # then along world x, so branch pages (turned about that axis) fan out towards -y, where
@@ -357,7 +358,10 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         if not cons:
             continue
         if len(cons) == 1:
-            starts = [(tap, pol, True, rotate(t_up, tap.axis, sgn * TAP_LEAN), None)]
+            # a gate's tap is a lever (free to ~85 deg); a source's is a half unit, whose
+            # junction with the chain bends at most max_bend: lean less, turn less
+            lean = TAP_LEAN if wire[0] == "gate" else SOURCE_LEAN * max_bend(geo)
+            starts = [(tap, pol, True, rotate(t_up, tap.axis, sgn * lean), None)]
         else:
             starts = []
             angs = branch_angles(len(cons))
@@ -382,8 +386,11 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                     parts, pin, pout = half_unit_parts(f"{tag}_stub", start.centre, start.axis, t0, sstate, geo,
                                                        in_stop=stop_at_tap if start is tap else POST_WIDTH)
                     parts.bonds += join(f"{tag}_stub_j", start, pin, geo.k)
-                    if start is not tap and half_unit_prefix(start):     # a page: stop its junction
+                    if half_unit_prefix(start):     # on a page or a source: stop its junction
                         parts.bonds += junction_stops(f"{tag}_stub_s", half_unit_prefix(start), f"{tag}_stub", geo, geo.k)
+                    elif start is tap and wire[0] == "gate":       # on a lever: the tap stop
+                        parts.bonds += _tap_stop(f"{tag}_stub_s", by_name[tap.lo.split(".")[0]], tap.lo.split(".")[1],
+                                                 t_up, t0, f"{tag}_stub", geo.k)
                     add(parts)
                     n_half += 1
                     end = pout
@@ -408,7 +415,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             z_in = zp - 8.0 - (PIN_STAGGER if yp > other.centre[1] else 0.0)
             x_end = xp + side * PIN_END
             lane = Lane(x_rise, start.centre[2] + 3.0, z_run, x_in, z_in, x_end, zp - 6.0)
-            sbm = TAP_TURN if len(starts) == 1 else END_BEND * max_bend(geo)
+            sbm = (END_BEND * max_bend(geo) if len(starts) > 1 else TAP_TURN if wire[0] == "gate"
+                   else SOURCE_TURN * max_bend(geo))
             plane = lanes.assign(lane)
             route = None
             best = (-math.inf, None, plane)
@@ -461,6 +469,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             parts.add(lp)
             parts.bonds += join(f"{tag}_j0", start, pairs[0], geo.k)
             if start is not tap and half_unit_prefix(start):     # the junction after a branch page
+                parts.bonds += junction_stops(f"{tag}_s0", half_unit_prefix(start), f"{tag}_0", geo, geo.k)
+            if start is tap and wire[0] != "gate" and half_unit_prefix(start):   # on a source half unit
                 parts.bonds += junction_stops(f"{tag}_s0", half_unit_prefix(start), f"{tag}_0", geo, geo.k)
             if start is tap and wire[0] == "gate":            # the chain hangs on the lever: its stop
                 parts.bonds += _tap_stop(f"{tag}_s0", by_name[tap.lo.split(".")[0]], tap.lo.split(".")[1],
