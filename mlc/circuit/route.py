@@ -5,15 +5,18 @@ first tangent and the bend at every junction (:func:`mlc.gates.connector.chain_f
 junction ``i`` turns the next tangent about the junction's pair axis).  Routing finds
 bends such that the last pair lands on the target pair:
 
-* centre ``c_n = P`` (3 equations) and axis ``u_n = +-a`` (2 equations), solved to 1e-10
-  sigma: the joints close exactly when the scene is built;
+* centre ``c_n = P`` (3 equations) and axis ``u_n = +-a`` (2 equations), to within
+  ``EXACT`` (1e-7 sigma; the closing passes stop at the first evaluation within a tenth of
+  it): the joints close exactly when the scene is built;
 * the last tangent points along ``approach`` (the side the target is open to), softly;
 * the chain passes near ``waypoints`` (fractions of its length), softly;
 * every bend within ``+-bend_max`` (bounds), so neighbouring layers never touch;
 * smallest bends otherwise (a weak term).
 
 ``n`` has the parity the signal needs (every half unit is a NOT) and grows from the
-straight-line estimate until the equations close.  Units: sigma, radians.
+steered guess until the equations close.  The solve is scipy's bounded trust region
+(dense Jacobian, one SVD per iteration), so its cost grows faster than ``n``: the
+reason circuit builds scale worse than linearly (docs/circuits.md).  Units: sigma, radians.
 """
 from __future__ import annotations
 

@@ -284,7 +284,7 @@ def chain_parts(prefix: str, centre, axis, tangent, bends, state: int, geo: Conn
                 in_stop: float = POST_WIDTH, stops: bool = False) -> tuple[Parts, list[Pair]]:
     """A chain of ``len(bends)`` half units (see :func:`chain_frames`), the first input pair
     carrying ``state``.  Consecutive half units are joined by two universal joints, and
-    with ``stops`` by the two :func:`junction_stops` that keep their layers apart.
+    with ``stops`` by the :func:`junction_stops` bond that keeps their layers apart.
     ``in_stop``: how far the first half unit's input posts stop short of their joints (see
     :func:`half_unit_parts`).  Returns (parts, pairs) with pairs[0] the chain's input and
     pairs[-1] its output."""
