@@ -136,3 +136,13 @@ def test_restore_maps_back_to_the_listing():
     h = canon.restore(g, c, s)
     assert h.inputs == s.inputs and h.outputs == s.outputs
     assert h.truth_tables() == s.on
+
+
+def test_default_effort_meets_abc_on_majority5_and_cmp3():
+    """At the default -O2 (issue 15 step): majority-5 in 10 ANDs (the Shannon split with
+    the cofactors synthesised together, its deterministic part) and the 3-bit
+    comparator in 13 (extra restarts regrouped by extract_and), ABC compress2rs's and
+    &deepsyn's counts, in the given and the reversed listing (was 12 and 14)."""
+    for spec, want in ((library.majority(5), 10), (library.comparator(3), 13)):
+        for s in list(listings(spec, 2, seed=3)):
+            assert synthesize(s, 2).num_ands() == want, s.source

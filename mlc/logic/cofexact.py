@@ -156,12 +156,15 @@ def _build(spec, x: int, refs, sub: AIG | None, k: int) -> AIG:
     return g.cleanup()
 
 
-def try_cofactor_exact(spec, best: AIG, time_limit: float, info: dict | None = None) -> AIG | None:
+def try_cofactor_exact(spec, best: AIG, time_limit: float, info: dict | None = None,
+                       sat: bool = True) -> AIG | None:
     """The smallest network found this way if smaller than ``best``, else None.
 
-    ``time_limit``: real seconds in all (each SAT call gets what is left)."""
+    ``time_limit``: real seconds in all (each SAT call gets what is left).  With
+    ``sat=False`` (-O2) only the deterministic part runs: the cofactors by the -O2
+    flow, no SAT descent."""
     n = len(spec.inputs)
-    if n != INPUTS or not exactsat.available() or best.num_ands() <= 3:
+    if n != INPUTS or (sat and not exactsat.available()) or best.num_ands() <= 3:
         return None
     end = time.monotonic() + time_limit
     per_call = max(1.0, time_limit / (2 * n))
@@ -193,7 +196,7 @@ def try_cofactor_exact(spec, best: AIG, time_limit: float, info: dict | None = N
             found = g
         joins = sum(_join_bound(r0, r1, targets) for r0, r1 in refs)
         gates = min(sub.num_ands(), (found or best).num_ands() - joins) - 1
-        while gates >= len(targets):
+        while sat and gates >= len(targets):
             left = end - time.monotonic()
             if left < 0.05:
                 break

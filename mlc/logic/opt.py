@@ -856,8 +856,9 @@ def extract_and(g: AIG, max_leaves: int = 16) -> AIG:
     pair of operands that most of these ANDs have in common (greedy, ties broken by
     the literals' order; deterministic), so that the pair is one shared node; the rest
     of each AND is paired shallowest first.  Never adds nodes to the collapsed form;
-    used on restart starting points at -O3, where it opens sharing that resubstitution
-    and rewriting then exploit (3-bit comparator: 14 -> 13 ANDs)."""
+    used on restart starting points (every other -O3 restart; every other one of the
+    12 extra -O2 restarts), where it opens sharing that resubstitution and rewriting
+    then exploit (3-bit comparator: 14 -> 13 ANDs)."""
     n = g.num_inputs
     refs = refcounts(g)
     absorbed = bytearray(g.num_nodes)
@@ -1157,6 +1158,11 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
 
 CANON_NETWORK_INPUTS = 12
 EXTRACT_BIG = True
+# -O2 restarts after the plain ones (tables of <= 8 inputs), every O2_MOD-th from the
+# start regrouped by extract_and: 3-bit comparator 14 -> 13 (the 16th restart), the
+# random 7-input functions 53 -> 52 and 34 -> 32; no function of the suite worse
+O2_EXTRA = 12
+O2_MOD = 2
 
 
 def optimize(spec, effort: int, time_budget: float | None = None) -> AIG:
@@ -1191,8 +1197,10 @@ def _optimize(spec, effort: int, time_budget: float | None = None,
     default_budget = time_budget is None
     if time_budget is None:
         n = len(spec.inputs)
-        # -O2 answers within a second up to 10 inputs, a few seconds at 16
-        time_budget = {0: 1.0, 1: 0.5, 2: (1.0 if n <= 8 else 0.6) + 0.8 * max(0, min(n, 20) - 10),
+        # -O2 answers within a second up to 4 inputs, two up to 8 (the extract_and
+        # restarts), under a second at 9-10, a few seconds at 16
+        o2 = (1.0 if n <= 4 else 2.0 if n <= 8 else 0.6) + 0.8 * max(0, min(n, 20) - 10)
+        time_budget = {0: 1.0, 1: 0.5, 2: o2,
                        3: 5.0 + 2.0 * max(0, min(n, 20) - 10)}[effort]
     cands = initial_candidates(spec, effort) + list(extra or [])
     if effort == 0:
@@ -1220,11 +1228,12 @@ def _optimize(spec, effort: int, time_budget: float | None = None,
         e = exact_multi.try_exact(spec, best, t0 + time_budget)
         if e is not None and cost(e) < cost(best):
             best = e
-    if effort >= 3 and isinstance(spec, TableSpec):
+    if effort >= 2 and isinstance(spec, TableSpec):
         from mlc.logic import cofexact
         if n == cofexact.INPUTS:
+            # -O2: the deterministic part only (cofactors by the -O2 flow, no SAT)
             limit = cofexact.TIME_LIMIT if default_budget else min(cofexact.TIME_LIMIT, time_budget)
-            e = cofexact.try_cofactor_exact(spec, best, limit)
+            e = cofexact.try_cofactor_exact(spec, best, limit, sat=effort >= 3)
             if e is not None:
                 e = improve(e, effort, care, work.now() + 1.0)
                 if cost(e) < cost(best):
@@ -1237,8 +1246,11 @@ def _restarts(spec, effort: int, care, best: AIG, end: float, time_budget: float
     """Restarts: decompositions of the specification listed in random orders of its
     inputs and outputs (fixed seed) with a randomised Shannon choice, each mapped back
     to the given order and improved; the best network is kept.  -O2 does a fixed
-    number (deterministic unless the budget runs out), -O3 runs until 25 restarts in
-    a row bring nothing or the budget is spent."""
+    number (deterministic unless the budget runs out): 8 (up to 4 inputs) or 4 (5..8
+    inputs) plain ones, then :data:`O2_EXTRA` more of which every other one starts
+    from the decomposition regrouped by :func:`extract_and` (the plain ones come
+    first, so the result is never worse than without the extra ones); -O3 runs until
+    25 restarts in a row bring nothing or the budget is spent."""
     from mlc.logic import canon, decomp
     from mlc.logic.equiv import spec_tables
     n = len(spec.inputs)
@@ -1250,8 +1262,10 @@ def _restarts(spec, effort: int, care, best: AIG, end: float, time_budget: float
     rng = random.Random(12345)
     stale = 0
     restarts = 0
+    base = 0
     if effort == 2:
-        max_restarts = 8 if n <= 4 else 4 if n <= 8 else 0
+        base = 8 if n <= 4 else 4 if n <= 8 else 0
+        max_restarts = base + (O2_EXTRA if n <= 8 else 0)
     else:
         max_restarts = 10 ** 9
     if cap is not None:
@@ -1265,7 +1279,8 @@ def _restarts(spec, effort: int, care, best: AIG, end: float, time_budget: float
         ps = canon.permuted(ts, pi, po)
         c = decomp.from_table(ps, effort, rng)
         c = canon.restore(c, canon.Canon(ps, pi, po, True), ts)
-        if effort >= 3 and restarts % 2 == 0:
+        if (effort >= 3 and restarts % 2 == 0) or (effort == 2 and restarts > base
+                                                      and (restarts - base) % O2_MOD == 0):
             c = extract_and(c)
         step_end = min(end, work.now() + max(0.5, 0.2 * time_budget))
         c = improve(c, effort, care, step_end)
