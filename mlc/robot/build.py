@@ -44,7 +44,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from mlc.errors import MlcError
-from mlc.gates.connector import Pair, chain_parts, connector_geometry, join
+from mlc.gates.connector import (POST_WIDTH, STOP_ARM, Pair, chain_parts, connector_geometry, half_unit_prefix, join,
+                                 junction_stops)
 from mlc.gates.parts import axis_sites, hinge, segment_box, slab_body
 from mlc.geometry.rotation import matrix_to_quat
 from mlc.robot.spec import RobotSpec
@@ -63,6 +64,8 @@ STOP_R_OVER = (1.8, 1.2)           # sigma: the over-turn stop's sites, on both 
 STOP_R_UNDER = 1.2                 # sigma: the under-turn stop's sites
 STOP_UNDER_LOW = math.radians(52.5)  # rad: the under-turn stop's arms this far apart at its lower limit
 STOP_K = 4.0                       # k0: the stops' stiffness once engaged (a wire joint's is 1)
+LEVER_STOP = 0.35                  # sigma: a chain's first posts stop this short of a gate lever's joints (as in circuits)
+CHAIN_STOPS = True                 # junction stops in the coupling chains (docs/robot.md 2.2, 3.3)
 
 
 @dataclass
@@ -184,6 +187,34 @@ def _pair_tangent(scene: Scene, lo: str, hi: str, centre, axis):
         t = np.array([0.0, 0.0, 1.0]) - axis[2] * axis
         n = float(np.linalg.norm(t))
     return t / n
+
+
+def _lever_stop(name: str, lever: Body, site: str, axis, t_first, first: str, k: float) -> tuple[Body, Bond]:
+    """The first junction of a coupling chain hung on a gate's output lever (pair axis
+    ``axis``): a flat-bottom bond like the circuit's tap stop (``mlc.circuit.build._tap_stop``,
+    docs/circuits.md "Junction stops"), from a site ``STOP_ARM`` behind the lever's joint
+    ``site`` along the chain's built first tangent ``t_first`` to the first half unit's
+    ``stop_in``.  The two are 2 m cos(phi/2) apart for a swing phi of the chain from its
+    built direction; the bond is free up to TAP_CONTACT minus the built lean from the
+    pair's upward normal (clamped to TAP_FREE).  Returns a copy of ``lever`` with the site
+    (named after the chain: two chains may hang on one lever) and the bond.  Units: sigma, k0."""
+    import copy
+
+    from mlc.circuit.build import TAP_CONTACT, TAP_FREE
+    m = STOP_ARM
+    axis = np.asarray(axis, float) / np.linalg.norm(axis)
+    t_first = np.asarray(t_first, float) / np.linalg.norm(t_first)
+    up = np.array([0.0, 0.0, 1.0])
+    t_up = up - float(up @ axis) * axis
+    t_up /= np.linalg.norm(t_up)
+    lean = math.acos(float(np.clip(t_first @ t_up, -1.0, 1.0)))
+    free = min(max(TAP_CONTACT - lean, TAP_FREE[0]), TAP_FREE[1])
+    lev = copy.deepcopy(lever)
+    sname = f"stop_{name}"
+    lev.sites[sname] = lev.rotation().T @ (lev.world(site) - m * t_first - lev.position)
+    d_stop, d_free = 2.0 * m * math.cos(0.5 * free), 2.0 * m + 0.5
+    return lev, Bond(name, f"{lev.name}.{sname}", f"{first}_AB.stop_in", k, 0.5 * (d_stop + d_free),
+                     0.5 * (d_free - d_stop), "bond", None)
 
 
 def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
@@ -332,6 +363,7 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
     cbyname = {b.name: b for b in circuit.bodies}
     sbyname = {b.name: b for b in bodies}
     placed = np.array([b.position for b in list(circuit.bodies) + bodies])
+    by_body = {b.name: b for b in circuit.bodies}     # circuit bodies, some copied with a stop site
     for ds, name, target, pr in targets:
         pa = cbyname[pr.a.split(".")[0]].world(pr.a.split(".", 1)[1])
         pb = cbyname[pr.b.split(".")[0]].world(pr.b.split(".", 1)[1])
@@ -367,7 +399,9 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
                     break
             if route is None:
                 continue
-            parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, sstate, geo)
+            on_lever = half_unit_prefix(start) is None     # a gate's output lever (else a half unit's pair)
+            parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, sstate, geo,
+                                       in_stop=LEVER_STOP if on_lever else POST_WIDTH, stops=CHAIN_STOPS)
             new_c = np.array([b.position for b in parts.bodies])
             d2 = ((new_c[:, None, :] - placed[None, :, :]) ** 2).sum(-1)
             if float(d2.min()) >= CLEAR ** 2:
@@ -379,6 +413,14 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
         route, parts, pairs = found
         placed = np.vstack([placed, new_c])
         parts.bonds += join(f"{tag}_j0", start, pairs[0], geo.k)
+        if CHAIN_STOPS and not on_lever:               # on a half unit (a branch page): its junction stop
+            parts.bonds += junction_stops(f"{tag}_s0", half_unit_prefix(start), f"{tag}_0", geo, geo.k)
+        elif CHAIN_STOPS:                              # on a gate's lever: the tap stop
+            lname = start.lo.split(".")[0]
+            lev, bd = _lever_stop(f"{tag}_s0", by_body[lname], start.lo.split(".", 1)[1], start.axis,
+                                  pairs[1].centre - pairs[0].centre, f"{tag}_0", geo.k)
+            by_body[lname] = lev
+            parts.bonds.append(bd)
         lout = pairs[-1]
         same = float(lout.axis @ tax) > 0
         ends = (lout.lo, lout.hi) if same else (lout.hi, lout.lo)
@@ -399,7 +441,7 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
                   "stops": {"margin_deg": math.degrees(STOP_MARGIN),
                             "free_turn_deg": [-math.degrees(STOP_MARGIN), 90 + math.degrees(STOP_MARGIN)]},
                   "dofs": dofs_meta, "chains": n_chains, "half_units": n_half})
-    scene = Scene(name=f"robot_{spec.name}", bodies=list(circuit.bodies) + bodies + parts_bodies,
+    scene = Scene(name=f"robot_{spec.name}", bodies=[by_body[b.name] for b in circuit.bodies] + bodies + parts_bodies,
                   bonds=list(circuit.bonds) + bonds + parts_bonds, muscles=list(circuit.muscles),
                   probes=list(circuit.probes) + probes, inputs=list(circuit.inputs), outputs=list(circuit.outputs),
                   truth_table=dict(circuit.truth_table) if circuit.truth_table else None,
