@@ -157,14 +157,13 @@ def test_verify_tau_dt_are_validated(robot, capsys, opts, words):
     assert rc == 2 and words in err and "Traceback" not in err
 
 
-def test_verify_tau_dt_need_dynamic_and_a_robot(robot, capsys):
+def test_verify_tau_dt_need_dynamic(robot, capsys):
     rc = main(["verify", str(robot / "out" / "robot.yaml"), "--tau", "100"])
     err = capsys.readouterr().err
     assert rc == 2 and "--tau needs --dynamic" in err
-    # a circuit's dynamic check computes its own tau and step (mlc.verify.circuit.verify_dynamic)
-    rc = main(["verify", str(robot / "out" / "circuit.yaml"), "--dynamic", "--dt", "0.1"])
+    rc = main(["verify", str(robot / "out" / "circuit.yaml"), "--dt", "0.1"])
     err = capsys.readouterr().err
-    assert rc == 2 and "--dt applies to robot scenes only" in err and "Traceback" not in err
+    assert rc == 2 and "--dt needs --dynamic" in err and "Traceback" not in err
 
 
 def test_verify_tau_dt_reach_the_robot_run(robot, capsys):

@@ -13,7 +13,7 @@ from mlc.gates.library import gate_scene
 from mlc.scene.model import Body, Box, Muscle, Probe, Scene
 from mlc.sim.drive import Drive
 from mlc.sim.integrator import SimOptions, Simulation
-from mlc.verify.dynamic import check_scene_dynamic_multi, probe_thermal_sd, relaxation_time
+from mlc.verify.dynamic import check_scene_dynamic_multi, probe_thermal_sd, relaxation_time, signal_time
 
 
 def _points(n: int, k: float, gamma: float = 1.0) -> Scene:
@@ -132,3 +132,61 @@ def test_bad_arguments_are_one_clear_error():
     sc.truth_table = None
     with pytest.raises(MlcError, match="no truth table"):
         check_scene_dynamic_multi(sc)
+
+
+def test_signal_time_of_one_mode_is_its_relaxation_time():
+    """Two bodies and one muscle: one restoring mode, so the mean step time of the probe is
+    that mode's relaxation time, 1/(2k/gamma)."""
+    sc = _points(2, 0.5, 1.0)
+    assert signal_time(sc, "0", "1") == pytest.approx(relaxation_time(sc), rel=1e-6)
+    assert signal_time(sc, "1", "1") == 0.0                  # no switch, no signal
+
+
+def test_signal_time_of_a_chain_is_pi2_over_8_of_tau():
+    """Theory: a line diffusing from a step at one end answers at the other with
+    1 - sum_n (4/pi) (-1)^n/(2n+1) exp(-(2n+1)^2 t/tau), whose integral is tau (4/pi) (pi^3/32)
+    = (pi^2/8) tau.  A 10-unit connector chain is such a line."""
+    sc = chain_scene(10, "contract")
+    assert signal_time(sc, "0", "1") / relaxation_time(sc) == pytest.approx(np.pi ** 2 / 8, rel=0.01)
+
+
+def test_signal_time_against_the_integrator():
+    """Independent check by the integrator: at kT = 0 the far end of a 5-unit chain whose
+    muscle switches by 1 % of its stroke (the linear regime) has a remaining response
+    1 - a(t)/a(inf) whose integral is the predicted mean time."""
+    sc = chain_scene(5, "contract")
+    for m in sc.muscles:
+        m.actuated = m.rest + 0.01 * (m.actuated - m.rest)
+    T = signal_time(sc, "0", "1")
+    sim = Simulation(sc, {"a": Drive.constant(1)}, SimOptions(scheme="stiff", kT=0.0, dt=0.01))
+    res = sim.run(12 * T, record_interval=0.01, quiet=True)
+    a = res.probes["out"]
+    rem = (a[-1] - a) / (a[-1] - a[0])
+    measured = float(np.sum(0.5 * (rem[1:] + rem[:-1]) * np.diff(res.times)))
+    assert measured == pytest.approx(T, rel=0.03)
+
+
+def test_a_large_scene_uses_the_signal_time(monkeypatch):
+    """Above DENSE_MAX degrees of freedom (a circuit) the time floor comes from signal_time,
+    not from the eigensolver, and a given tau is used as given."""
+    import mlc.verify.dynamic as dyn
+
+    sc = chain_scene(3, "expand")
+    monkeypatch.setattr(dyn, "DENSE_MAX", 6)
+
+    def boom(*a, **k):
+        raise AssertionError("relaxation_time called")
+    monkeypatch.setattr(dyn, "relaxation_time", boom)
+    row = dyn.check_scene_dynamic_multi(sc, 1e-5, [0], rows=["1"], progress=False)[0]
+    assert row["ok"] and row["tau"] == pytest.approx(signal_time(sc, "0", "1"), rel=0.2)
+    assert row["relax_time"] >= 3 * signal_time(sc, "0", "1")
+    given = dyn.check_scene_dynamic_multi(sc, 1e-5, [0], rows=["1"], progress=False, tau=0.5, dt=0.02)[0]
+    assert given["ok"] and given["tau"] == 0.5
+
+
+def test_circuit_verify_takes_tau_and_dt():
+    from mlc.verify.circuit import verify_dynamic
+
+    rep = verify_dynamic(chain_scene(2, "expand"), ["1"], seeds=1, tau=0.3, dt=0.02, progress=False)
+    assert rep.ok and rep.params["tau"] == 0.3 and rep.params["dt"] == 0.02
+    assert all(e["tau"] == 0.3 for e in rep.entries)

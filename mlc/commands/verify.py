@@ -20,12 +20,12 @@ def register(sub):
     p.add_argument("--seeds", type=int, default=3, help="seeds per row for --dynamic (default 3)")
     p.add_argument("--scheme", choices=("stiff", "euler"), default="stiff", help="integrator for --dynamic")
     p.add_argument("--tau", type=float, metavar="T",
-                   help="--dynamic, robot scenes only: the slowest relaxation time (t0); a run lasts at least 3 T and "
-                        "ends at the first plateau or the fold time. Default for a robot: mlc.robot.verify.ROBOT_TAU "
-                        "(docs/robot.md section 3); circuits always compute it")
+                   help="--dynamic: the slowest relaxation time (t0); a run lasts at least 3 T and ends at the first "
+                        "plateau (robots: or the fold time). Default for a robot: mlc.robot.verify.ROBOT_TAU "
+                        "(docs/robot.md section 3); for a circuit, computed per row (mlc.verify.dynamic.signal_time)")
     p.add_argument("--dt", type=float, metavar="DT",
-                   help="--dynamic, robot scenes only: the integrator's step (t0). Default for a robot: "
-                        "mlc.robot.verify.ROBOT_DT; circuits use the verifier's own step")
+                   help="--dynamic: the integrator's step (t0). Default for a robot: mlc.robot.verify.ROBOT_DT; "
+                        "for a circuit, mlc.verify.dynamic.DT (0.01 t0 with the stiff scheme)")
     p.add_argument("--rows", metavar="BITS", nargs="+", help="verify only these rows (bit strings in input order)")
     p.add_argument("--require-clearance", action="store_true",
                    help="static: also fail a row whose slabs interpenetrate (reported as a warning otherwise)")
@@ -36,22 +36,17 @@ def register(sub):
 def verify_scene_file(scene, dynamic: bool = False, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
                       rows=None, require_clearance: bool = False, tau: float | None = None, dt: float | None = None):
     """The report for an already loaded scene (used by ``mlc compile --verify`` too).  ``tau``
-    and ``dt`` (t0) apply to robot scenes only (mlc.verify.circuit.verify_dynamic takes
-    neither): given for a circuit, they are refused."""
-    from mlc.errors import MlcError
+    and ``dt`` (t0, dynamic only): the relaxation time a run lasts at least 3 times and the
+    integrator's step; None: the robot's or the verifier's defaults."""
     from mlc.io.progress import Progress
     from mlc.verify.circuit import select_rows, verify_dynamic, verify_static
 
     if isinstance(scene.meta, dict) and scene.meta.get("element") == "robot":     # docs/robot.md
         from mlc.robot.verify import verify_robot
         return verify_robot(scene, dynamic, kT, seeds, scheme, rows, tau=tau, dt=dt)
-    for opt, v in (("--tau", tau), ("--dt", dt)):
-        if v is not None:
-            raise MlcError(f"{opt} applies to robot scenes only; {scene.name} is not a robot scene", opt,
-                           f"leave {opt} out (a circuit's dynamic check computes its own relaxation time and step)")
     n = len(select_rows(scene, rows))
     if dynamic:
-        return verify_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme)
+        return verify_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme, tau=tau, dt=dt)
     with Progress(f"static verification of {scene.name}", total=n) as bar:
         return verify_static(scene, rows, progress=lambda done, total: bar.update(done),
                              require_clearance=require_clearance)

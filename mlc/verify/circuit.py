@@ -114,7 +114,11 @@ def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_s
 
 
 def verify_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
-                   progress=None) -> Report:
+                   progress=None, tau: float | None = None, dt: float | None = None) -> Report:
+    """Brownian-dynamics check of every row in ``rows`` (default all) over ``seeds`` seeds at
+    ``kT`` (k0 sigma^2): :func:`mlc.verify.dynamic.check_scene_dynamic_multi`.  ``tau`` (t0):
+    the relaxation time a run lasts at least 3 times (default computed per row, see there);
+    ``dt`` (t0): the integrator's step (default the scheme's, mlc.verify.dynamic.DT)."""
     from mlc.verify.dynamic import check_scene_dynamic_multi
 
     states = select_rows(scene, rows)
@@ -122,12 +126,14 @@ def verify_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int = 3, sc
         raise MlcError(f"need at least one seed, got {seeds}", "--seeds")
     t0 = time.perf_counter()
     entries = check_scene_dynamic_multi(scene, kT=kT, seeds=int(seeds), scheme=scheme, rows=states,
-                                        progress=progress)
-    rep = Report(scene.name, "dynamic", params={"kT": kT, "seeds": int(seeds), "scheme": scheme})
+                                        progress=progress, tau=tau, dt=dt)
+    rep = Report(scene.name, "dynamic", params={"kT": kT, "seeds": int(seeds), "scheme": scheme,
+                                                "tau": tau, "dt": dt})
     for e in entries:
         rep.entries.append({"state": e["state"], "output": e["output"], "expected": e["expected"],
                             "measured": e["measured"], "bit": e.get("bit"), "margin": e["margin"],
-                            "relax_time": e.get("relax_time"), "per_seed": e.get("per_seed"), "ok": bool(e["ok"])})
+                            "relax_time": e.get("relax_time"), "per_seed": e.get("per_seed"), "tau": e.get("tau"),
+                            "ok": bool(e["ok"])})
     for s in states:
         es = [e for e in rep.entries if e["state"] == s]
         rts = [e["relax_time"] for e in es]

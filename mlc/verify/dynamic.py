@@ -22,8 +22,8 @@ dynamics runs (:class:`mlc.sim.integrator.Simulation`, stiff scheme by default) 
    01 but 0.086 t0 about the rest pose).
 
 The plateau alone is not enough.  A signal crosses a long connector chain by
-diffusion (``tau`` grows as the square of the length: 0.03, 0.8, 3.0, 12 t0 for
-1, 5, 10, 20 full units), and the far end of a 20-unit chain sits still, within
+diffusion (``tau`` grows as the square of the length: 0.04, 0.96, 3.8, 15 t0 for
+1, 5, 10, 20 full units of an expanding chain, three times that contracting), and the far end of a 20-unit chain sits still, within
 0.02 sigma of its old length, for the first ~1 t0 after the input switched: a
 plateau test run alone declares it relaxed and reads the wrong bit.  ``tau`` comes
 from the linearised overdamped dynamics about the starting pose,
@@ -63,6 +63,7 @@ MAX_TAUS = 12.0
 DT = {"stiff": 0.01, "euler": None}      # t0; None: the integrator's own (half the Euler limit)
 DENSE_MAX = 1800       # degrees of freedom up to which the spectrum is computed densely
 ZERO = 1e-9            # eigenvalues below ZERO * lambda_max count as zero modes
+SIGNAL_MIN = 0.01      # probes answering less than this fraction of the largest answer are left out of signal_time
 
 
 def relaxation_time(scene, pos=None, quat=None, gamma_r: float | None = None,
@@ -96,6 +97,78 @@ def relaxation_time(scene, pos=None, quat=None, gamma_r: float | None = None,
         return 0.0
     t_unit = gamma / (1e-3 * k0)       # the integrator's time per t0
     return 1.0 / lam / t_unit
+
+
+def _probe_gradients(prob, scene):
+    """Gradient of every probe's length (sigma) with respect to each body's translation
+    and rotation vector, one column per probe: shape (6 N, P)."""
+    A = scene.arrays()
+    p, rs = prob.sites()
+    G = np.zeros((prob.n, len(scene.probes)))
+    for k in range(len(scene.probes)):
+        i, j = A.probe_i[k], A.probe_j[k]
+        d = p[i] - p[j]
+        n = d / max(float(np.linalg.norm(d)), 1e-300)
+        for site, sign in ((i, 1.0), (j, -1.0)):
+            b = A.site_body[site]
+            G[6 * b:6 * b + 3, k] += sign * n
+            G[6 * b + 3:6 * b + 6, k] += sign * np.cross(rs[site], n)
+    return G
+
+
+def signal_time(scene, start: str, state: str, pos=None, quat=None, gamma_r: float | None = None,
+                min_response: float = SIGNAL_MIN) -> float:
+    """Mean time (t0) for the inputs' switch from row ``start`` to row ``state`` to reach
+    the probes, in the linearised overdamped dynamics about ``pos``/``quat`` (default: the
+    scene's own): the largest over probes of
+
+        T = y_g^T M^-1 y_f / g^T y_f,    y_g = H^+ g,  y_f = H^+ f,
+
+    the integral of the probe's remaining step response ``1 - a(t)/a(inf)`` after the
+    muscles' rest lengths change (``f = J_m^T sqrt(k) dL``, ``g``: the probe's gradient,
+    ``H = J^T J``, ``M = diag(1/gamma, 1/gamma_r)``): for one mode it is the mode's
+    relaxation time, for a diffusing chain it grows as the square of its length.  Probes
+    whose linear response ``g^T y_f`` is under ``min_response`` times the largest one (a
+    probe behind a gate: the gate's switch is not linear about its rest pose) are left out.
+    A large switch is faster than its linearisation: the far end of a 5-unit chain answers
+    a full switch in 0.85 (expanding) to 0.89 (contracting) of ``T``, a 1 % one in 0.99.  Two sparse solves per row and probe,
+    where the smallest non-zero eigenvalue of :func:`relaxation_time` needs an iterative
+    eigensolver that the hundreds of near-zero bending modes of a circuit's connector
+    chains slow to minutes.  0 when no probe responds."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import splu
+
+    from mlc.verify.static import _Problem
+
+    A = scene.arrays()
+    prob = _Problem(scene, A.pos if pos is None else pos, A.quat if quat is None else quat, pin_first=False)
+    if prob.m == 0 or prob.n == 0 or not scene.probes or not len(A.muscle_i):
+        return 0.0
+    u = scene.units
+    gamma, k0 = float(u.get("gamma", 1.0)), float(u.get("k0", 1.0))
+    gr = gamma if gamma_r is None else float(gamma_r)
+    J = prob.jacobian().tocsr()
+    H = (J.T @ J).tocsc()
+    eps = 1e-10 * max(float(H.diagonal().max()), 1e-300)
+    lu = splu((H + sp.identity(prob.n, format="csc") * eps).tocsc())
+    a = np.asarray([int(c) for c in start], float)[A.muscle_input]
+    b = np.asarray([int(c) for c in state], float)[A.muscle_input]
+    dL = np.array([(m.actuated - m.rest) for m in scene.muscles]) * (b - a)
+    if not np.any(dL):
+        return 0.0
+    r = np.zeros(prob.m)
+    r[prob.m - len(A.muscle_i):] = np.sqrt(A.muscle_k) * dL
+    yf = lu.solve(J.T @ r)
+    G = _probe_gradients(prob, scene)
+    Yg = lu.solve(G)
+    minv = np.tile(np.r_[np.full(3, gamma), np.full(3, gr)], prob.N)
+    resp = G.T @ yf
+    num = Yg.T @ (minv * yf)
+    keep = np.abs(resp) >= min_response * float(np.max(np.abs(resp)))
+    if not np.any(keep) or not np.max(np.abs(resp)) > 0:
+        return 0.0
+    t_unit = gamma / (1e-3 * k0)       # the integrator's time per t0
+    return float(np.max(np.abs(num[keep] / resp[keep]))) / t_unit
 
 
 def probe_thermal_sd(scene, kT: float, pos=None, quat=None) -> dict:
@@ -247,7 +320,12 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
     bar) or a callable ``f(done, total)`` called after each (row, seed) run.  ``tau``
     (t0): the slowest relaxation time, if already known, used for every row (default
     :func:`relaxation_time` at the starting pose and at each row's static equilibrium,
-    the larger of the two).
+    the larger of the two; for a scene of more than ``DENSE_MAX`` / 6 bodies, a circuit,
+    :func:`signal_time` of the row's switch at the same two poses, the larger of the two:
+    a circuit's chains have hundreds of near-zero bending modes that slow the sparse
+    eigensolver to minutes, while the step response needs two solves per probe; on
+    connector chains it is pi^2/8 times the slowest relaxation time, the ratio for a
+    diffusing line driven at one end).
     ``max_time`` (t0): give up on a run after this long (default the larger of 20 t0 and
     12 tau of the row).  ``window`` (t0): averaging window (default the larger of 0.05 t0 and tau/20)."""
     from mlc.io.progress import Progress
@@ -261,7 +339,13 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
     seed_list = _seed_list(seeds)
     opt0 = SimOptions(scheme=scheme)
     tau_given = tau is not None
-    tau = relaxation_time(scene, gamma_r=opt0.gamma_r) if tau is None else float(tau)
+    large = 6 * len(scene.bodies) > DENSE_MAX      # a circuit: signal_time, not the spectrum
+    if tau_given:
+        tau = float(tau)
+    elif large:
+        tau = max([signal_time(scene, "0" * len(scene.inputs), s, gamma_r=opt0.gamma_r) for s in states] + [0.0])
+    else:
+        tau = relaxation_time(scene, gamma_r=opt0.gamma_r)
     max_time_given = max_time is not None
     max_time = float(max_time) if max_time_given else None
     window = max(WINDOW, tau / 20.0) if window is None else float(window)
@@ -281,7 +365,13 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
             try:
                 eq = equilibrium(scene, state)
                 sd = probe_thermal_sd(scene, kT, eq.pos, eq.quat)
-                tau_row = tau if tau_given else max(tau, relaxation_time(scene, eq.pos, eq.quat, opt0.gamma_r))
+                if tau_given:
+                    tau_row = tau
+                elif large:
+                    tau_row = max(signal_time(scene, rest, state, gamma_r=opt0.gamma_r),
+                                  signal_time(scene, rest, state, eq.pos, eq.quat, opt0.gamma_r))
+                else:
+                    tau_row = max(tau, relaxation_time(scene, eq.pos, eq.quat, opt0.gamma_r))
             except (MlcError, ValueError, RuntimeError, np.linalg.LinAlgError):
                 sd, tau_row = probe_thermal_sd(scene, kT), tau
             t_min = tau_factor * tau_row if state != rest else 0.0
@@ -314,4 +404,5 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
     return out
 
 
-__all__ = ["check_scene_dynamic_multi", "plateau_tol", "probe_thermal_sd", "relax_all", "relaxation_time"]
+__all__ = ["check_scene_dynamic_multi", "plateau_tol", "probe_thermal_sd", "relax_all", "relaxation_time",
+           "signal_time"]
