@@ -87,11 +87,14 @@ def _xor_chain(n: int, order) -> NetworkSpec:
     return NetworkSpec(ins, ["p"], nodes, [prev])
 
 
-def test_over_budget_is_undecided_never_equivalent():
+def test_over_budget_is_undecided_never_equivalent(monkeypatch):
     # b*a against a*b: unrelated structures, hard for SAT (14 inputs: cec works at any
     # width).  Over its budget the check says Undecided; with its budget it proves it.
+    # (Sweeping with Glucose and 16384 patterns merges enough of the two that the
+    # outputs then need no conflict at all, so the sweep gets 1 conflict per pair too.)
     spec = library.array_multiplier(7)
     g = from_spec(library.array_multiplier(7, swap=True))
+    monkeypatch.setattr(cec, "SWEEP_CONFLICTS", 1)
     with pytest.raises(cec.Undecided):
         cec.check(g, spec, max_conflicts=1)
 
@@ -117,3 +120,26 @@ def test_miter_is_structurally_zero_for_a_copy():
     spec = library.array_multiplier(4)
     m, outs = cec.miter(from_spec(spec), spec)
     assert outs == [0] * 8
+
+
+def test_output_left_open_by_the_sweeping_solver_goes_to_cadical(monkeypatch):
+    # nothing merged by the sweep and no conflict allowed to the sweeping solver on the
+    # outputs: the proof (and a counterexample for a wrong circuit) comes from the
+    # CaDiCaL fallback, which gets the same clauses and the proven equivalences
+    spec = library.array_multiplier(6)
+    g = from_spec(library.array_multiplier(6, swap=True))
+    monkeypatch.setattr(cec, "SWEEP_CONFLICTS", 1)
+    monkeypatch.setattr(cec, "SWEEP_OUTPUT_CONFLICTS", 1)
+    calls = []
+    real = cec._Sat.__init__
+
+    def spy(self, m, solver=cec.SOLVER):
+        calls.append(solver)
+        real(self, m, solver)
+    monkeypatch.setattr(cec._Sat, "__init__", spy)
+    assert cec.check(g, spec) == [None] * len(spec.outputs)
+    assert calls == [cec.SWEEP_SOLVER, cec.SOLVER]
+    bad = from_spec(library.array_multiplier(6, swap=True))
+    bad.output_lits[3] ^= 1
+    res = cec.check(bad, spec)
+    assert res[3] is not None
