@@ -155,10 +155,18 @@ class HingeAxis:
     rho: float = 0.0          # trim radius around other bodies' knuckles
     layout: list = field(default_factory=list)   # body of each knuckle, in axis order
     scene_span: float = 0.0   # mm, span given by the scene (distance of the bond ends)
+    joint: str | None = None  # compound junction: the universal joint part that holds this axis's pin
+    joint_iv: tuple = ()      # ... and its knuckle in the stack (s0, s1)
 
     @property
     def owner(self) -> str:
         return self.bodies[0]
+
+    @property
+    def pin_owner(self) -> str:
+        """The part whose pin runs through the stack: the first body, or the joint part of a
+        compound junction."""
+        return self.joint or self.bodies[0]
 
 
 @dataclass
@@ -171,9 +179,12 @@ class YokeLayout:
     pin: tuple                # extent of the joint part's pin
     cut: tuple                # range where the body is trimmed away from the axis (except its knuckles)
     plate: tuple = (0.0, 0.0)  # range of the yoke plate joining the knuckles to the slab
+    reach: float | None = None  # compound junction ("host"): how far the hub reaches along the axis
 
     @property
     def extent(self) -> float:
+        if self.reach is not None:
+            return self.reach
         return max(abs(x) for iv in self.own + self.caps for x in iv)
 
 
@@ -190,6 +201,10 @@ class UJoint:
     r_pin: float
     r_hole: float
     rho: tuple                # trim radius of C around u and of O around v
+    host: HingeAxis | None = None  # compound junction: C's hinge axis that carries the hub (u on its line)
+    hub_r: float = 0.0        # compound junction: radius of the ball hub and of its collar
+    collar: float = 0.0       # compound junction: the collar runs from -collar to 0 along u (mm)
+    fin: float = 0.0          # compound junction: O's yoke fin runs from 0 to fin along u (0: a plain plate)
 
 
 @dataclass
@@ -249,6 +264,8 @@ class Assembly:
             F0 = _ortho(u.axes[0], u.axes[1])
             # the hub sits where the two bodies' copies of the joint point are (their mean)
             c = 0.5 * (Tc[:3, :3] @ u.center + Tc[:3, 3] + To[:3, :3] @ u.center + To[:3, 3])
+            if u.host is not None:      # compound junction: its pin runs through C's hinge
+                c = Tc[:3, :3] @ u.center + Tc[:3, 3]
             T = np.eye(4)
             T[:3, :3] = F1 @ F0.T
             T[:3, 3] = c - T[:3, :3] @ u.center
@@ -416,7 +433,18 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         bd = bonds[0]
         cb, ob = bd.a.split(".")[0], bd.b.split(".")[0]
         center = 0.5 * (scene.site_world(bd.a) + scene.site_world(bd.b)) * s
-        u = _hinge_dir(cb, axes, slabs, center)
+        # compound junction: the joint point lies on the line of a hinge of one body, past the
+        # end of its knuckles (connector chains): the hub's first pin IS that hinge's pin
+        compound = None
+        for side_b, other_b in ((cb, ob), (ob, cb)):
+            hx = _host_axis(side_b, axes, center, s, g)
+            if hx is not None:
+                compound = _compound(hx, center, other_b, axes, s, prof, R, r_pin, kmin)
+                if compound is not None:
+                    cb, ob = side_b, other_b
+                    break
+                notes.append(f"universal joint {jname}: no room for a compound junction on hinge {hx.name}")
+        u = _hinge_dir(cb, axes, slabs, center) if compound is None else compound["u"]
         v = _hinge_dir(ob, axes, slabs, center)
         if abs(np.dot(u, v)) > 0.95:
             w = np.mean([sb.center for sb in slabs[ob]], axis=0) - center
@@ -430,17 +458,28 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         cap = max(kmin, prof.min_wall)
         W = (_extent_along(slabs[cb], center, u), _extent_along(slabs[ob], center, v))
         best = None
-        for modes in (("both", "both"), ("+", "both"), ("-", "both"), ("both", "+"), ("both", "-")):
-            lays = tuple(_yoke_layout(m, hub, g, ky, cap, W[i], s) for i, m in enumerate(modes))
+        mode_list = (("both", "both"), ("+", "both"), ("-", "both"), ("both", "+"), ("both", "-"))
+        if compound is not None:
+            mode_list = (("host", "both"), ("host", "+"), ("host", "-"))
+            hub = compound["hub_v"]
+        for modes in mode_list:
+            if compound is not None:
+                lays = (compound["layout"], _yoke_layout(modes[1], hub, g, ky, cap, W[1], s))
+            else:
+                lays = tuple(_yoke_layout(m, hub, g, ky, cap, W[i], s) for i, m in enumerate(modes))
             part_name = jname if jname not in bodies else f"joint_{jname}"
             uj = UJoint(jname, part_name, center, (cb, ob), (u, v), lays, hub, R, r_pin, r_hole,
                         (float(np.hypot(lays[1].extent, R)) + c, float(np.hypot(lays[0].extent, R)) + c))
+            if compound is not None:
+                uj.host, uj.hub_r, uj.collar = compound["axis"], compound["hub_r"], compound["collar"]
+                if np.isfinite(compound["dO"]):
+                    uj.fin = compound["dO"] + t
             if best is not None and not (uj.rho[0] + uj.rho[1], modes != ("both", "both")) < best[0]:
                 continue     # its trim radii are at least these: it cannot beat the best layout
             smp = {bn: base_samples[bn] for bn in uj.bodies}
             for side, bn in enumerate(uj.bodies):
                 smp[bn] = np.concatenate([smp[bn], _slab_samples(
-                    _yoke_plates(slabs[bn], center, uj.axes[side], [lays[side].plate], uj.rho[side] + reach, t), h)])
+                    _uj_plates(uj, side, slabs[bn], uj.rho[side] + reach, t), h)])
             need = _ujoint_trim_memo(memo, uj, smp, state_T, t, c, h)
             rho = (max(uj.rho[0], need[0]), max(uj.rho[1], need[1]))
             score = (rho[0] + rho[1], modes != ("both", "both"))
@@ -449,12 +488,23 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                 best = (score, uj)
         uj = best[1]
         ujoints.append(uj)
-        if uj.layouts[0].mode != "both" or uj.layouts[1].mode != "both":
+        if compound is not None:
+            hx = compound["axis"]
+            hx.span, hx.knuckle, hx.intervals = compound["span"], compound["k"], compound["intervals"]
+            hx.layout = [x if x is not None else uj.part for x in compound["stack"]]
+            hx.joint, hx.joint_iv = uj.part, compound["joint_iv"]
+            if compound["o_axis"] is not None:
+                _own_ends(compound["o_axis"], ob)
+            features.append((f"knuckle length ({hx.name}, with joint {jname})", hx.knuckle, prof.min_feature))
+            features.append((f"hub wall ({jname})", uj.hub_r - r_pin, prof.min_wall))
+            notes.append(f"universal joint {jname}: compound junction on hinge {hx.name} (its pin is the joint's)")
+        if uj.layouts[0].mode not in ("both", "host") or uj.layouts[1].mode != "both":
             notes.append(f"universal joint {jname}: one-sided yoke ({uj.layouts[0].mode} on {cb}, "
                          f"{uj.layouts[1].mode} on {ob}) with a capped pin, clear of the other arm")
         ks = [iv[1] - iv[0] for lay in uj.layouts for iv in lay.own + lay.caps]
         features.append((f"yoke knuckle length ({jname})", min(ks), prof.min_feature))
-        features.append((f"hub length ({jname})", hub, prof.min_feature))
+        if compound is None:
+            features.append((f"hub length ({jname})", hub, prof.min_feature))
 
     if memo is not None:
         _share_ujoint_radii(ujoints, base_samples, slabs)
@@ -468,8 +518,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                                            reach, t)
     for uj in ujoints:
         for side, bn in enumerate(uj.bodies):
-            plates[bn] += _yoke_plates(slabs[bn], uj.center, uj.axes[side], [uj.layouts[side].plate],
-                                       uj.rho[side] + reach, t)
+            plates[bn] += _uj_plates(uj, side, slabs[bn], uj.rho[side] + reach, t)
     shapes = {bn: slabs[bn] + plates[bn] for bn in slabs}
     samples = {bn: _slab_samples(shapes[bn], h) for bn in shapes}
 
@@ -519,6 +568,9 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
             lay = uj.layouts[side]
             for a0, a1 in _complement(lay.own, *lay.cut):
                 cuts.append(cylinder(uj.center, uj.axes[side], a0, a1, uj.rho[side], n, cutter=True))
+        for uj in ujoints:      # compound junction: the other bodies of its hinge clear the yoke too
+            if uj.host is not None and bn in uj.host.bodies and bn not in uj.bodies:
+                cuts.append(cylinder(uj.center, uj.axes[0], *uj.layouts[0].cut, uj.rho[0], n, cutter=True))
         cut_solid = _clean(subtract(solid, cuts))
         if len(cut_solid.decompose()) > len(_clean(solid).decompose()):
             # a slab running along an axis is severed by the clearance around another body's
@@ -554,6 +606,8 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         if cones:
             cr = r_cone + c * np.sqrt(2)
             for ax in my_axes:
+                if ax.joint is not None:     # a compound junction's stack keeps the joint's straight pin
+                    continue
                 seq = sorted((iv, b2) for b2, ivs in ax.intervals.items() for iv in ivs)
                 for (iv0, b0), (iv1, b1) in zip(seq, seq[1:]):
                     face = iv0[1]          # the cone grows from the end face of the lower knuckle
@@ -568,7 +622,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         holes = []
         holes += recess
         for ax in my_axes:
-            if ax.owner != bn and not cones:
+            if ax.pin_owner != bn and (not cones or ax.joint is not None):
                 for a0, a1 in ax.intervals[bn]:
                     holes.append(cylinder(ax.origin, ax.direction, a0 - g / 2, a1 + g / 2, r_hole, n, cutter=True))
         for uj, side in my_uj:
@@ -580,9 +634,10 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         solid = subtract(solid, holes)
         # 4. the owner's pin
         pins = [cylinder(ax.origin, ax.direction, -ax.span / 2, ax.span / 2, r_pin, n)
-                for ax in my_axes if ax.owner == bn and not cones]
+                for ax in my_axes if ax.pin_owner == bn and not cones]
         solid = _clean(union([solid] + pins))
         protected[bn] = union(keep + pins + rings)
+        solid = _drop_scraps(solid, protected[bn], bn, notes)
         # the spot where the attachment hole would go (0.85 mm in from the site), kept if possible
         spots = [cylinder(_spot(x[4], x[0], lug_out), x[1], -t, t, lug_out + c, n) for x in lugs[bn] if not x[2]]
         soft[bn] = union([protected[bn]] + spots)
@@ -596,22 +651,30 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
             fat += [cylinder(uj.center, uj.axes[side], a0 - e, a1 + e, R + e, n)
                     for uj, side in my_uj for a0, a1 in uj.layouts[side].own]
             fat += [cylinder(ax.origin, ax.direction, -ax.span / 2 - e, ax.span / 2 + e, r_pin + e, n)
-                    for ax in my_axes if ax.owner == bn and not cones]
+                    for ax in my_axes if ax.pin_owner == bn and not cones]
             fat += [cylinder(x[0], x[1], -t / 2 - e, t / 2 + e, lug_out + e, n) for x in lugs[bn] if x[2]]
             fat += male
             fat_guard[bn] = (union(fat), union(fat + spots) if spots else None)
         partners = sorted({o for ax in my_axes for o in ax.bodies if o != bn}
-                          | {uj.part for uj, _ in my_uj})
+                          | {uj.part for uj, _ in my_uj} | {ax.joint for ax in my_axes if ax.joint is not None})
         parts.append(Part(bn, "body", solid, partners))
 
     for uj in ujoints:
         u, v = uj.axes
-        pieces = [cylinder(uj.center, u, -uj.hub / 2, uj.hub / 2, R, n),
-                  cylinder(uj.center, v, -uj.hub / 2, uj.hub / 2, R, n)]
+        partners = list(uj.bodies)
+        if uj.host is None:
+            pieces = [cylinder(uj.center, u, -uj.hub / 2, uj.hub / 2, R, n),
+                      cylinder(uj.center, v, -uj.hub / 2, uj.hub / 2, R, n)]
+        else:       # compound junction: ball hub, collar down to the stack, its knuckle in the stack
+            hx = uj.host
+            pieces = [mf.Manifold.sphere(uj.hub_r, n).translate(uj.center.tolist()),
+                      cylinder(uj.center, u, -uj.collar, 0.0, uj.hub_r, n),
+                      cylinder(hx.origin, hx.direction, hx.joint_iv[0], hx.joint_iv[1], R, n)]
+            partners += [o for o in hx.bodies if o not in partners]
         for side, lay in enumerate(uj.layouts):
             pieces.append(cylinder(uj.center, uj.axes[side], lay.pin[0], lay.pin[1], r_pin, n))
             pieces += [cylinder(uj.center, uj.axes[side], a0, a1, R, n) for a0, a1 in lay.caps]
-        parts.append(Part(uj.part, "joint", union(pieces), list(uj.bodies)))
+        parts.append(Part(uj.part, "joint", union(pieces), partners))
         protected[uj.part] = parts[-1].solid
 
     for jname, bonds in joints.items():
@@ -936,6 +999,115 @@ def _ujoint_trim_memo(memo, uj: UJoint, samples, state_T, t, c, h):
     if key not in memo:
         memo[key] = _ujoint_trim(uj, samples, state_T, t, c, h)
     return memo[key]
+
+
+def _drop_scraps(solid: mf.Manifold, keep: mf.Manifold, bn: str, notes: list) -> mf.Manifold:
+    """A body left in several pieces by the clearance cuts (a post on a hinge line cut off
+    by the trim around the next knuckle, at a chain's open end) keeps its largest piece and
+    every piece with knuckle or pin material; scraps under 5 % of its volume are dropped, with
+    a note.  A body in one piece is returned as it is."""
+    comps = solid.decompose()
+    if len(comps) < 2:
+        return solid
+    total = sum(x.volume() for x in comps)
+    big = max(comps, key=lambda x: x.volume())
+    out, dropped = [], 0.0
+    for x in comps:
+        if x is big or x.volume() >= 0.05 * total or (x ^ keep).volume() > 1e-9:
+            out.append(x)
+        else:
+            dropped += x.volume()
+    if not dropped:
+        return solid
+    notes.append(f"{bn}: dropped {len(comps) - len(out)} scrap(s) of {dropped:.3g} mm^3 cut off by the clearance "
+                 f"around a joint")
+    return union(out)
+
+
+def _host_axis(bn, axes, center, s, g):
+    """The hinge axis of body ``bn`` whose line passes through the joint point ``center`` (mm)
+    beyond the end of its knuckles (a connector junction), or None."""
+    for ax in axes:
+        if bn not in ax.bodies or ax.joint is not None:
+            continue
+        rel = center - ax.origin
+        a = float(np.dot(rel, ax.direction))
+        if np.linalg.norm(rel - a * ax.direction) < _TOL * s and abs(a) > ax.span / 2 + g:
+            return ax
+    return None
+
+
+def _compound(ax: HingeAxis, center, other, axes, s, prof, R, r_pin, kmin):
+    """A compound junction on hinge axis ``ax``: the universal joint part holds the pin of the
+    whole knuckle stack and has one knuckle in it (next to the end knuckle of the pin owner,
+    on the joint's side, so the stack is captive), a ball hub at the joint point with a collar
+    down to the stack, and the second pin (the other body's yoke) through the ball.
+
+        [owner | b2 .. | joint | owner] gap [collar + ball hub]   (along the axis, in mm)
+
+    Relative to the bodies of ``ax`` the joint turns about the axis only (collar and stack
+    stay coaxial); relative to ``other`` it turns about the second pin only, and the ball is
+    the same in every such turn, so it keeps its distance (>= clearance) from ``other``'s own
+    knuckles on the same line (the next layer's hinge).  Returns None when the ball would be
+    thinner than the pin plus a minimum wall."""
+    c, g = prof.clearance, prof.knuckle_gap
+    a = float(np.dot(center - ax.origin, ax.direction))
+    sg = 1.0 if a > 0 else -1.0
+    blist = ax.bodies
+    stack = ([blist[0]] + blist[1:] + [None] + [blist[0]]) if sg > 0 else ([blist[0], None] + blist[1:] + [blist[0]])
+    nk = len(stack)
+    L = ax.scene_span
+    S = max(L, nk * kmin + (nk - 1) * g)
+    k = (S - (nk - 1) * g) / nk
+    intervals: dict = {bn: [] for bn in blist}
+    joint_iv = ()
+    for i, bn in enumerate(stack):
+        a0 = -S / 2 + i * (k + g)
+        if bn is None:
+            joint_iv = (a0, a0 + k)
+        else:
+            intervals[bn].append((a0, a0 + k))
+    d0 = abs(a) - S / 2                      # from the stack's end to the joint point
+    dO = np.inf                              # ... and to the other body's own knuckles on this line
+    o_axis = None
+    for bx in axes:
+        if other in bx.bodies:
+            rel = center - bx.origin
+            b = float(np.dot(rel, bx.direction))
+            if np.linalg.norm(rel - b * bx.direction) < _TOL * s and abs(b) > bx.span / 2:
+                if abs(b) - bx.span / 2 < dO:
+                    dO, o_axis = abs(b) - bx.span / 2, bx
+    hub_r = float(min(R, d0 - g, dO - c))
+    if hub_r < r_pin + prof.min_wall:
+        return None
+    # the other body's yoke knuckles (radius R about the second pin, from +-v0 outwards) clear
+    # the collar (axially, by the knuckle gap) and the corners of both stacks (by the clearance)
+    v0 = hub_r + g
+    for dd in (d0, dO):
+        if np.isfinite(dd) and dd - R < c:
+            v0 = max(v0, R + float(np.sqrt(c * c - max(0.0, dd - R) ** 2)))
+    u = ax.direction * sg
+    lay = YokeLayout("host", [], [], (-(d0 + S), 0.0), (-(R + c), R + c), (0.0, 0.0), reach=max(d0 - g, hub_r))
+    return {"axis": ax, "u": u.copy(), "span": S, "k": k, "intervals": intervals, "stack": stack,
+            "joint_iv": joint_iv, "hub_r": hub_r, "collar": d0 - g, "hub_v": 2 * (v0 - g), "layout": lay,
+            "o_axis": o_axis, "dO": dO}
+
+
+def _own_ends(ax: HingeAxis, bn: str) -> None:
+    """Re-lay hinge axis ``ax`` so that body ``bn`` holds its end knuckles and pin (the same
+    knuckle slots, bodies in another order): the other body's yoke of a compound junction then
+    joins its own end knuckle, not a slab trimmed back around another body's knuckle."""
+    if ax.bodies[0] == bn or ax.joint is not None:
+        return
+    blist = [bn] + [b for b in ax.bodies if b != bn]
+    layout = [blist[0]] + blist[1:] + [blist[0]]
+    slots = sorted(iv for ivs in ax.intervals.values() for iv in ivs)
+    if len(slots) != len(layout):
+        return
+    ax.bodies, ax.layout = blist, layout
+    ax.intervals = {b: [] for b in blist}
+    for b, iv in zip(layout, slots):
+        ax.intervals[b].append(iv)
 
 
 def _yoke_layout(mode, hub, g, k, cap, W, s) -> YokeLayout:
@@ -1550,6 +1722,24 @@ def _extent_along(sbs, center, d) -> float:
     return float(np.sum(np.abs(near.R.T @ d) * near.size))
 
 
+def _uj_plates(uj: UJoint, side: int, sbs, reach, t):
+    """The plates joining a universal joint's yoke knuckles to the body of ``side``: none for
+    the host of a compound junction (its knuckles are in its hinge's stack); for the other body
+    of a compound junction whose own hinge lies on the same line (the next layer), a fin across
+    both knuckles, in the plane of u and v and ``t`` thick, from the second pin up into that
+    body's end knuckle; else :func:`_yoke_plates`."""
+    lay = uj.layouts[side]
+    if uj.host is not None and side == 0:
+        return []
+    if uj.host is not None and uj.fin > 0:
+        u, v = uj.axes
+        e = np.cross(u, v)
+        a0, a1 = lay.plate
+        Rm = np.column_stack([v, u, e])
+        return [SlabBox(uj.center + v * 0.5 * (a0 + a1) + u * 0.5 * uj.fin, Rm, np.array([a1 - a0, uj.fin, t]), 2)]
+    return _yoke_plates(sbs, uj.center, uj.axes[side], [lay.plate], reach, t)
+
+
 def _yoke_plates(sbs, origin, d, intervals, reach, t):
     """Plates (as slab boxes) widening a body's slabs over ``intervals`` of an axis."""
     out = []
@@ -1567,6 +1757,8 @@ def _yoke_plates(sbs, origin, d, intervals, reach, t):
         reach_b = min(reach, 2 * half)
         Rm = np.column_stack([d, w, np.cross(d, w)])
         for a0, a1 in intervals:
+            if a1 - a0 <= 0:
+                continue
             out.append(SlabBox(origin + d * 0.5 * (a0 + a1) + w * reach_b / 2, Rm,
                                np.array([a1 - a0, reach_b, t]), 2))
     return out

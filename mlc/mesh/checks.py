@@ -341,12 +341,16 @@ def _retention(asm: Assembly) -> Check:
         F = _perp_frame(ax.direction)
         size = [2 * (ax.R + 3 * c)] * 2 + [ax.span + 6 * c]
         for bn in ax.bodies:
-            tests.append((bn, [o for o in ax.bodies if o != bn], ax.direction, ax.name, ax.origin, F, size))
+            tests.append((bn, [o for o in ax.bodies if o != bn] + ([ax.joint] if ax.joint else []), ax.direction,
+                          ax.name, ax.origin, F, size))
     for uj in asm.ujoints:
         C, O = uj.bodies
         half = max(lay.extent for lay in uj.layouts) + uj.R + 3 * c
-        for who, partners, d in ((C, [uj.part], uj.axes[0]), (O, [uj.part], uj.axes[1]),
-                                 (uj.part, [C, O], uj.axes[0])):
+        mates = [C, O] + ([o for o in uj.host.bodies if o not in (C, O)] if getattr(uj, "host", None) else [])
+        # compound junction: C turns in its hinge's stack, held there by the joint and the stack
+        hold = [uj.part] + [o for o in mates if o not in (C, O)]
+        for who, partners, d in ((C, hold, uj.axes[0]), (O, [uj.part], uj.axes[1]),
+                                 (uj.part, mates, uj.axes[0])):
             tests.append((who, partners, d, uj.name, uj.center, np.eye(3), [2 * half] * 3))
     fails = []
     n = 0
