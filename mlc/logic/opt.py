@@ -354,7 +354,7 @@ def resub_odc(g: AIG, care_out: list[int] | None = None, max_new: int = 2,
     return g
 
 
-def resub_window(g: AIG, max_leaves: int = 10, max_new: int = 2, max_window: int = 150,
+def resub_window(g: AIG, max_leaves: int | None = None, max_new: int = 2, max_window: int | None = None,
                  deadline: float | None = None) -> AIG:
     """Resubstitution for networks too wide for global tables: each node gets a
     window (a reconvergence-driven cut and the nodes computable from it), and its
@@ -362,6 +362,11 @@ def resub_window(g: AIG, max_leaves: int = 10, max_new: int = 2, max_window: int
     n = g.num_inputs
     if not g.ands:
         return g
+    if max_leaves is None:
+        max_leaves = WINDOW_LEAVES
+    if max_window is None:
+        max_window = WINDOW_SIZE
+    tick = WIDE_TICK if n > TT_LIMIT else 1.0
     refs = refcounts(g)
     fanouts: list[list[int]] = [[] for _ in range(g.num_nodes)]
     for k, (a, b) in enumerate(g.ands):
@@ -373,7 +378,7 @@ def resub_window(g: AIG, max_leaves: int = 10, max_new: int = 2, max_window: int
     repl: dict[int, tuple] = {}
     virt = _Virtual(g)
     for x in range(n + 1, g.num_nodes):
-        if deadline is not None and work.now(g.num_nodes) > deadline:
+        if deadline is not None and work.now(g.num_nodes, tick) > deadline:
             break
         if touched[x] or refs[x] == 0:
             continue
@@ -571,6 +576,18 @@ def _place_class_circuit(g: AIG, ent: dict, lits: list, out: int, incone: set[in
 CUT_LIMIT = 10
 STRUCT_VARIANTS = True
 ROUNDS_BIG = 30
+# resub_window in the plain rounds of wide networks: 12-leaf cuts, windows of up to
+# 300 nodes (was 10 and 150; with WIDE_TICK, EPFL i2c 1105 -> 1052, max 2860 -> 2795,
+# priority 423 -> 414, router 159 -> 157); the zero-gain rounds keep 10 and 150
+WINDOW_LEAVES = 12
+WINDOW_SIZE = 300
+WINDOW_LEAVES_Z = 10
+WINDOW_SIZE_Z = 150
+# work-clock tick of resub_window and rewrite on wide networks (> TT_LIMIT inputs):
+# their real cost per node visited is 0.15-0.22 of the usual tick on EPFL sin (0.78 s
+# and 1.1 s CPU for 5.1 and 5.0 virtual s), so the budget stopped them after one
+# round; at 0.25 sin gets 5149 -> 5089 ANDs (and takes 8 -> 19 s CPU)
+WIDE_TICK = 0.25
 STALE_BIG = 4
 
 
@@ -584,11 +601,12 @@ def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> A
     refs = refcounts(g)
     cuts = enumerate_cuts(g, limit=CUT_LIMIT)
     lev = g.levels()
+    tick = WIDE_TICK if n > TT_LIMIT else 1.0
     touched = bytearray(g.num_nodes)
     repl: dict[int, tuple] = {}
     virt = _Virtual(g)
     for x in range(n + 1, g.num_nodes):
-        if deadline is not None and work.now(g.num_nodes) > deadline:
+        if deadline is not None and work.now(g.num_nodes, tick) > deadline:
             break
         if touched[x] or refs[x] == 0:
             continue
@@ -1111,7 +1129,8 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
                 # compress2rs-like: zero-gain restructuring over wider cuts opens
                 # moves for the next round (router 242 -> 231)
                 cur = refactor(cur, max_leaves=10, zero_gain=True, deadline=deadline)
-                cur = resub_window(cur, max_new=2, deadline=deadline)
+                cur = resub_window(cur, max_leaves=WINDOW_LEAVES_Z, max_window=WINDOW_SIZE_Z,
+                                   max_new=2, deadline=deadline)
                 cur = rewrite(cur, zero_gain=True, deadline=deadline)
         b = balance(cur)
         if cost(b) <= cost(cur):

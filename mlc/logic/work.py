@@ -25,8 +25,9 @@ def reset() -> None:
     _ticks = 0
 
 
-def now(nodes: int = 0) -> float:
-    """Advance the clock by one check on a network of ``nodes`` nodes; virtual seconds."""
+def now(nodes: int = 0, weight: float = 1.0) -> float:
+    """Advance the clock by one check on a network of ``nodes`` nodes (``weight`` times
+    the usual tick, for a pass whose work per check is known to differ); virtual seconds."""
     global _ticks
-    _ticks += int(round(TICK_US * math.sqrt(1.0 + nodes / 256.0)))
+    _ticks += int(round(TICK_US * weight * math.sqrt(1.0 + nodes / 256.0)))
     return _ticks * 1e-6
