@@ -205,6 +205,7 @@ class UJoint:
     hub_r: float = 0.0        # compound junction: radius of the ball hub and of its collar
     collar: float = 0.0       # compound junction: the collar runs from -collar to 0 along u (mm)
     fin: float = 0.0          # compound junction: O's yoke fin runs from 0 to fin along u (0: a plain plate)
+    o_axis: HingeAxis | None = None  # compound junction: O's own hinge on the same line (re-laid), if any
 
 
 @dataclass
@@ -264,8 +265,6 @@ class Assembly:
             F0 = _ortho(u.axes[0], u.axes[1])
             # the hub sits where the two bodies' copies of the joint point are (their mean)
             c = 0.5 * (Tc[:3, :3] @ u.center + Tc[:3, 3] + To[:3, :3] @ u.center + To[:3, 3])
-            if u.host is not None:      # compound junction: its pin runs through C's hinge
-                c = Tc[:3, :3] @ u.center + Tc[:3, 3]
             T = np.eye(4)
             T[:3, :3] = F1 @ F0.T
             T[:3, 3] = c - T[:3, :3] @ u.center
@@ -439,7 +438,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         for side_b, other_b in ((cb, ob), (ob, cb)):
             hx = _host_axis(side_b, axes, center, s, g)
             if hx is not None:
-                compound = _compound(hx, center, other_b, axes, s, prof, R, r_pin, kmin)
+                compound = _compound(hx, center, side_b, other_b, axes, s, prof, R, r_pin, kmin)
                 if compound is not None:
                     cb, ob = side_b, other_b
                     break
@@ -460,11 +459,11 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         best = None
         mode_list = (("both", "both"), ("+", "both"), ("-", "both"), ("both", "+"), ("both", "-"))
         if compound is not None:
-            mode_list = (("host", "both"), ("host", "+"), ("host", "-"))
+            mode_list = (("host", "both"),)
             hub = compound["hub_v"]
         for modes in mode_list:
             if compound is not None:
-                lays = (compound["layout"], _yoke_layout(modes[1], hub, g, ky, cap, W[1], s))
+                lays = (compound["layout_c"], _yoke_layout(modes[1], hub, g, ky, cap, W[1], s))
             else:
                 lays = tuple(_yoke_layout(m, hub, g, ky, cap, W[i], s) for i, m in enumerate(modes))
             part_name = jname if jname not in bodies else f"joint_{jname}"
@@ -474,6 +473,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                 uj.host, uj.hub_r, uj.collar = compound["axis"], compound["hub_r"], compound["collar"]
                 if np.isfinite(compound["dO"]):
                     uj.fin = compound["dO"] + t
+                    uj.o_axis = compound["o_axis"]
             if best is not None and not (uj.rho[0] + uj.rho[1], modes != ("both", "both")) < best[0]:
                 continue     # its trim radii are at least these: it cannot beat the best layout
             smp = {bn: base_samples[bn] for bn in uj.bodies}
@@ -526,6 +526,14 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     #    outside the radius inside which only the knuckle's own body has material
     for ax in axes:
         ax.rho = _trim_radius_memo(memo, ax, samples, state_T, t, c, h, s, notes, slabs)
+    for uj in ujoints:
+        # compound junction: the other body's own hinge on the line is re-laid so that body
+        # holds the end knuckles; the bodies between them clear its yoke fin (which reaches
+        # into the end knuckle) in every turn about the axis
+        ox = uj.o_axis
+        if ox is not None and uj.fin > 0:
+            half = max(abs(x) for x in uj.layouts[1].plate)
+            ox.rho = max(ox.rho, float(np.hypot(half, t / 2)) + c)
     if memo is not None:
         _share_hinge_radii(axes, samples, slabs)
 
@@ -570,7 +578,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                 cuts.append(cylinder(uj.center, uj.axes[side], a0, a1, uj.rho[side], n, cutter=True))
         for uj in ujoints:      # compound junction: the other bodies of its hinge clear the yoke too
             if uj.host is not None and bn in uj.host.bodies and bn not in uj.bodies:
-                cuts.append(cylinder(uj.center, uj.axes[0], *uj.layouts[0].cut, uj.rho[0], n, cutter=True))
+                cuts.append(cylinder(uj.center, uj.axes[0], -(R + c), R + c, uj.rho[0], n, cutter=True))
         cut_solid = _clean(subtract(solid, cuts))
         if len(cut_solid.decompose()) > len(_clean(solid).decompose()):
             # a slab running along an axis is severed by the clearance around another body's
@@ -1037,7 +1045,7 @@ def _host_axis(bn, axes, center, s, g):
     return None
 
 
-def _compound(ax: HingeAxis, center, other, axes, s, prof, R, r_pin, kmin):
+def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, kmin):
     """A compound junction on hinge axis ``ax``: the universal joint part holds the pin of the
     whole knuckle stack and has one knuckle in it (next to the end knuckle of the pin owner,
     on the joint's side, so the stack is captive), a ball hub at the joint point with a collar
@@ -1088,9 +1096,10 @@ def _compound(ax: HingeAxis, center, other, axes, s, prof, R, r_pin, kmin):
             v0 = max(v0, R + float(np.sqrt(c * c - max(0.0, dd - R) ** 2)))
     u = ax.direction * sg
     lay = YokeLayout("host", [], [], (-(d0 + S), 0.0), (-(R + c), R + c), (0.0, 0.0), reach=max(d0 - g, hub_r))
+    lay_c = lay
     return {"axis": ax, "u": u.copy(), "span": S, "k": k, "intervals": intervals, "stack": stack,
             "joint_iv": joint_iv, "hub_r": hub_r, "collar": d0 - g, "hub_v": 2 * (v0 - g), "layout": lay,
-            "o_axis": o_axis, "dO": dO}
+            "o_axis": o_axis, "dO": dO, "layout_c": lay_c}
 
 
 def _own_ends(ax: HingeAxis, bn: str) -> None:

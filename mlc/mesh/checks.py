@@ -30,7 +30,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from mlc.mesh.build import Assembly, _perp_frame, box, transform_solid, union
+from mlc.mesh.build import Assembly, _log, _perp_frame, box, transform_solid, union
 
 #: checks reported but not (yet) failing an export: the library gates do not meet them (issue 13)
 NON_BLOCKING = ("wall_thickness", "bed_contact", "supports")
@@ -148,6 +148,7 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
     checks.append(Check("watertight", not bad, len(parts) - len(bad), len(parts),
                         f"{len(parts) - len(bad)}/{len(parts)} parts closed with positive volume", bad))
 
+    _log("check watertight done")
     # -- part count --------------------------------------------------------------
     expected = len(asm.scene.bodies) + len(asm.ujoints)
     split = [f"{i['name']} is in {i['pieces']} pieces" for i in info if i["pieces"] != 1]
@@ -155,6 +156,7 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
                         f"{pieces} pieces printed, expected {len(asm.scene.bodies)} bodies + "
                         f"{len(asm.ujoints)} joint parts = {expected}", split))
 
+    _log("check part count done")
     # -- min gap at rest -------------------------------------------------------------
     boxes = [_bbox(p.solid) for p in parts]
     cong = getattr(asm, "congruence", None)
@@ -179,6 +181,7 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
               else f"no two parts within {2 * c:g} mm")
     checks.append(Check("min_gap", not fails, gval, c, detail, fails))
 
+    _log("check min_gap done")
     # -- logic states --------------------------------------------------------------------
     if poses:
         from mlc.mesh.spatial import box_pairs, local_boxes, obb_overlap, part_frames, posed_boxes
@@ -224,9 +227,11 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
                             "no equilibrium poses: the logic states were not checked",
                             ["static verification gave no poses (use --force to export unchecked)"]))
 
+    _log("check states done")
     # -- retention ---------------------------------------------------------------------------
     checks.append(_retention(asm))
 
+    _log("check retention done")
     # -- features ------------------------------------------------------------------------------
     small = [f"{what}: {val:.3g} mm < {lim:g} mm" for what, val, lim in asm.features if val < lim - 1e-9]
     checks.append(Check("features", not small, len(asm.features) - len(small), len(asm.features),
@@ -235,7 +240,9 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
 
     if walls:
         checks.append(wall_check(asm))
+        _log("check wall_thickness done")
     checks += bed_checks(asm)
+    _log("check bed_contact, supports done")
 
     rep = Report(asm.scene.name, prof.to_dict(), info, checks, list(asm.notes))
     rep.size_mm = print_size(asm)
@@ -345,7 +352,7 @@ def _retention(asm: Assembly) -> Check:
                           ax.name, ax.origin, F, size))
     for uj in asm.ujoints:
         C, O = uj.bodies
-        half = max(lay.extent for lay in uj.layouts) + uj.R + 3 * c
+        half = max(max(lay.extent, abs(lay.pin[0]), abs(lay.pin[1])) for lay in uj.layouts) + uj.R + 3 * c
         mates = [C, O] + ([o for o in uj.host.bodies if o not in (C, O)] if getattr(uj, "host", None) else [])
         # compound junction: C turns in its hinge's stack, held there by the joint and the stack
         hold = [uj.part] + [o for o in mates if o not in (C, O)]
