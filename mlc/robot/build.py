@@ -65,6 +65,7 @@ STOP_R_UNDER = 1.2                 # sigma: the under-turn stop's sites
 STOP_UNDER_LOW = math.radians(52.5)  # rad: the under-turn stop's arms this far apart at its lower limit
 STOP_K = 4.0                       # k0: the stops' stiffness once engaged (a wire joint's is 1)
 LEVER_STOP = 0.35                  # sigma: a chain's first posts stop this short of a gate lever's joints (as in circuits)
+SLACK_FRACTION = 0.0               # >0: a chain spans at most this fraction of its length in any row (2.4; 0.6 tried: no faster)
 CHAIN_STOPS = True                 # junction stops in the coupling chains (docs/robot.md 2.2, 3.3)
 
 
@@ -357,6 +358,27 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
             from mlc.geometry.rotation import quat_to_matrix
             b.position = O + Rz @ (b.position - O)
             b.orientation = matrix_to_quat(Rz @ quat_to_matrix(b.orientation))
+    # ---- where each DOF's lever pair goes in every row (the body held still) ----------------
+    def row_transforms(bits: str) -> dict:
+        """Rigid motion (R, t) of each skeleton body from the built pose to row ``bits``'s
+        target pose, the body unit held still (docs/robot.md 2.4)."""
+        by = {b.name: b for b in bodies}
+        tr = {n: (np.eye(3), np.zeros(3)) for n in order}
+        for dm in dofs_meta:
+            out = dm["output"]
+            on = dm.get("value", 0) if dm["coupling"] == "lock" else (int(bits[outs.index(out)]) if out else 0)
+            on0 = dm.get("value", 0) if dm["coupling"] == "lock" else (int(bits0[outs.index(out)]) if out else 0)
+            if on == on0:
+                continue
+            R0, t0_ = tr[dm["bodies"][0]]
+            O = R0 @ by[dm["bodies"][0]].world(f"h_{dm['name']}_0") + t0_
+            ang = (math.pi / 2 if dm["side"] == "up" else -math.pi / 2) * (on - on0)
+            Rz = _rotz(ang)
+            for nm in order[order.index(dm["bodies"][1]):]:
+                R, t_ = tr[nm]
+                tr[nm] = (Rz @ R, Rz @ (t_ - O) + O)
+        return tr
+    row_tr = [row_transforms(bits) for bits in table.values() if len(bits) == len(outs)] if table else []
     # ---- couplings: a chain from each output pair to its DOF's lever sites ---------------
     parts_bodies, parts_bonds = [], []
     n_chains = n_half = 0
@@ -375,6 +397,14 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
         tc, tax = 0.5 * (ta + tb), (tb - ta) / np.linalg.norm(tb - ta)
         t0v = _pair_tangent(circuit, pr.a, pr.b, start.centre, start.axis)
         sstate = int(bits0[outs.index(ds.output)])
+        # slack (docs/robot.md 2.4): the chain's contour length is at least the farthest
+        # start-to-end distance over the rows' poses divided by SLACK_FRACTION
+        b_lo, b_hi = target.lo.split(".")[0], target.hi.split(".")[0]
+        d_rows = [float(np.linalg.norm(0.5 * (tr[b_lo][0] @ ta + tr[b_lo][1] + tr[b_hi][0] @ tb + tr[b_hi][1])
+                                       - start.centre)) for tr in row_tr] or [float(np.linalg.norm(tc - start.centre))]
+        need = max(d_rows) / SLACK_FRACTION if SLACK_FRACTION else 0.0
+        min_half = max(2, int(math.ceil(need / geo.pitch)))
+        min_half += min_half % 2                       # even: the chain arrives with the output's state
         wps = []
         if start.centre[2] < hi_c[2] - 3.0:          # an output inside the circuit: out at the back, then up
             yb = float(hi_c[1]) + BACK
@@ -394,7 +424,7 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
             tv = expmap(start.axis * math.radians(fan)) @ t0v
             for wp in (wps, []):
                 route = solve_route(start.centre, start.axis, tc, tax, geo, 0, waypoints=wp, tangent=tv,
-                                    free_start=fan == 0, approach=ez)
+                                    free_start=fan == 0, approach=ez, min_half=min_half)
                 if route is not None:
                     break
             if route is None:
@@ -431,7 +461,8 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
         n_chains += 1
         n_half += len(route.bends)
         next(d for d in dofs_meta if d["name"] == name)["chain"] = {
-            "half_units": len(route.bends), "prefix": tag, "route_seconds": round(time.perf_counter() - tr, 2)}
+            "half_units": len(route.bends), "prefix": tag, "route_seconds": round(time.perf_counter() - tr, 2),
+            "reach_max": round(max(d_rows), 3), "reach_fraction": round(max(d_rows) / (len(route.bends) * geo.pitch), 3)}
     rmeta = spec.as_dict()
     rmeta.update({"origin": [float(v) for v in origin], "plane_normal": [0.0, 0.0, 1.0], "x_axis": [1.0, 0, 0],
                   "joint_length": s, "links": [f"skel_u{i}" for i in range(spec.units + 1)],
