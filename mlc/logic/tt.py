@@ -32,10 +32,15 @@ def var(n: int, i: int) -> int:
     return t
 
 
+@lru_cache(maxsize=None)
+def nvar(n: int, i: int) -> int:
+    """Truth table of the complement of variable ``i`` over ``n`` variables."""
+    return mask(n) & ~var(n, i)
+
+
 def cof0(t: int, n: int, i: int) -> int:
     """Negative cofactor w.r.t. variable ``i``, as a full-width table independent of ``i``."""
-    x = var(n, i)
-    lo = t & ~x & mask(n)
+    lo = t & nvar(n, i)
     return lo | (lo << (1 << i))
 
 
@@ -47,9 +52,7 @@ def cof1(t: int, n: int, i: int) -> int:
 
 
 def depends(t: int, n: int, i: int) -> bool:
-    x = var(n, i)
-    s = 1 << i
-    return ((t & x) >> s) != (t & ~x & mask(n))
+    return ((t & var(n, i)) >> (1 << i)) != (t & nvar(n, i))
 
 
 def support(t: int, n: int) -> list[int]:
