@@ -675,13 +675,16 @@ def reconv_cut(g: AIG, x: int, max_leaves: int) -> list[int]:
     leaves = {a >> 1, b >> 1}
     leaves.discard(0)
     inside = {x}
+    ands = g.ands
     while True:
         best, bcost = None, None
         for y in leaves:
             if y <= n:
                 continue
-            fa, fb = g.ands[y - n - 1]
-            c = sum(1 for z in (fa >> 1, fb >> 1) if z not in leaves and z not in inside and z) - 1
+            fa, fb = ands[y - n - 1]
+            za, zb = fa >> 1, fb >> 1
+            c = ((za != 0 and za not in leaves and za not in inside)
+                 + (zb != 0 and zb not in leaves and zb not in inside) - 1)
             if bcost is None or c < bcost or (c == bcost and y > best):
                 best, bcost = y, c
         if best is None or len(leaves) + bcost > max_leaves:
