@@ -517,26 +517,30 @@ def _find_resub(f: int, care: int, full: int, divs: list[int], vals: list[int], 
 def enumerate_cuts(g: AIG, k: int = 4, limit: int = 10) -> list[list[tuple[int, ...]]]:
     n = g.num_inputs
     cuts: list[list[tuple[int, ...]]] = [[()]] + [[(i,)] for i in range(1, n + 1)]
+    sets: list[list[frozenset]] = [[frozenset()]] + [[frozenset((i,))] for i in range(1, n + 1)]
     for idx, (a, b) in enumerate(g.ands):
         x = n + 1 + idx
-        ca, cb = cuts[a >> 1], cuts[b >> 1]
+        ca, cb = sets[a >> 1], sets[b >> 1]
         res = set()
         for c1 in ca:
             for c2 in cb:
-                u = tuple(sorted(set(c1) | set(c2)))
+                u = c1 | c2
                 if len(u) <= k:
                     res.add(u)
-        lst = sorted(res, key=lambda c: (len(c), c))
+        lst = sorted((tuple(sorted(u)) for u in res), key=lambda c: (len(c), c))
         # drop dominated cuts (supersets of another cut)
         kept: list[tuple[int, ...]] = []
+        kept_s: list[frozenset] = []
         for c in lst:
-            sc = set(c)
-            if any(set(d) <= sc for d in kept):
+            sc = frozenset(c)
+            if any(d <= sc for d in kept_s):
                 continue
             kept.append(c)
+            kept_s.append(sc)
             if len(kept) >= limit:
                 break
         cuts.append(kept + [(x,)])
+        sets.append(kept_s + [frozenset((x,))])
     return cuts
 
 
