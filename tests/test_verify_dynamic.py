@@ -177,9 +177,13 @@ def test_a_large_scene_uses_the_signal_time(monkeypatch):
     def boom(*a, **k):
         raise AssertionError("relaxation_time called")
     monkeypatch.setattr(dyn, "relaxation_time", boom)
-    row = dyn.check_scene_dynamic_multi(sc, 1e-5, [0], rows=["1"], progress=False)[0]
+    rest, row = dyn.check_scene_dynamic_multi(sc, 1e-5, [0], progress=False)
     assert row["ok"] and row["tau"] == pytest.approx(signal_time(sc, "0", "1"), rel=0.2)
     assert row["relax_time"] >= 3 * signal_time(sc, "0", "1")
+    # the rest row has no switch: it is held to the slowest row's time, and relaxes
+    assert rest["state"] == "0" and rest["ok"] and rest["tau"] == pytest.approx(signal_time(sc, "0", "1"))
+    only_rest = dyn.check_scene_dynamic_multi(sc, 1e-5, [0], rows=["0"], progress=False)[0]
+    assert only_rest["ok"] and only_rest["tau"] == rest["tau"]
     given = dyn.check_scene_dynamic_multi(sc, 1e-5, [0], rows=["1"], progress=False, tau=0.5, dt=0.02)[0]
     assert given["ok"] and given["tau"] == 0.5
 

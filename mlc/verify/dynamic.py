@@ -342,8 +342,9 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
     large = 6 * len(scene.bodies) > DENSE_MAX      # a circuit: signal_time, not the spectrum
     if tau_given:
         tau = float(tau)
-    elif large:
-        tau = max([signal_time(scene, "0" * len(scene.inputs), s, gamma_r=opt0.gamma_r) for s in states] + [0.0])
+    elif large:   # the rest row has no switch of its own: its floor is the slowest of all rows
+        rows_t = select_rows(scene) if "0" * len(scene.inputs) in states else states
+        tau = max([signal_time(scene, "0" * len(scene.inputs), s, gamma_r=opt0.gamma_r) for s in rows_t] + [0.0])
     else:
         tau = relaxation_time(scene, gamma_r=opt0.gamma_r)
     max_time_given = max_time is not None
@@ -366,6 +367,8 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
                 eq = equilibrium(scene, state)
                 sd = probe_thermal_sd(scene, kT, eq.pos, eq.quat)
                 if tau_given:
+                    tau_row = tau
+                elif large and state == rest:     # no switch: the probes' correlation time
                     tau_row = tau
                 elif large:
                     tau_row = max(signal_time(scene, rest, state, gamma_r=opt0.gamma_r),
