@@ -229,6 +229,9 @@ class Assembly:
     poses: dict | None = None  # state -> (pos (N,3), quat (N,4)) in sigma, as given to build()
     orient: np.ndarray = field(default_factory=lambda: np.eye(4))  # world -> print frame (mm)
     congruence: Congruence | None = None   # shape keys and cached exact results (large assemblies)
+    # large assemblies: each part's joint material (knuckles less their holes, pins, rings): a
+    # subset of the finished part (no trim takes from it), for the retention check's first test
+    cores: dict = field(default_factory=dict)
 
     def part(self, name: str) -> Part:
         for p in self.parts:
@@ -559,6 +562,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
 
     # -- assemble body solids ----------------------------------------------------------
     parts: list[Part] = []
+    cores: dict[str, mf.Manifold] = {}
     protected: dict[str, mf.Manifold] = {}
     soft: dict[str, mf.Manifold] = {}
     fat_guard: dict[str, tuple] = {}     # reuse only: (hard, soft or None) guards grown by GUARD_PAD
@@ -645,6 +649,8 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                 for ax in my_axes if ax.pin_owner == bn and not cones]
         solid = _clean(union([solid] + pins))
         protected[bn] = union(keep + pins + rings)
+        if reuse:
+            cores[bn] = union([subtract(union(keep + rings), holes)] + pins)
         solid = _drop_scraps(solid, protected[bn], bn, notes)
         # the spot where the attachment hole would go (0.85 mm in from the site), kept if possible
         spots = [cylinder(_spot(x[4], x[0], lug_out), x[1], -t, t, lug_out + c, n) for x in lugs[bn] if not x[2]]
@@ -692,6 +698,8 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         notes.append("pin: cone pins on the hinges; the universal joint keeps straight pins in its yokes")
 
     asm = Assembly(scene, prof, parts, axes, ujoints, notes, features, t, poses)
+    if reuse:
+        asm.cores = dict(cores, **{uj.part: asm.part(uj.part).solid for uj in ujoints})
     if reuse:
         asm.congruence = Congruence(_congruence_frames(asm, slabs))
     _log(f"{len(parts)} parts built ({sum(p.solid.num_vert() for p in parts)} vertices)")
