@@ -63,6 +63,27 @@ def test_every_row_verifies_statically_and_reports_clearance(tetris):
     assert tetris[2].scene.meta["connector"]["tight_chains"] == []
 
 
+def test_static_check_reports_the_thermal_spread(tetris):
+    """Each probe's harmonic thermal spread at kT (mlc.verify.dynamic.probe_thermal_sd, checked
+    against the integrator in test_verify_dynamic): a row is thermal_ok when every margin is
+    at least 3 spreads; failing that is a warning, not a wrong bit."""
+    from mlc.verify.circuit import THERMAL_SDS
+
+    rep = verify_static(tetris[2].scene, rows=["01"], clearance=False)
+    sds = [e["thermal_sd"] for e in rep.entries]
+    assert all(0 <= v < 0.25 for v in sds) and max(sds) > 0
+    assert min(sds) == 0.0                    # the constant outputs: both probe ends on one body
+    hot = verify_static(tetris[2].scene, rows=["01"], clearance=False, kT=1e-2)
+    for a, b in zip(rep.entries, hot.entries):  # the harmonic spread grows as sqrt(kT)
+        assert b["thermal_sd"] == pytest.approx(a["thermal_sd"] * 1000 ** 0.5, rel=1e-6)
+    for r in (rep, hot):
+        want = all(e["margin"] >= THERMAL_SDS * e["thermal_sd"] for e in r.entries)
+        assert r.ok and r.rows[0]["thermal_ok"] == want
+        assert ("WARNING: thermal spread" in format_report(r)) == (not want)
+    assert not hot.rows[0]["thermal_ok"] and "past the threshold" in format_report(hot)
+    assert "thermal_sd" not in verify_static(tetris[2].scene, rows=["01"], clearance=False, kT=None).entries[0]
+
+
 def test_a_swapped_gate_is_caught(tetris):
     spec, c, _ = tetris
     nl = copy.deepcopy(c.netlist)

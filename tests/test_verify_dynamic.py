@@ -88,6 +88,13 @@ def test_a_zero_mode_probe_has_no_finite_spread():
     assert probe_thermal_sd(chain_scene(1, "expand"), 1e-5)["out"] < 0.05
 
 
+def test_a_probe_on_one_body_has_no_spread():
+    sc = _points(2, 1.0)
+    sc.bodies[0].sites["e"] = np.array([0.05, 0.0, 0.0])
+    sc.probes[0].b = "b0.e"
+    assert probe_thermal_sd(sc.check(), 1e-5)["out"] == 0.0
+
+
 def test_two_input_gate_every_row_and_seed():
     sc = gate_scene("NAND", "expand")
     seen = []

@@ -16,7 +16,9 @@ def register(sub):
                                    "length and margin (sigma); exit 1 on a wrong bit. Units: sigma, k0, t0.")
     p.add_argument("scene", metavar="SCENE", help="scene file (.yaml), e.g. OUT/circuit.yaml from mlc compile")
     p.add_argument("--dynamic", action="store_true", help="Brownian dynamics instead of statics")
-    p.add_argument("--kT", type=float, default=1e-5, help="thermal energy for --dynamic (k0 sigma^2, default 1e-5)")
+    p.add_argument("--kT", type=float, default=1e-5,
+                   help="thermal energy (k0 sigma^2, default 1e-5): the Brownian dynamics' (--dynamic), or the one "
+                        "the static check's thermal spread of every probe is computed at (0: skip that)")
     p.add_argument("--seeds", type=int, default=3, help="seeds per row for --dynamic (default 3)")
     p.add_argument("--scheme", choices=("stiff", "euler"), default="stiff", help="integrator for --dynamic")
     p.add_argument("--tau", type=float, metavar="T",
@@ -49,7 +51,7 @@ def verify_scene_file(scene, dynamic: bool = False, kT: float = 1e-5, seeds: int
         return verify_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme, tau=tau, dt=dt)
     with Progress(f"static verification of {scene.name}", total=n) as bar:
         return verify_static(scene, rows, progress=lambda done, total: bar.update(done),
-                             require_clearance=require_clearance)
+                             require_clearance=require_clearance, kT=kT)
 
 
 def run(args) -> int:
@@ -57,7 +59,7 @@ def run(args) -> int:
     from mlc.scene.io import load_scene
     from mlc.verify.circuit import format_report
 
-    if args.dynamic and not (args.kT >= 0 and args.kT < float("inf")):
+    if not (args.kT >= 0 and args.kT < float("inf")):
         raise MlcError(f"kT must be finite and >= 0, got {args.kT}", "--kT")
     if args.dynamic and not 1 <= args.seeds <= MAX_SEEDS:
         raise MlcError(f"--seeds must be between 1 and {MAX_SEEDS}, got {args.seeds} (each seed of each row is a "

@@ -18,6 +18,7 @@ Units: sigma, k0, t0.
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 
@@ -26,6 +27,7 @@ from mlc.scene.model import Scene
 
 TOL_LENGTH = 0.05       # sigma: a read length must be this close to its ideal (static)
 TOL_STRETCH = 1e-3      # sigma: largest joint stretch allowed in a row's equilibrium
+THERMAL_SDS = 3.0       # a bit is read reliably at kT when its margin is at least this many thermal spreads
 
 
 @dataclass
@@ -71,19 +73,30 @@ def select_rows(scene: Scene, rows=None) -> list[str]:
 
 
 def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_stretch: float = TOL_STRETCH,
-                  clearance: bool = True, progress=None, require_clearance: bool = False) -> Report:
+                  clearance: bool = True, progress=None, require_clearance: bool = False,
+                  kT: float | None = 1e-5) -> Report:
+    """Static check of every row in ``rows`` (default all), see the module docstring.  With
+    ``kT`` (k0 sigma^2; None: skipped) each entry also gets ``thermal_sd``, the probe's
+    harmonic thermal spread in that row's equilibrium (sigma,
+    :func:`mlc.verify.dynamic.probe_thermal_sd`), and each row ``thermal_ok``: every
+    expected bit read with a margin of at least ``THERMAL_SDS`` spreads.  Like clearance it
+    is its own verdict and a warning: a row that fails it computes right at rest but not
+    reliably at ``kT`` (docs/circuits.md, "Thermal spread")."""
+    from mlc.verify.dynamic import probe_thermal_sd
     from mlc.verify.overlap import clearance as clear
     from mlc.verify.static import equilibrium
 
     states = select_rows(scene, rows)
     t0 = time.perf_counter()
     rep = Report(scene.name, "static", params={"tol_length": tol_length, "tol_stretch": tol_stretch,
-                                               "require_clearance": require_clearance})
+                                               "require_clearance": require_clearance, "kT": kT})
     for i, state in enumerate(states):
         t_row = time.perf_counter()
         eq = equilibrium(scene, state)
         want = scene.truth_table.get(state)
         row_ok = eq.max_joint_stretch <= tol_stretch
+        sd = probe_thermal_sd(scene, kT, eq.pos, eq.quat) if kT is not None and kT > 0 else {}
+        thermal_ok = True
         for pr in scene.probes:
             k = scene.outputs.index(pr.output)
             bit = None if want is None or want[k] == "-" else int(want[k])
@@ -91,10 +104,18 @@ def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_s
             ideal = None if bit is None else (pr.actuated if bit else pr.rest)
             ok = bit is None or (pr.bit(L) == bit and abs(L - ideal) <= tol_length)
             row_ok &= ok
-            rep.entries.append({"state": state, "output": pr.output, "expected": bit, "measured": L,
-                                "bit": pr.bit(L), "margin": None if bit is None else float(pr.margin(L, bit)),
-                                "error": None if ideal is None else float(abs(L - ideal)), "ok": bool(ok)})
+            margin = None if bit is None else float(pr.margin(L, bit))
+            entry = {"state": state, "output": pr.output, "expected": bit, "measured": L,
+                     "bit": pr.bit(L), "margin": margin,
+                     "error": None if ideal is None else float(abs(L - ideal)), "ok": bool(ok)}
+            if pr.name in sd:
+                entry["thermal_sd"] = float(sd[pr.name])
+                if margin is not None and not margin >= THERMAL_SDS * sd[pr.name]:
+                    thermal_ok = False
+            rep.entries.append(entry)
         row = {"state": state, "joint_stretch": eq.max_joint_stretch, "seconds": 0.0}
+        if sd:
+            row["thermal_ok"] = thermal_ok
         if clearance:
             c = clear(scene, eq.pos, eq.quat)
             row["clearance"] = c.min_clearance
@@ -179,6 +200,19 @@ def format_report(rep: Report) -> str:
             if rep.mode == "static" and r["joint_stretch"] > rep.params.get("tol_stretch", TOL_STRETCH):
                 lines.append(f"WRONG: row {r['state']}: joint stretch {r['joint_stretch']:.2e} sigma "
                              f"(bound {rep.params.get('tol_stretch', TOL_STRETCH)})")
+    thermal = [e for e in rep.entries if e.get("thermal_sd") is not None and e["margin"] is not None
+               and not e["margin"] >= THERMAL_SDS * e["thermal_sd"]]
+    if thermal:
+        w = min(thermal, key=lambda e: e["margin"] / e["thermal_sd"] if e["thermal_sd"] > 0 else -1.0)
+        rows_t = sorted({e["state"] for e in thermal})
+        z = w["margin"] / w["thermal_sd"] if w["thermal_sd"] > 0 else 0.0
+        past = 100.0 * 0.5 * math.erfc(z / math.sqrt(2.0))
+        lines.append(f"WARNING: thermal spread at kT {rep.params.get('kT')}: row {w['state']}, output {w['output']} "
+                     f"fluctuates by {w['thermal_sd']:.3f} sigma (harmonic) against a margin of {w['margin']:.3f} "
+                     f"sigma (less than {THERMAL_SDS:g} spreads, in {len(rows_t)} of {len(rep.rows)} rows): its "
+                     f"instantaneous length is past the threshold about {past:.2g} % of the time, though a "
+                     f"time average reads right; shorter chains or stiffer connector joints narrow it "
+                     f"(docs/circuits.md, 'Thermal spread')")
     for r in rep.rows:
         if rep.mode == "static" and r.get("overlaps"):
             a, b, d = r["overlaps"][0]

@@ -207,6 +207,9 @@ def probe_thermal_sd(scene, kT: float, pos=None, quat=None) -> dict:
         # (g . y = sum c^2/(lambda + eps); eps |y|^2 is about eps/lambda of it for the stiff
         # modes, and about all of it for a zero mode)
         gy = float(g @ y)
+        if float(np.linalg.norm(g)) < 1e-9:  # both ends on one body: rigid, no spread
+            out[pr.name] = 0.0
+            continue
         out[pr.name] = float(np.sqrt(kT * gy)) if eps * float(y @ y) < 0.1 * gy else float("inf")
     return out
 
