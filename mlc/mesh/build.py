@@ -232,6 +232,7 @@ class Assembly:
     # large assemblies: each part's joint material (knuckles less their holes, pins, rings): a
     # subset of the finished part (no trim takes from it), for the retention check's first test
     cores: dict = field(default_factory=dict)
+    axis_cores: dict = field(default_factory=dict)   # compound junction's joint part: its stack knuckle and pin
 
     def part(self, name: str) -> Part:
         for p in self.parts:
@@ -700,6 +701,9 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     asm = Assembly(scene, prof, parts, axes, ujoints, notes, features, t, poses)
     if reuse:
         asm.cores = dict(cores, **{uj.part: asm.part(uj.part).solid for uj in ujoints})
+        asm.axis_cores = {uj.part: union([cylinder(uj.host.origin, uj.host.direction, *uj.host.joint_iv, R, n),
+                                          cylinder(uj.center, uj.axes[0], *uj.layouts[0].pin, r_pin, n)])
+                          for uj in ujoints if uj.host is not None}
     if reuse:
         asm.congruence = Congruence(_congruence_frames(asm, slabs))
     _log(f"{len(parts)} parts built ({sum(p.solid.num_vert() for p in parts)} vertices)")

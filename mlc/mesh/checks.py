@@ -376,6 +376,8 @@ def _retention(asm: Assembly) -> Check:
         for bn in ax.bodies:
             tests.append((bn, [o for o in ax.bodies if o != bn] + ([ax.joint] if ax.joint else []), ax.direction,
                           ax.name, ax.origin, F, size))
+        if ax.joint:      # compound junction: the joint part holds this stack's pin, held by its knuckles
+            tests.append((ax.joint, list(ax.bodies), ax.direction, ax.name, ax.origin, F, size))
     for uj in asm.ujoints:
         C, O = uj.bodies
         half = max(max(lay.extent, abs(lay.pin[0]), abs(lay.pin[1])) for lay in uj.layouts) + uj.R + 3 * c
@@ -384,6 +386,8 @@ def _retention(asm: Assembly) -> Check:
         hold = [uj.part] + [o for o in mates if o not in (C, O)]
         for who, partners, d in ((C, hold, uj.axes[0]), (O, [uj.part], uj.axes[1]),
                                  (uj.part, mates, uj.axes[0])):
+            if getattr(uj, "host", None) is not None and who != O:
+                continue     # compound junction: C and the joint part are tested on C's hinge (above)
             tests.append((who, partners, d, uj.name, uj.center, np.eye(3), [2 * half] * 3))
     fails = []
     n = 0
@@ -393,6 +397,8 @@ def _retention(asm: Assembly) -> Check:
     index = {p.name: i for i, p in enumerate(asm.parts)}
 
     cores = getattr(asm, "cores", None) or {}
+    axis_cores = getattr(asm, "axis_cores", None) or {}
+    axis_names = {ax.name for ax in asm.axes}
 
     def free_moves(name, partners, d, centre, Fc, size, solid=lambda o: by[o].solid):
         F = _perp_frame(d)
@@ -405,15 +411,17 @@ def _retention(asm: Assembly) -> Check:
             out.append(float((moved ^ other).volume()) <= VOL_EPS)
         return out
 
-    def core_first(name, partners, d, centre, Fc, size):
+    def core_first(name, partners, d, centre, Fc, size, on_axis=False):
         # large assemblies: the joint material alone (a subset of each part, which no trim
         # touches) blocks every move in most joints; material only adds blocking, so a move it
         # blocks is blocked by the finished parts too -- the finished parts only where it does not
         if all(o in cores for o in [name] + partners):
             # the cropped joint material, keyed by its shape in the joint's own frame: hinges of
             # one layout have the same cylinders there (built in that frame), one test for all
-            other = union([cores[o] for o in partners]) ^ box(centre, Fc, size)
-            mine = cores[name] ^ box(centre, Fc, [x + 4 * step for x in size])
+            # (on a hinge, a compound junction's joint part counts with its stack knuckle and pin only)
+            core = (lambda o: axis_cores.get(o, cores[o])) if on_axis else cores.__getitem__
+            other = union([core(o) for o in partners]) ^ box(centre, Fc, size)
+            mine = core(name) ^ box(centre, Fc, [x + 4 * step for x in size])
             W = np.eye(4)
             W[:3, :3], W[:3, 3] = _perp_frame(d), centre
             Fd = W[:3, :3]
@@ -441,7 +449,7 @@ def _retention(asm: Assembly) -> Check:
                    tuple((cong.key(index[o], by[o].solid), cong.rel(i, index[o])) for o in partners),
                    np.round(Fi[:3, :3] @ _perp_frame(d) / 1e-7).astype(np.int64).tobytes(),
                    cong.rel(i, i, None, T @ np.linalg.inv(cong.frames[i])), tuple(np.round(size, 6).tolist()))
-            free = core_first(name, partners, d, centre, Fc, size) if cores else \
+            free = core_first(name, partners, d, centre, Fc, size, jn in axis_names) if cores else \
                 cong.lookup(key, lambda: free_moves(name, partners, d, centre, Fc, size))
         for k, f in enumerate(free):
             n += 1
