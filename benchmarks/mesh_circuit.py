@@ -112,13 +112,16 @@ def plot(rows, path: Path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
-    done = sorted((r for r in rows if r.get("finished")), key=lambda r: r["bodies"])
+    done = sorted((r for r in rows if r.get("finished") and not r.get("superseded") and r.get("total_s")),
+                  key=lambda r: r["bodies"])
     if not done:
         return
     fig, ax = plt.subplots(1, 2, figsize=(9, 3.6))
     x = [r["bodies"] for r in done]
     ax[0].loglog(x, [r["total_s"] for r in done], "o-", label="mesh + files")
-    ax[0].loglog(x, [r["poses_s"] for r in done], "s--", label="static poses")
+    pz = [(r["bodies"], r["poses_s"]) for r in done if r.get("poses_s")]
+    if pz:
+        ax[0].loglog(*zip(*pz), "s--", label="static poses")
     ax[0].set_xlabel("bodies")
     ax[0].set_ylabel("wall-clock s (shared 2-core machine)")
     ax[0].legend()

@@ -215,11 +215,15 @@ def export_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     return full, report
 
 
-def _swept_box(asm: Assembly, part: Part, mech_poses, shift):
+def _swept_box(asm: Assembly, part: Part, mech_poses, shift, Ts=None):
+    """The box a part sweeps over its mechanism's poses (``Ts``: each pose's part transforms,
+    computed once per pose by the caller; a mechanism of thousands of parts took minutes
+    when every part recomputed them)."""
     lo, hi = _bbox(part.solid)
-    for pos, quat in mech_poses.values():
-        T = asm.part_transforms(pos, quat)[part.name]
-        l2, h2 = _bbox(part.solid, T)
+    if Ts is None:
+        Ts = [asm.part_transforms(pos, quat) for pos, quat in mech_poses.values()]
+    for T in Ts:
+        l2, h2 = _bbox(part.solid, T[part.name])
         lo, hi = np.minimum(lo, l2), np.maximum(hi, h2)
     return lo + shift, hi + shift
 
@@ -281,8 +285,9 @@ def _merge_reports(scene, profile, mechs, built, full, owner) -> Report:
         poses = a.poses or {}
         lo = np.full(3, np.inf)
         hi = np.full(3, -np.inf)
+        Ts = [a.part_transforms(pos, quat) for pos, quat in poses.values()]
         for p in a.parts:
-            l2, h2 = _swept_box(a, p, poses, m.shift * s)
+            l2, h2 = _swept_box(a, p, poses, m.shift * s, Ts)
             lo, hi = np.minimum(lo, l2), np.maximum(hi, h2)
         swept.append((lo, hi))
     st = checks[3]
@@ -321,12 +326,19 @@ def _cross_states(mechs, built, i, j, s) -> list[str]:
             T = {p.name: np.eye(4) for p in a.parts} if pq is None else a.part_transforms(*pq)
             per[st] = [transform_solid(p.solid, T[p.name]).translate((m.shift * s).tolist()) for p in a.parts]
         posed.append(per)
+    from mlc.mesh.spatial import box_pairs, solid_boxes
+    boxes = [{st: solid_boxes(P) for st, P in per.items()} for per in posed]
     for (s1, P1), (s2, P2) in itertools.product(posed[0].items(), posed[1].items()):
-        for x in P1:
-            for y in P2:
-                if (x ^ y).volume() > VOL_EPS:
-                    out.append(f"{mechs[i].scene.name} in state {s1} meets {mechs[j].scene.name} in state {s2}")
-                    break
+        # only parts whose posed boxes touch can meet (thousands of parts: not every pair)
+        (l1, h1), (l2, h2) = boxes[0][s1], boxes[1][s2]
+        n1 = len(P1)
+        cand = [(a, b - n1) for a, b in box_pairs(np.vstack([l1, l2]), np.vstack([h1, h2]), 0.0)
+                if a < n1 <= b]
+        hit = set()
+        for a, b in cand:          # as before: one line for each part of the first that meets one of the second
+            if a not in hit and (P1[a] ^ P2[b]).volume() > VOL_EPS:
+                hit.add(a)
+                out.append(f"{mechs[i].scene.name} in state {s1} meets {mechs[j].scene.name} in state {s2}")
     return out
 
 
