@@ -32,6 +32,12 @@ rigid slab) holds its DOF with a plain bond between the tips at its constant len
 bonds (:func:`dof_stops`) that leave it free over [-15, 105] degrees of turn and close
 the lever triangle's mirror equilibria at 180 and -90 degrees.
 
+**Chain stops** (docs/robot.md section 2.2).  Every junction of a coupling chain has the
+circuit's junction stop (:func:`mlc.gates.connector.junction_stops`); a chain's first
+junction gets one too when it hangs on a half unit, or a tap stop (:func:`_lever_stop`)
+when it hangs on a gate's output lever.  ``SLACK_FRACTION`` > 0 lengthens the chains so
+that none spans more than that fraction of its length in any row (section 2.4; off).
+
 Every DOF has a probe across its tips, named ``dof_u{i}_{side}``, reading the DOF's
 own output (rest d0, actuated d1): the circuit verifier checks the DOF lengths like any
 output, and :mod:`mlc.robot.verify` reads the shape.  Units: sigma, k0, radians.
