@@ -316,28 +316,40 @@ def _merge_reports(scene, profile, mechs, built, full, owner) -> Report:
 
 
 def _cross_states(mechs, built, i, j, s) -> list[str]:
+    from mlc.mesh.spatial import box_pairs, posed_boxes, solid_boxes
     out = []
     A = [(mechs[i], built[i if mechs[i].rep < 0 else mechs[i].rep][0]),
          (mechs[j], built[j if mechs[j].rep < 0 else mechs[j].rep][0])]
-    posed = []
+    posed, boxes = [], []
     for m, a in A:
-        per = {}
+        # each part's transform in each state (shift included) and the box of its moved rest box;
+        # a part is moved (a new mesh) only for a pair whose boxes touch: moving every part of a
+        # mechanism of thousands in every state held gigabytes
+        per, bx = {}, {}
+        lo, hi = solid_boxes([p.solid for p in a.parts])
         for st, pq in (a.poses or {"rest": None}).items():
             T = {p.name: np.eye(4) for p in a.parts} if pq is None else a.part_transforms(*pq)
-            per[st] = [transform_solid(p.solid, T[p.name]).translate((m.shift * s).tolist()) for p in a.parts]
+            Ts = []
+            for p in a.parts:
+                Tm = np.array(T[p.name], float)
+                Tm[:3, 3] += m.shift * s
+                Ts.append(Tm)
+            per[st] = Ts
+            bx[st] = posed_boxes(lo, hi, Ts)
         posed.append(per)
-    from mlc.mesh.spatial import box_pairs, solid_boxes
-    boxes = [{st: solid_boxes(P) for st, P in per.items()} for per in posed]
+        boxes.append(bx)
+    parts = [a.parts for _, a in A]
     for (s1, P1), (s2, P2) in itertools.product(posed[0].items(), posed[1].items()):
         # only parts whose posed boxes touch can meet (thousands of parts: not every pair)
         (l1, h1), (l2, h2) = boxes[0][s1], boxes[1][s2]
         n1 = len(P1)
-        cand = [(a, b - n1) for a, b in box_pairs(np.vstack([l1, l2]), np.vstack([h1, h2]), 0.0)
-                if a < n1 <= b]
+        cand = [(x, y - n1) for x, y in box_pairs(np.vstack([l1, l2]), np.vstack([h1, h2]), 0.0)
+                if x < n1 <= y]
         hit = set()
-        for a, b in cand:          # as before: one line for each part of the first that meets one of the second
-            if a not in hit and (P1[a] ^ P2[b]).volume() > VOL_EPS:
-                hit.add(a)
+        for x, y in cand:          # as before: one line for each part of the first that meets one of the second
+            if x not in hit and (transform_solid(parts[0][x].solid, P1[x])
+                                 ^ transform_solid(parts[1][y].solid, P2[y])).volume() > VOL_EPS:
+                hit.add(x)
                 out.append(f"{mechs[i].scene.name} in state {s1} meets {mechs[j].scene.name} in state {s2}")
     return out
 
