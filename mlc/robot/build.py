@@ -32,7 +32,8 @@ rigid slab) holds its DOF with a plain bond between the tips at its constant len
 bonds (:func:`dof_stops`) that leave it free over [-15, 105] degrees of turn and close
 the lever triangle's mirror equilibria at 180 and -90 degrees.
 
-**Chain stops** (docs/robot.md section 2.2).  Every junction of a coupling chain has the
+**Chain stops** (docs/robot.md section 2.2; ``CHAIN_STOPS``, off by default: with them the
+Tetris couplings cannot reach the O pose).  Every junction of a coupling chain has the
 circuit's junction stop (:func:`mlc.gates.connector.junction_stops`); a chain's first
 junction gets one too when it hangs on a half unit, or a tap stop (:func:`_lever_stop`)
 when it hangs on a gate's output lever.  ``SLACK_FRACTION`` > 0 lengthens the chains so
@@ -72,7 +73,8 @@ STOP_UNDER_LOW = math.radians(52.5)  # rad: the under-turn stop's arms this far 
 STOP_K = 4.0                       # k0: the stops' stiffness once engaged (a wire joint's is 1)
 LEVER_STOP = 0.35                  # sigma: a chain's first posts stop this short of a gate lever's joints (as in circuits)
 SLACK_FRACTION = 0.0               # >0: a chain spans at most this fraction of its length in any row (2.4; 0.6 tried: no faster)
-CHAIN_STOPS = True                 # junction stops in the coupling chains (docs/robot.md 2.2, 3.3)
+CHAIN_STOPS = False                # junction stops in the coupling chains: off, with them static row 11 of
+                                   # the Tetris robot folds wrong and dynamics 8/12 (docs/robot.md 2.2, 2.4, 3.1)
 
 
 @dataclass
