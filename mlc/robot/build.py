@@ -52,7 +52,7 @@ import numpy as np
 
 from mlc.errors import MlcError
 from mlc.gates.connector import (POST_WIDTH, STOP_ARM, Pair, chain_parts, connector_geometry, half_unit_prefix, join,
-                                 junction_stops)
+                                 junction_stops, max_bend)
 from mlc.gates.parts import axis_sites, hinge, segment_box, slab_body
 from mlc.geometry.rotation import matrix_to_quat
 from mlc.robot.spec import RobotSpec
@@ -231,7 +231,7 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
     posed in the all-zero input row."""
     import time
 
-    from mlc.circuit.route import solve_route
+    from mlc.circuit.route import BEND_FRACTION, solve_route
 
     t0 = time.perf_counter()
     meta = circuit.meta if isinstance(circuit.meta, dict) else {}
@@ -427,17 +427,21 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
         found = None
         # the first start that leaves every new body clear of those placed (a chain on an output pair
         # that already carries one fans out about the pair's axis, like a branch's pages)
-        for fan in FAN_ANGLES:
+        on_lever = half_unit_prefix(start) is None     # a gate's output lever (else a half unit's pair)
+        # a chain on a half unit with junction stops: its first junction is a junction like any
+        # other, so it may not be fanned out and its first bend stays within the routes' limit
+        stop_first = CHAIN_STOPS and not on_lever
+        sbm = BEND_FRACTION * max_bend(geo) if stop_first else math.radians(50.0)
+        for fan in ((0.0,) if stop_first else FAN_ANGLES):
             from mlc.geometry.rotation import expmap
             tv = expmap(start.axis * math.radians(fan)) @ t0v
             for wp in (wps, []):
                 route = solve_route(start.centre, start.axis, tc, tax, geo, 0, waypoints=wp, tangent=tv,
-                                    free_start=fan == 0, approach=ez, min_half=min_half)
+                                    free_start=fan == 0, approach=ez, min_half=min_half, start_bend_max=sbm)
                 if route is not None:
                     break
             if route is None:
                 continue
-            on_lever = half_unit_prefix(start) is None     # a gate's output lever (else a half unit's pair)
             parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, sstate, geo,
                                        in_stop=LEVER_STOP if on_lever else POST_WIDTH, stops=CHAIN_STOPS)
             new_c = np.array([b.position for b in parts.bodies])

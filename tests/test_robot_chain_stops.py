@@ -1,0 +1,68 @@
+"""Junction stops in a robot's coupling chains (docs/robot.md section 2.2, ``CHAIN_STOPS``):
+with the option on, every junction of every chain, the first included, has one flat-bottom
+stop bond; none is engaged as built (the routes bend at most 0.75 of the largest bend);
+each stop reads a junction's bend as 2 m cos(beta/2) between its sites; the default build
+has none.  Also the reach bookkeeping of section 2.4."""
+import math
+
+import numpy as np
+import pytest
+
+import mlc.robot.build as rb
+from mlc.gates.connector import STOP_ARM, STOP_FRACTION, connector_geometry, max_bend
+
+TINY = """mlc_robot: 1
+name: tiny
+inputs: [a]
+skeleton: {units: 2}
+dofs:
+  - {unit: 1, side: up, output: u1_up}
+  - {unit: 2, side: dn, output: u2_dn}
+poses:
+  - {row: "0", shape: I, turns: [0, 0]}
+  - {row: "1", shape: hook, turns: [90, -90]}
+"""
+
+
+@pytest.fixture(scope="module")
+def circuit(tmp_path_factory):
+    from mlc.cli import main
+    d = tmp_path_factory.mktemp("tinystops")
+    (d / "tiny.robot.yaml").write_text(TINY)
+    assert main(["compile", "-e", "u1_up = a; u2_dn = a", "-o", str(d / "out")]) == 0
+    return d
+
+
+def _build(d, monkeypatch, stops: bool):
+    from mlc.robot.spec import load_robot
+    from mlc.scene.io import load_scene
+    monkeypatch.setattr(rb, "CHAIN_STOPS", stops)
+    circ = load_scene(d / "out" / "circuit.yaml")
+    return rb.build_robot(circ, load_robot(str(d / "tiny.robot.yaml"), circ)).scene
+
+
+def _site(sc, by, s):
+    b, n = s.split(".", 1)
+    return by[b].world(n)
+
+
+@pytest.mark.parametrize("stops", [True, False])
+def test_chain_stops_one_per_junction_free_as_built(circuit, monkeypatch, stops):
+    sc = _build(circuit, monkeypatch, stops)
+    by = {b.name: b for b in sc.bodies}
+    geo = connector_geometry("expand")
+    for d in sc.meta["robot"]["dofs"]:
+        if "chain" not in d:
+            continue
+        pre, n = d["chain"]["prefix"], d["chain"]["half_units"]
+        st = [bd for bd in sc.bonds if bd.name.startswith(f"{pre}_s")]
+        assert len(st) == (n if stops else 0)           # n - 1 inner junctions + the first one
+        for bd in st:
+            dd = float(np.linalg.norm(_site(sc, by, bd.a) - _site(sc, by, bd.b)))
+            assert abs(dd - bd.rest) <= bd.tolerance + 1e-9          # free as built
+            if bd.a.split(".")[0].startswith(pre):                   # an inner junction: read its bend
+                beta = 2 * math.degrees(math.acos(min(1.0, dd / (2 * STOP_ARM))))
+                assert beta < STOP_FRACTION * math.degrees(max_bend(geo))
+        # reach bookkeeping (section 2.4): the largest distance over the rows over the contour
+        assert d["chain"]["reach_fraction"] == pytest.approx(d["chain"]["reach_max"] / (n * geo.pitch), abs=2e-3)
+        assert 0 < d["chain"]["reach_fraction"] < 1.0
