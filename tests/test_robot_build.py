@@ -11,23 +11,10 @@ import pytest
 from mlc.cli import main
 from mlc.scene.io import dump_scene, load_scene
 
-TINY = """mlc_robot: 1
-name: tiny
-inputs: [a]
-skeleton: {units: 2}
-dofs:
-  - {unit: 1, side: up, output: u1_up}
-  - {unit: 2, side: dn, output: u2_dn}
-poses:
-  - {row: "0", shape: I, turns: [0, 0]}
-  - {row: "1", shape: hook, turns: [90, -90]}
-"""
-
-
 @pytest.fixture(scope="module")
-def robot(tmp_path_factory):
+def robot(tmp_path_factory, tiny_robot_yaml):
     d = tmp_path_factory.mktemp("tiny")
-    (d / "tiny.robot.yaml").write_text(TINY)
+    (d / "tiny.robot.yaml").write_text(tiny_robot_yaml)
     rc = main(["compile", "-e", "u1_up = a; u2_dn = a", "--robot", str(d / "tiny.robot.yaml"), "-o", str(d / "out")])
     assert rc == 0
     return d

@@ -11,24 +11,11 @@ import pytest
 import mlc.robot.build as rb
 from mlc.gates.connector import STOP_ARM, STOP_FRACTION, connector_geometry, max_bend
 
-TINY = """mlc_robot: 1
-name: tiny
-inputs: [a]
-skeleton: {units: 2}
-dofs:
-  - {unit: 1, side: up, output: u1_up}
-  - {unit: 2, side: dn, output: u2_dn}
-poses:
-  - {row: "0", shape: I, turns: [0, 0]}
-  - {row: "1", shape: hook, turns: [90, -90]}
-"""
-
-
 @pytest.fixture(scope="module")
-def circuit(tmp_path_factory):
+def circuit(tmp_path_factory, tiny_robot_yaml):
     from mlc.cli import main
     d = tmp_path_factory.mktemp("tinystops")
-    (d / "tiny.robot.yaml").write_text(TINY)
+    (d / "tiny.robot.yaml").write_text(tiny_robot_yaml)
     assert main(["compile", "-e", "u1_up = a; u2_dn = a", "-o", str(d / "out")]) == 0
     return d
 
