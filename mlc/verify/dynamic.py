@@ -135,9 +135,6 @@ def signal_time(scene, start: str, state: str, pos=None, quat=None, gamma_r: flo
     where the smallest non-zero eigenvalue of :func:`relaxation_time` needs an iterative
     eigensolver that the hundreds of near-zero bending modes of a circuit's connector
     chains slow to minutes.  0 when no probe responds."""
-    import scipy.sparse as sp
-    from scipy.sparse.linalg import splu
-
     from mlc.verify.static import _Problem
 
     A = scene.arrays()
@@ -147,10 +144,7 @@ def signal_time(scene, start: str, state: str, pos=None, quat=None, gamma_r: flo
     u = scene.units
     gamma, k0 = float(u.get("gamma", 1.0)), float(u.get("k0", 1.0))
     gr = gamma if gamma_r is None else float(gamma_r)
-    J = prob.jacobian().tocsr()
-    H = (J.T @ J).tocsc()
-    eps = 1e-10 * max(float(H.diagonal().max()), 1e-300)
-    lu = splu((H + sp.identity(prob.n, format="csc") * eps).tocsc())
+    J, lu, _ = _factorised(prob)
     a = np.asarray([int(c) for c in start], float)[A.muscle_input]
     b = np.asarray([int(c) for c in state], float)[A.muscle_input]
     dL = np.array([(m.actuated - m.rest) for m in scene.muscles]) * (b - a)
@@ -178,9 +172,6 @@ def probe_thermal_sd(scene, kT: float, pos=None, quat=None) -> dict:
     stiffness, k0/sigma^2, zero modes left out), so a probe with gradient ``g`` (per body
     translation and rotation vector) has variance ``kT g^T H^+ g``.  A probe that a zero
     mode moves (``g`` not orthogonal to the null space) has no finite variance: inf."""
-    import scipy.sparse as sp
-    from scipy.sparse.linalg import splu
-
     from mlc.verify.static import _Problem
 
     A = scene.arrays()
@@ -188,30 +179,33 @@ def probe_thermal_sd(scene, kT: float, pos=None, quat=None) -> dict:
     out = {p.name: 0.0 for p in scene.probes}
     if prob.m == 0 or prob.n == 0 or kT <= 0 or not scene.probes:
         return out
-    J = prob.jacobian()
-    H = (J.T @ J).tocsc()
-    eps = 1e-10 * max(float(H.diagonal().max()), 1e-300)
-    lu = splu((H + sp.identity(prob.n, format="csc") * eps).tocsc())
-    p, rs = prob.sites()
+    _, lu, eps = _factorised(prob)
+    G = _probe_gradients(prob, scene)
     for k, pr in enumerate(scene.probes):
-        i, j = A.probe_i[k], A.probe_j[k]
-        d = p[i] - p[j]
-        n = d / max(float(np.linalg.norm(d)), 1e-300)
-        g = np.zeros(prob.n)
-        for site, sign in ((i, 1.0), (j, -1.0)):
-            b = A.site_body[site]
-            g[6 * b:6 * b + 3] += sign * n
-            g[6 * b + 3:6 * b + 6] += sign * np.cross(rs[site], n)
+        g = G[:, k]
+        if float(np.linalg.norm(g)) < 1e-9:  # both ends on one body: rigid, no spread
+            out[pr.name] = 0.0
+            continue
         y = lu.solve(g)
         # a component of g along a zero mode shows up as a 1/eps blow-up: no finite variance
         # (g . y = sum c^2/(lambda + eps); eps |y|^2 is about eps/lambda of it for the stiff
         # modes, and about all of it for a zero mode)
         gy = float(g @ y)
-        if float(np.linalg.norm(g)) < 1e-9:  # both ends on one body: rigid, no spread
-            out[pr.name] = 0.0
-            continue
         out[pr.name] = float(np.sqrt(kT * gy)) if eps * float(y @ y) < 0.1 * gy else float("inf")
     return out
+
+
+def _factorised(prob):
+    """(J, LU of H + eps I, eps) for the harmonic analyses: ``H = J^T J`` about the
+    problem's poses, regularised by ``eps`` = 1e-10 of its largest diagonal entry so that
+    the zero modes (rigid motion, floppy bends) do not make it singular."""
+    import scipy.sparse as sp
+    from scipy.sparse.linalg import splu
+
+    J = prob.jacobian().tocsr()
+    H = (J.T @ J).tocsc()
+    eps = 1e-10 * max(float(H.diagonal().max()), 1e-300)
+    return J, splu((H + sp.identity(prob.n, format="csc") * eps).tocsc()), eps
 
 
 def _diag(v):
@@ -347,7 +341,8 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
         tau = float(tau)
     elif large:   # the rest row has no switch of its own: its floor is the slowest of all rows
         rows_t = select_rows(scene) if "0" * len(scene.inputs) in states else states
-        tau = max([signal_time(scene, "0" * len(scene.inputs), s, gamma_r=opt0.gamma_r) for s in rows_t] + [0.0])
+        t_start = {s: signal_time(scene, "0" * len(scene.inputs), s, gamma_r=opt0.gamma_r) for s in rows_t}
+        tau = max(list(t_start.values()) + [0.0])
     else:
         tau = relaxation_time(scene, gamma_r=opt0.gamma_r)
     max_time_given = max_time is not None
@@ -374,8 +369,7 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
                 elif large and state == rest:     # no switch: the probes' correlation time
                     tau_row = tau
                 elif large:
-                    tau_row = max(signal_time(scene, rest, state, gamma_r=opt0.gamma_r),
-                                  signal_time(scene, rest, state, eq.pos, eq.quat, opt0.gamma_r))
+                    tau_row = max(t_start[state], signal_time(scene, rest, state, eq.pos, eq.quat, opt0.gamma_r))
                 else:
                     tau_row = max(tau, relaxation_time(scene, eq.pos, eq.quat, opt0.gamma_r))
             except (MlcError, ValueError, RuntimeError, np.linalg.LinAlgError):
