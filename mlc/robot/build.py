@@ -51,7 +51,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from mlc.errors import MlcError
-from mlc.gates.connector import (POST_WIDTH, STOP_ARM, Pair, chain_parts, connector_geometry, half_unit_prefix, join,
+from mlc.gates.connector import (POST_WIDTH, STOP_ARM, Pair, chain_parts, connector_geometry, half_unit_parts,
+                                 half_unit_prefix, join,
                                  junction_stops, max_bend)
 from mlc.gates.parts import axis_sites, hinge, segment_box, slab_body
 from mlc.geometry.rotation import matrix_to_quat
@@ -63,6 +64,8 @@ POST = 0.6               # sigma: the lever sites sit this far below the skeleto
 HINGE_WIDTH = 0.5        # sigma between the two bonds of a skeleton hinge (along z)
 APPROACH_RUN = 4.0       # sigma: the chain's last stretch rises straight into the skeleton
 FAN_ANGLES = (0.0, 70.0, -70.0, 140.0, -140.0, 180.0)   # deg: a chain's first tangent turned about its output pair
+PAGE_FANS = (90.0, -90.0, 120.0, -120.0, 150.0, -150.0, 180.0, 60.0, -60.0)   # deg: a second chain's page, the same
+PAGE_CLEAR = 0.2         # sigma: extra page post beyond the branch's (as mlc.circuit.build.PAGE_CLEAR)
 CLEAR = 0.3              # sigma: a chain's body centres keep this far from every body placed before
 SLACK = 0.0              # sigma: a sideways bulge half way up each chain (tried 4: no faster, docs/robot.md 3.1)
 BACK = 4.0               # sigma behind the circuit (+y) where a chain from inside the circuit rises
@@ -224,6 +227,36 @@ def _lever_stop(name: str, lever: Body, site: str, axis, t_first, first: str, k:
     d_stop, d_free = 2.0 * m * math.cos(0.5 * free), 2.0 * m + 0.5
     return lev, Bond(name, f"{lev.name}.{sname}", f"{first}_AB.stop_in", k, 0.5 * (d_stop + d_free),
                      0.5 * (d_free - d_stop), "bond", None)
+
+
+def _end_bonds(tag: str, lout: Pair, target: Pair, tax, k: float) -> list[Bond]:
+    """The two universal joints from a chain's last pair ``lout`` to its DOF's lever sites."""
+    same = float(lout.axis @ tax) > 0
+    ends = (lout.lo, lout.hi) if same else (lout.hi, lout.lo)
+    return [Bond(f"{tag}_end_lo", ends[0], target.lo, k, 0.0, 0.0, "universal", f"{tag}_end_lo"),
+            Bond(f"{tag}_end_hi", ends[1], target.hi, k, 0.0, 0.0, "universal", f"{tag}_end_hi")]
+
+
+def _chain_overlap(placed: list[Body], placed_bonds: list[Bond], parts, new_bonds: list[Bond],
+                   radius: float = 4.0) -> float:
+    """Deepest interpenetration (sigma; 0 when clear) between a new chain's slabs and the
+    bodies placed before, by the oriented-box test :func:`mlc.verify.overlap.clearance`
+    (contact at shared joints left out, as there) on the placed bodies within ``radius``
+    sigma of a new body centre."""
+    from scipy.spatial import cKDTree
+
+    from mlc.verify.overlap import clearance
+
+    new_names = {b.name for b in parts.bodies}
+    pc = np.array([b.position for b in placed])
+    nc = np.array([b.position for b in parts.bodies])
+    near = sorted({i for lst in cKDTree(pc).query_ball_point(nc, radius) for i in lst})
+    sub = [placed[i] for i in near] + list(parts.bodies)
+    keep = {b.name for b in sub}
+    bonds = [bd for bd in list(placed_bonds) + list(parts.bonds) + list(new_bonds)
+             if bd.a.split(".")[0] in keep and bd.b.split(".")[0] in keep]
+    rep = clearance(Scene(name="chain_clearance", bodies=sub, bonds=bonds))
+    return max((d for a, b, d in rep.overlaps if a in new_names or b in new_names), default=0.0)
 
 
 def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
@@ -394,6 +427,7 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
     sbyname = {b.name: b for b in bodies}
     placed = np.array([b.position for b in list(circuit.bodies) + bodies])
     by_body = {b.name: b for b in circuit.bodies}     # circuit bodies, some copied with a stop site
+    used_pairs: set = set()                           # output pairs that already carry a chain
     for ds, name, target, pr in targets:
         pa = cbyname[pr.a.split(".")[0]].world(pr.a.split(".", 1)[1])
         pb = cbyname[pr.b.split(".")[0]].world(pr.b.split(".", 1)[1])
@@ -424,57 +458,88 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
             wps = wps + [tuple(mid + SLACK * side - np.array([0.0, 0.0, 0.0]))]
         tag = f"rc_{name}"
         tr = time.perf_counter()
-        found = None
-        # the first start that leaves every new body clear of those placed (a chain on an output pair
-        # that already carries one fans out about the pair's axis, like a branch's pages)
+        found = fallback = None
         on_lever = half_unit_prefix(start) is None     # a gate's output lever (else a half unit's pair)
-        # a chain on a half unit with junction stops: its first junction is a junction like any
-        # other, so it may not be fanned out and its first bend stays within the routes' limit
-        stop_first = CHAIN_STOPS and not on_lever
+        # a second chain on one output pair leaves on a page (docs/robot.md 2.2): a half unit with long
+        # input posts, turned about the pair's axis like a branch's pages, so that its layer clears the
+        # first chain's first layer; the chain goes on from the page's output pair
+        shared = (pr.a, pr.b) in used_pairs
+        used_pairs.add((pr.a, pr.b))
+        # a chain on a half unit (a branch page): its first junction is a junction like any other, so it
+        # may not be fanned out and its first bend stays within the routes' limit (past the largest
+        # bend the two layers interpenetrate: 0.047 sigma in the tiny robot at a 50-degree limit)
+        stop_first = not on_lever and not shared
         sbm = BEND_FRACTION * max_bend(geo) if stop_first else math.radians(50.0)
-        for fan in ((0.0,) if stop_first else FAN_ANGLES):
+        fans = PAGE_FANS if shared else ((0.0,) if stop_first else FAN_ANGLES)
+        for fan in fans:
             from mlc.geometry.rotation import expmap
             tv = expmap(start.axis * math.radians(fan)) @ t0v
+            pg = None
+            if shared:
+                post = max(geo.branch_post, geo.reach / math.tan(0.5 * math.radians(abs(fan))) + 0.25) + PAGE_CLEAR
+                pg, pin, pout = half_unit_parts(f"{tag}_pg", start.centre, start.axis, tv, sstate, geo, in_post=post,
+                                                in_stop=LEVER_STOP if on_lever else POST_WIDTH)
+                pg.bonds += join(f"{tag}_pg_j", start, pin, geo.k)
+                c_start, parity, cstate, free, sb = pout, 1, 1 - sstate, True, BEND_FRACTION * max_bend(geo)
+            else:
+                c_start, parity, cstate, free, sb = start, 0, sstate, fan == 0, sbm
             for wp in (wps, []):
-                route = solve_route(start.centre, start.axis, tc, tax, geo, 0, waypoints=wp, tangent=tv,
-                                    free_start=fan == 0, approach=ez, min_half=min_half, start_bend_max=sbm)
+                route = solve_route(c_start.centre, c_start.axis, tc, tax, geo, parity, waypoints=wp, tangent=tv,
+                                    free_start=free, approach=ez, min_half=min_half + parity, start_bend_max=sb)
                 if route is not None:
                     break
             if route is None:
                 continue
-            parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, sstate, geo,
-                                       in_stop=LEVER_STOP if on_lever else POST_WIDTH, stops=CHAIN_STOPS)
+            parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, cstate, geo,
+                                       in_stop=LEVER_STOP if (on_lever and not shared) else POST_WIDTH,
+                                       stops=CHAIN_STOPS)
+            if pg is not None:
+                parts.bodies = pg.bodies + parts.bodies
+                parts.bonds = pg.bonds + parts.bonds
             new_c = np.array([b.position for b in parts.bodies])
             d2 = ((new_c[:, None, :] - placed[None, :, :]) ** 2).sum(-1)
-            if float(d2.min()) >= CLEAR ** 2:
-                found = (route, parts, pairs)
+            if float(d2.min()) < CLEAR ** 2:
+                continue
+            # the slabs too (oriented boxes): two chains on one pair whose first layers interpenetrate
+            # are not printable, though their centres keep CLEAR apart (docs/robot.md 2.2)
+            first = join(f"{tag}_j0", c_start, pairs[0], geo.k)
+            ends = _end_bonds(tag, pairs[-1], target, tax, geo.k)
+            depth = _chain_overlap(list(by_body.values()) + bodies + parts_bodies,
+                                   list(circuit.bonds) + bonds + parts_bonds, parts, first + ends)
+            if depth <= 0.0:
+                found = (route, parts, pairs, c_start, pg is not None, tv, fan)
                 break
+            if fallback is None or depth < fallback[0]:
+                fallback = (depth, (route, parts, pairs, c_start, pg is not None, tv, fan))
+        if found is None and fallback is not None:      # every start overlaps: the least (mlc verify reports it)
+            found = fallback[1]
         if found is None:
             raise MlcError(f"cannot route output {ds.output} to dof {name}: no connector chain reaches it "
                            "clear of the others", ds.loc, "this is a placement limit of mlc; try a larger skeleton height")
-        route, parts, pairs = found
+        route, parts, pairs, c_start, paged, tv, fan = found
+        new_c = np.array([b.position for b in parts.bodies])
         placed = np.vstack([placed, new_c])
-        parts.bonds += join(f"{tag}_j0", start, pairs[0], geo.k)
-        if CHAIN_STOPS and not on_lever:               # on a half unit (a branch page): its junction stop
+        parts.bonds += join(f"{tag}_j0", c_start, pairs[0], geo.k)
+        if CHAIN_STOPS and paged:                      # the junction after the page
+            parts.bonds += junction_stops(f"{tag}_s0", f"{tag}_pg", f"{tag}_0", geo, geo.k)
+        if CHAIN_STOPS and not on_lever and not paged:  # on a half unit (a branch page): its junction stop
             parts.bonds += junction_stops(f"{tag}_s0", half_unit_prefix(start), f"{tag}_0", geo, geo.k)
-        elif CHAIN_STOPS:                              # on a gate's lever: the tap stop
+        elif CHAIN_STOPS and on_lever:                 # on a gate's lever: the tap stop (of the page or the chain)
             lname = start.lo.split(".")[0]
-            lev, bd = _lever_stop(f"{tag}_s0", by_body[lname], start.lo.split(".", 1)[1], start.axis,
-                                  pairs[1].centre - pairs[0].centre, f"{tag}_0", geo.k)
+            lev, bd = _lever_stop(f"{tag}_s{'p' if paged else '0'}", by_body[lname], start.lo.split(".", 1)[1],
+                                  start.axis, tv if paged else pairs[1].centre - pairs[0].centre,
+                                  f"{tag}_pg" if paged else f"{tag}_0", geo.k)
             by_body[lname] = lev
             parts.bonds.append(bd)
-        lout = pairs[-1]
-        same = float(lout.axis @ tax) > 0
-        ends = (lout.lo, lout.hi) if same else (lout.hi, lout.lo)
-        parts.bonds.append(Bond(f"{tag}_end_lo", ends[0], target.lo, geo.k, 0.0, 0.0, "universal", f"{tag}_end_lo"))
-        parts.bonds.append(Bond(f"{tag}_end_hi", ends[1], target.hi, geo.k, 0.0, 0.0, "universal", f"{tag}_end_hi"))
+        parts.bonds += _end_bonds(tag, pairs[-1], target, tax, geo.k)
         parts_bodies += parts.bodies
         parts_bonds += parts.bonds
         n_chains += 1
-        n_half += len(route.bends)
+        nh = len(route.bends) + (1 if paged else 0)
+        n_half += nh
         next(d for d in dofs_meta if d["name"] == name)["chain"] = {
-            "half_units": len(route.bends), "prefix": tag, "route_seconds": round(time.perf_counter() - tr, 2),
-            "reach_max": round(max(d_rows), 3), "reach_fraction": round(max(d_rows) / (len(route.bends) * geo.pitch), 3)}
+            "half_units": nh, "prefix": tag, "page": paged, "fan_deg": fan, "route_seconds": round(time.perf_counter() - tr, 2),
+            "reach_max": round(max(d_rows), 3), "reach_fraction": round(max(d_rows) / (nh * geo.pitch), 3)}
     rmeta = spec.as_dict()
     rmeta.update({"origin": [float(v) for v in origin], "plane_normal": [0.0, 0.0, 1.0], "x_axis": [1.0, 0, 0],
                   "joint_length": s, "links": [f"skel_u{i}" for i in range(spec.units + 1)],

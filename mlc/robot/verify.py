@@ -224,8 +224,22 @@ def _name_of(q, rm) -> str:
     return "?" + "".join({-1: "d", 0: "s", 1: "u", 2: "x"}[k] for k in q)
 
 
-def verify_robot_static(scene: Scene, rows=None, steps: int = STEPS, progress=None, keep_poses: bool = False) -> Report:
-    """Static check of every row (see the module doc)."""
+def _clearance_row(scene: Scene, pos=None, quat=None) -> dict:
+    """The oriented-box slab test (:func:`mlc.verify.overlap.clearance`) of ``scene`` posed at
+    ``pos``/``quat`` (default: as built): smallest clearance (sigma; negative: the deepest
+    interpenetration), its pair of bodies, and the first 10 interpenetrating pairs."""
+    from mlc.verify.overlap import clearance
+
+    c = clearance(scene, pos, quat)
+    return {"clearance": c.min_clearance if abs(c.min_clearance) > 1e-12 else 0.0, "clearance_pair": list(c.pair), "overlaps": [list(o) for o in c.overlaps[:10]],
+            "n_overlaps": len(c.overlaps), "clearance_ok": bool(c.ok())}
+
+
+def verify_robot_static(scene: Scene, rows=None, steps: int = STEPS, progress=None, keep_poses: bool = False,
+                        clearance: bool = True) -> Report:
+    """Static check of every row (see the module doc).  With ``clearance`` each row's
+    equilibrium and the scene as built also get the slab-overlap test (docs/robot.md 3):
+    reported, a warning when slabs interpenetrate, not part of a row's verdict."""
     from mlc.verify.static import equilibrium
 
     rm = robot_meta(scene)
@@ -233,6 +247,8 @@ def verify_robot_static(scene: Scene, rows=None, steps: int = STEPS, progress=No
     t0 = time.perf_counter()
     rep = Report(scene.name, "static", params={"tol_length": TOL_LENGTH, "tol_stretch": TOL_STRETCH, "steps": steps,
                                                "robot": True})
+    if clearance:
+        rep.params["as_built"] = _clearance_row(scene)
     poses = {}
     for i, state in enumerate(states):
         t_row = time.perf_counter()
@@ -252,6 +268,8 @@ def verify_robot_static(scene: Scene, rows=None, steps: int = STEPS, progress=No
                                 "error": None if ideal is None else float(abs(L - ideal)), "ok": bool(ok)})
         row = {"state": state, "joint_stretch": eq.max_joint_stretch}
         row.update(_shape_row(scene, rm, state, eq.pos, eq.quat))
+        if clearance:                      # slab overlap in the row's pose (a printability check, not the shape's)
+            row.update(_clearance_row(scene, eq.pos, eq.quat))
         row["ok"] = bool(row_ok and row["shape_ok"])
         row["seconds"] = time.perf_counter() - t_row
         rep.rows.append(row)
@@ -371,7 +389,7 @@ def format_robot_report(rep: Report) -> str:
     DOF angle error."""
     from mlc.verify.circuit import format_report
 
-    table = [ln for ln in format_report(rep).splitlines() if not ln.startswith(("all ", "WRONG"))]
+    table = [ln for ln in format_report(rep).splitlines() if not ln.startswith(("all ", "WRONG", "WARNING: row"))]
     lines = table + [f"{rep.scene}: {rep.mode} verification of the skeleton, {len(rep.rows)} rows"
              + (f", {rep.params.get('seeds')} seeds, kT = {rep.params.get('kT')}" if rep.mode == "dynamic" else "")]
     for r in rep.rows:
@@ -382,6 +400,20 @@ def format_robot_report(rep: Report) -> str:
         lines.append(f"row {r['state']}: shape {r['shape_read']:<6} expected {r['shape_expected']:<6} turns (deg) "
                      f"{turns}  largest DOF error {r['max_dof_error_deg']:.2f} deg ({r['max_dof_error_rad']:.4f} rad)"
                      f"  {tail}  {'ok' if r['ok'] else 'WRONG'}")
+    built = rep.params.get("as_built")
+    if built is not None:
+        lines.append(f"slab clearance as built: {built['clearance']:+.4f} sigma ({'/'.join(built['clearance_pair'])})"
+                     + ("" if "clearance" not in (rep.rows[0] if rep.rows else {}) else
+                        "; in the rows' poses: " + ", ".join(f"{r['state']} {r['clearance']:+.4f}" for r in rep.rows)))
+    for r in [dict(built, state="as built")] if built and built.get("overlaps") else []:
+        a, b, d = r["overlaps"][0]
+        lines.append(f"WARNING: {r['state']}: slabs {a} and {b} interpenetrate by {d:.4f} sigma "
+                     f"({r['n_overlaps']} pairs); smallest clearance {r['clearance']:+.4f} sigma (not printable as built)")
+    for r in rep.rows:
+        if r.get("overlaps"):
+            a, b, d = r["overlaps"][0]
+            lines.append(f"WARNING: row {r['state']}: slabs {a} and {b} interpenetrate by {d:.4f} sigma "
+                         f"({r['n_overlaps']} pairs) in the static pose; smallest clearance {r['clearance']:+.4f} sigma")
     for r in rep.rows:
         if not r["shape_ok"]:
             lines.append(f"WRONG: row {r['state']}: the skeleton folded into {r['shape_read']} (turns "

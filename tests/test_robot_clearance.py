@@ -1,0 +1,78 @@
+"""Slab clearance of a robot as built (docs/robot.md section 2.2, "Two chains on one pair"):
+two DOFs driven by one gate output hang two chains on one pair; the second leaves on a
+page (a half unit with long posts, turned about the pair's axis) so that no two slabs
+interpenetrate (the oriented-box test of mlc.verify.overlap); the page keeps the chain's
+parity (the DOF reads its output in every row); mlc verify reports the clearance as built
+and in every row's pose.  With the page's posts cut short the builder finds no clear start
+and the overlap shows: the check is not vacuous."""
+import json
+
+import pytest
+
+import mlc.robot.build as rb
+from mlc.verify.overlap import clearance
+
+PAIR_ROBOT = """mlc_robot: 1
+name: pair
+inputs: [a, b]
+skeleton: {units: 2}
+dofs:
+  - {unit: 1, side: up, output: u1_up}
+  - {unit: 2, side: dn, output: u2_dn}
+poses:
+  - {row: "00", shape: I, turns: [0, 0]}
+  - {row: "01", shape: I, turns: [0, 0]}
+  - {row: "10", shape: I, turns: [0, 0]}
+  - {row: "11", shape: hook, turns: [90, -90]}
+"""
+
+
+@pytest.fixture(scope="module")
+def pair_dir(tmp_path_factory):
+    from mlc.cli import main
+    d = tmp_path_factory.mktemp("pair")
+    (d / "pair.robot.yaml").write_text(PAIR_ROBOT)
+    assert main(["compile", "-e", "u1_up = a & b; u2_dn = a & b", "-o", str(d / "out")]) == 0
+    return d
+
+
+def _build(d):
+    from mlc.robot.spec import load_robot
+    from mlc.scene.io import load_scene
+    circ = load_scene(d / "out" / "circuit.yaml")
+    return rb.build_robot(circ, load_robot(str(d / "pair.robot.yaml"), circ)).scene
+
+
+def test_second_chain_on_a_pair_leaves_on_a_page_clear_of_the_first(pair_dir):
+    sc = _build(pair_dir)
+    pr = {p.name: p for p in sc.probes}
+    assert (pr["u1_up"].a, pr["u1_up"].b) == (pr["u2_dn"].a, pr["u2_dn"].b)      # one gate output, two DOFs
+    chains = {d["name"]: d["chain"] for d in sc.meta["robot"]["dofs"] if d.get("chain")}
+    assert chains["u1_up"]["page"] is False and chains["u2_dn"]["page"] is True
+    assert any(b.name == "rc_u2_dn_pg_AB" for b in sc.bodies)
+    rep = clearance(sc)
+    assert rep.ok(), rep.overlaps[:3]
+
+
+def test_static_verify_reports_clearance_and_the_page_keeps_parity(pair_dir, tmp_path, capsys):
+    from mlc.cli import main
+    from mlc.scene.io import dump_scene
+    f = tmp_path / "robot.yaml"
+    f.write_text(dump_scene(_build(pair_dir)))
+    assert main(["verify", str(f), "--json"]) == 0
+    rep = json.loads(capsys.readouterr().out)
+    assert rep["ok"] and rep["params"]["as_built"]["clearance_ok"]
+    rows = {r["state"]: r for r in rep["rows"]}
+    assert rows["11"]["shape_read"] == "hook" and all("clearance" in r for r in rep["rows"])
+    dof = {(e["state"], e["output"]): e["measured"] for e in rep["entries"]}
+    assert abs(dof[("11", "dof_u2_dn")] - 3.0) < 0.01 and abs(dof[("00", "dof_u2_dn")] - 2.0) < 0.01
+    assert main(["verify", str(f)]) == 0
+    assert "slab clearance as built: +0.0000 sigma" in capsys.readouterr().out
+
+
+def test_short_page_posts_overlap_and_are_reported(pair_dir, monkeypatch):
+    monkeypatch.setattr(rb, "PAGE_CLEAR", -1.0)          # posts 1 sigma shorter: the page's layer meets the first chain's
+    sc = _build(pair_dir)
+    rep = clearance(sc)
+    assert not rep.ok()
+    assert any(a.startswith("rc_u2_dn_pg") or b.startswith("rc_u2_dn_pg") for a, b, _ in rep.overlaps)
