@@ -180,6 +180,10 @@ class YokeLayout:
     cut: tuple                # range where the body is trimmed away from the axis (except its knuckles)
     plate: tuple = (0.0, 0.0)  # range of the yoke plate joining the knuckles to the slab
     reach: float | None = None  # compound junction ("host"): how far the hub reaches along the axis
+    holes: list | None = None  # branch junction: the body's pin holes, (s0, s1, radius)
+    r_own: float | None = None  # branch junction: radius of the body's knuckle
+    head: list = field(default_factory=list)  # the joint pin's head, (s0, s1, radius) (none so far)
+    bridge: tuple = ()        # branch junction, outermost page: a plate over the cap, (s0, s1) along the pin
 
     @property
     def extent(self) -> float:
@@ -206,6 +210,8 @@ class UJoint:
     collar: float = 0.0       # compound junction: the collar runs from -collar to 0 along u (mm)
     fin: float = 0.0          # compound junction: O's yoke fin runs from 0 to fin along u (0: a plain plate)
     o_axis: HingeAxis | None = None  # compound junction: O's own hinge on the same line (re-laid), if any
+    primary: bool = True      # branch junction: False for every page but the first (the part is the first's)
+    mates: list = field(default_factory=list)  # branch junction: the other pages on the same joint part
 
 
 @dataclass
@@ -261,6 +267,8 @@ class Assembly:
                 i = idx[p.name]
                 out[p.name] = self.body_transform(i, pos[i], quat[i])
         for u in self.ujoints:
+            if not u.primary:       # branch junction: the shared joint part is posed by its first page
+                continue
             Tc = out[u.bodies[0]]
             To = out[u.bodies[1]]
             uu = Tc[:3, :3] @ u.axes[0]
@@ -430,9 +438,40 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     ujoints: list[UJoint] = []
     reach = R + c + 2 * R + 0.25 * s
     base_samples = {bn: _slab_samples(slabs[bn], h) for bn in slabs}
+    # branch junctions: several universal joints at one point of one body (a fan-out: the
+    # pages of a connector branch on its source half unit) share one joint part
+    groups = _branch_groups(joints, scene)
+    done: set = set()
     for jname, bonds in joints.items():
-        if bonds[0].kind != "universal":
+        if bonds[0].kind != "universal" or jname in done:
             continue
+        if jname in groups:
+            S, members = groups[jname]
+            made = _branch(members, S, joints, scene, bodies, axes, slabs, s, prof, R, r_pin, r_hole, kmin, t,
+                           base_samples, reach, memo, state_T, h, notes)
+            if made is not None:
+                br_uj, comp = made
+                ujoints += br_uj
+                done.update(members)
+                hx = comp["axis"]
+                hx.span, hx.knuckle, hx.intervals = comp["span"], comp["k"], comp["intervals"]
+                hx.layout = [x if x is not None else br_uj[0].part for x in comp["stack"]]
+                hx.joint, hx.joint_iv = br_uj[0].part, comp["joint_iv"]
+                if comp["o_axis"] is not None:
+                    _own_ends(comp["o_axis"], comp["o_body"])
+                for u_ in br_uj:
+                    _own_lines(u_.bodies[1], u_.center, u_.axes[1], axes, s)
+                features.append((f"knuckle length ({hx.name}, with joint {br_uj[0].part})", hx.knuckle,
+                                 prof.min_feature))
+                features.append((f"hub wall ({br_uj[0].part})", br_uj[0].hub_r - r_pin, prof.min_wall))
+                ks = [iv[1] - iv[0] for uj in br_uj for iv in uj.layouts[1].own]
+                features.append((f"yoke knuckle length ({br_uj[0].part})", min(ks), prof.min_feature))
+                notes.append(f"branch junction {br_uj[0].part}: {len(br_uj)} universal joints "
+                             f"({', '.join(u.name for u in br_uj)}) on one joint part, compound on hinge {hx.name}")
+                continue
+            notes.append(f"universal joints {', '.join(members)}: one point of {S}, but no branch junction fits")
+            for m in members:
+                groups.pop(m, None)
         bd = bonds[0]
         cb, ob = bd.a.split(".")[0], bd.b.split(".")[0]
         center = 0.5 * (scene.site_world(bd.a) + scene.site_world(bd.b)) * s
@@ -499,6 +538,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
             hx.joint, hx.joint_iv = uj.part, compound["joint_iv"]
             if compound["o_axis"] is not None:
                 _own_ends(compound["o_axis"], ob)
+            _own_lines(ob, center, uj.axes[1], axes, s)
             features.append((f"knuckle length ({hx.name}, with joint {jname})", hx.knuckle, prof.min_feature))
             features.append((f"hub wall ({jname})", uj.hub_r - r_pin, prof.min_wall))
             notes.append(f"universal joint {jname}: compound junction on hinge {hx.name} (its pin is the joint's)")
@@ -583,7 +623,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                 cuts.append(cylinder(uj.center, uj.axes[side], a0, a1, uj.rho[side], n, cutter=True))
         for uj in ujoints:      # compound junction: the other bodies of its hinge clear the yoke too
             if uj.host is not None and bn in uj.host.bodies and bn not in uj.bodies:
-                cuts.append(cylinder(uj.center, uj.axes[0], -(R + c), R + c, uj.rho[0], n, cutter=True))
+                cuts.append(cylinder(uj.center, uj.axes[0], *uj.layouts[0].cut, uj.rho[0], n, cutter=True))
         cut_solid = _clean(subtract(solid, cuts))
         if len(cut_solid.decompose()) > len(_clean(solid).decompose()):
             # a slab running along an axis is severed by the clearance around another body's
@@ -611,7 +651,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                 keep.append(cylinder(ax.origin, ax.direction, a0, a1, R, n))
         for uj, side in my_uj:
             for a0, a1 in uj.layouts[side].own:
-                keep.append(cylinder(uj.center, uj.axes[side], a0, a1, R, n))
+                keep.append(cylinder(uj.center, uj.axes[side], a0, a1, uj.layouts[side].r_own or R, n))
         # rings where the slab is too narrow for a hole; holes inside slabs are drilled last,
         # where the slab has room for them after trimming
         rings = [cylinder(x[0], x[1], -t / 2, t / 2, lug_out, n) for x in lugs[bn] if x[2]]
@@ -639,8 +679,10 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                 for a0, a1 in ax.intervals[bn]:
                     holes.append(cylinder(ax.origin, ax.direction, a0 - g / 2, a1 + g / 2, r_hole, n, cutter=True))
         for uj, side in my_uj:
-            for a0, a1 in uj.layouts[side].own:
-                holes.append(cylinder(uj.center, uj.axes[side], a0 - g / 2, a1 + g / 2, r_hole, n, cutter=True))
+            lay = uj.layouts[side]
+            for a0, a1, rh in (lay.holes if lay.holes is not None else [(a0 - g / 2, a1 + g / 2, r_hole)
+                                                                        for a0, a1 in lay.own]):
+                holes.append(cylinder(uj.center, uj.axes[side], a0, a1, rh, n, cutter=True))
         for x in lugs[bn]:
             if x[2]:
                 holes.append(cylinder(x[0], x[1], -t - 1, t + 1, lug_hole, n, cutter=True))
@@ -663,7 +705,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
             e = GUARD_PAD
             fat = [cylinder(ax.origin, ax.direction, a0 - e, a1 + e, R + e, n)
                    for ax in my_axes for a0, a1 in ax.intervals[bn]]
-            fat += [cylinder(uj.center, uj.axes[side], a0 - e, a1 + e, R + e, n)
+            fat += [cylinder(uj.center, uj.axes[side], a0 - e, a1 + e, (uj.layouts[side].r_own or R) + e, n)
                     for uj, side in my_uj for a0, a1 in uj.layouts[side].own]
             fat += [cylinder(ax.origin, ax.direction, -ax.span / 2 - e, ax.span / 2 + e, r_pin + e, n)
                     for ax in my_axes if ax.pin_owner == bn and not cones]
@@ -675,6 +717,8 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         parts.append(Part(bn, "body", solid, partners))
 
     for uj in ujoints:
+        if not uj.primary:      # branch junction: built with its first page
+            continue
         u, v = uj.axes
         partners = list(uj.bodies)
         if uj.host is None:
@@ -689,6 +733,14 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         for side, lay in enumerate(uj.layouts):
             pieces.append(cylinder(uj.center, uj.axes[side], lay.pin[0], lay.pin[1], r_pin, n))
             pieces += [cylinder(uj.center, uj.axes[side], a0, a1, R, n) for a0, a1 in lay.caps]
+            pieces += [cylinder(uj.center, uj.axes[side], a0, a1, rr, n) for a0, a1, rr in lay.head]
+        for mu in ujoints:      # branch junction: every page's pin and caps on the one part
+            if mu is not uj and not mu.primary and mu.part == uj.part:
+                lay = mu.layouts[1]
+                pieces.append(cylinder(mu.center, mu.axes[1], lay.pin[0], lay.pin[1], r_pin, n))
+                pieces += [cylinder(mu.center, mu.axes[1], a0, a1, R, n) for a0, a1 in lay.caps]
+                pieces += [cylinder(mu.center, mu.axes[1], a0, a1, rr, n) for a0, a1, rr in lay.head]
+                partners += [mu.bodies[1]]
         parts.append(Part(uj.part, "joint", union(pieces), partners))
         protected[uj.part] = parts[-1].solid
 
@@ -703,7 +755,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         asm.cores = dict(cores, **{uj.part: asm.part(uj.part).solid for uj in ujoints})
         asm.axis_cores = {uj.part: union([cylinder(uj.host.origin, uj.host.direction, *uj.host.joint_iv, R, n),
                                           cylinder(uj.center, uj.axes[0], *uj.layouts[0].pin, r_pin, n)])
-                          for uj in ujoints if uj.host is not None}
+                          for uj in ujoints if uj.host is not None and uj.primary}
     if reuse:
         asm.congruence = Congruence(_congruence_frames(asm, slabs))
     _log(f"{len(parts)} parts built ({sum(p.solid.num_vert() for p in parts)} vertices)")
@@ -1057,7 +1109,7 @@ def _host_axis(bn, axes, center, s, g):
     return None
 
 
-def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, kmin):
+def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, kmin, others=None):
     """A compound junction on hinge axis ``ax``: the universal joint part holds the pin of the
     whole knuckle stack and has one knuckle in it (next to the end knuckle of the pin owner,
     on the joint's side, so the stack is captive), a ball hub at the joint point with a collar
@@ -1090,13 +1142,15 @@ def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, 
     d0 = abs(a) - S / 2                      # from the stack's end to the joint point
     dO = np.inf                              # ... and to the other body's own knuckles on this line
     o_axis = None
+    o_body = None
     for bx in axes:
-        if other in bx.bodies:
+        if any(o in bx.bodies for o in (others or [other])) and abs(float(np.dot(bx.direction, ax.direction))) > 0.5:
             rel = center - bx.origin
             b = float(np.dot(rel, bx.direction))
             if np.linalg.norm(rel - b * bx.direction) < _TOL * s and abs(b) > bx.span / 2:
                 if abs(b) - bx.span / 2 < dO:
                     dO, o_axis = abs(b) - bx.span / 2, bx
+                    o_body = next(o for o in (others or [other]) if o in bx.bodies)
     hub_r = float(min(R, d0 - g, dO - c))
     if hub_r < r_pin + prof.min_wall:
         return None
@@ -1111,7 +1165,151 @@ def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, 
     lay_c = lay
     return {"axis": ax, "u": u.copy(), "span": S, "k": k, "intervals": intervals, "stack": stack,
             "joint_iv": joint_iv, "hub_r": hub_r, "collar": d0 - g, "hub_v": 2 * (v0 - g), "layout": lay,
-            "o_axis": o_axis, "dO": dO, "layout_c": lay_c}
+            "o_axis": o_axis, "dO": dO, "layout_c": lay_c, "o_body": o_body}
+
+
+def _branch_groups(joints, scene) -> dict:
+    """Universal joints that share one point and one body (a connector branch: every page's
+    junction on the source half unit): ``{joint: (shared body, [joints of the group])}``."""
+    by: dict = {}
+    for jname, bonds in joints.items():
+        if bonds[0].kind != "universal":
+            continue
+        bd = bonds[0]
+        p = 0.5 * (scene.site_world(bd.a) + scene.site_world(bd.b))
+        key = tuple(np.round(p / _TOL).astype(np.int64).tolist())
+        for bn in (bd.a.split(".")[0], bd.b.split(".")[0]):
+            by.setdefault((bn, key), []).append(jname)
+    out: dict = {}
+    for (bn, _), members in by.items():
+        if len(members) < 2 or any(m in out for m in members):
+            continue
+        for m in members:
+            out[m] = (bn, list(members))
+    return out
+
+
+def _branch(members, S, joints, scene, bodies, axes, slabs, s, prof, R, r_pin, r_hole, kmin, t,
+            base_samples, reach, memo, state_T, h, notes):
+    """A branch junction: the universal joints ``members`` of the pages of a connector branch,
+    all at one point of the source body ``S``, as ONE joint part (their relative turns about
+    the source's hinge line are the same: a page turns about that line with the source's
+    half unit).  The part is a compound junction on ``S``'s hinge (its knuckle in the stack,
+    ball hub, collar), with one second pin across it carrying every page's yoke knuckle, one
+    knuckle per page, pages on the side of the pin where their arm leaves the joint, nearest
+    first; the outermost knuckle of each side closes the pin's end (a blind hole), so every
+    knuckle is held between the ball, its neighbours and that end:
+
+        [end | page .. | page | ball | page | page .. | end]   (along the second pin)
+
+    A page stacked on the source's hinge line (a chain's next layer) keeps the compound
+    junction's fin into its own end knuckle.  Returns (UJoints, compound) or None when the
+    pages' second pins are not one line or there is no room."""
+    c, g = prof.clearance, prof.knuckle_gap
+    pages = []
+    for jn in members:
+        bd = joints[jn][0]
+        a, b = bd.a.split(".")[0], bd.b.split(".")[0]
+        pages.append(b if a == S else a)
+    bd = joints[members[0]][0]
+    center = 0.5 * (scene.site_world(bd.a) + scene.site_world(bd.b)) * s
+    hx = _host_axis(S, axes, center, s, g)
+    if hx is None or len(set(pages)) != len(pages):
+        return None
+    comp = _compound(hx, center, S, pages[0], axes, s, prof, R, r_pin, kmin, others=pages)
+    if comp is None:
+        return None
+    u = comp["u"]
+    vs = []
+    for pg in pages:
+        v = _hinge_dir(pg, axes, slabs, center)
+        if abs(np.dot(u, v)) > 0.95:
+            w = np.mean([sb.center for sb in slabs[pg]], axis=0) - center
+            v = np.cross(u, w)
+            if np.linalg.norm(v) < 1e-9:
+                v = _perp_frame(u)[:, 0]
+        v = v - np.dot(v, u) * u
+        vs.append(v / np.linalg.norm(v))
+    v = vs[0]
+    if any(abs(float(np.dot(v, x))) < 0.99 for x in vs):
+        return None
+    # sides: where each page's nearest slab (its arm) lies along the pin; a stacked page first
+    sd = {}
+    for pg in pages:
+        near = min(slabs[pg], key=lambda sb: np.linalg.norm(sb.center - center))
+        sd[pg] = float(np.dot(near.center - center, v))
+    side: dict = {1: [], -1: []}
+    for pg in sorted(pages, key=lambda p: (p != comp["o_body"], abs(sd[p]))):
+        if pg == comp["o_body"] or abs(sd[pg]) < 0.1 * s:
+            sg = 1 if len(side[1]) <= len(side[-1]) else -1
+        else:
+            sg = 1 if sd[pg] > 0 else -1
+        side[sg].append(pg)
+    ky = max(kmin, R)
+    v0 = comp["hub_v"] / 2 + g
+    # the outermost knuckle of a side is held by a cap on the pin; a page whose arm leaves
+    # along the pin's line is joined to it by a bridge over the cap (:func:`_uj_plates`)
+    cap = max(kmin, prof.min_wall)
+    ivs, caps, ends = {}, {}, {1: 0.0, -1: 0.0}
+    for sg, lst in side.items():
+        a = v0
+        for i, pg in enumerate(lst):
+            ivs[pg] = (a, a + ky)
+            a += ky + g
+        if lst:
+            caps[sg] = (a, a + cap)
+            a += cap + g
+        ends[sg] = a - g
+    # room: no hinge of a page on the pin's line may come within the clearance of the yokes
+    for ax in axes:
+        if not any(pg in ax.bodies for pg in pages) or abs(abs(float(np.dot(ax.direction, v))) - 1) > 1e-6:
+            continue
+        rel = center - ax.origin
+        b = float(np.dot(rel, ax.direction))
+        if np.linalg.norm(rel - b * ax.direction) > _TOL * s:
+            continue
+        mid = float(np.dot(ax.origin - center, v))
+        if mid + ax.span / 2 > -ends[-1] - c and mid - ax.span / 2 < ends[1] + c:
+            return None
+    part = members[0] if members[0] not in bodies else f"joint_{members[0]}"
+    out = []
+    for jn, pg in zip(members, pages):
+        sg = 1 if pg in side[1] else -1
+        last = side[sg][-1] == pg
+        f = (lambda iv: (iv[0], iv[1])) if sg > 0 else (lambda iv: (-iv[1], -iv[0]))
+        own = f(ivs[pg])
+        plate = f((-R, ivs[pg][1])) if pg == comp["o_body"] else own
+        lay_o = YokeLayout("+" if sg > 0 else "-", [own], [f(caps[sg])] if last else [], f((0.0, caps[sg][1])),
+                           (-ends[-1], ends[1]), plate, holes=[f((ivs[pg][0] - g / 2, ivs[pg][1] + g / 2)) + (r_hole,)],
+                           bridge=f((ivs[pg][0], caps[sg][1] + g + t)) if last else ())
+        lays = (comp["layout_c"], lay_o)
+        uj = UJoint(jn, part, center, (S, pg), (u, v), lays, comp["hub_v"], R, r_pin, r_hole,
+                    (float(np.hypot(lay_o.extent, R)) + c, float(np.hypot(lays[0].extent, R)) + c))
+        uj.host, uj.hub_r, uj.collar = comp["axis"], comp["hub_r"], comp["collar"]
+        if pg == comp["o_body"] and np.isfinite(comp["dO"]):
+            uj.fin = comp["dO"] + t
+            uj.o_axis = comp["o_axis"]
+        uj.primary = not out
+        uj.mates = [p for p in side[sg] if p != pg]
+        smp = {bn: base_samples[bn] for bn in uj.bodies}
+        for k, bn in enumerate(uj.bodies):
+            smp[bn] = np.concatenate([smp[bn], _slab_samples(_uj_plates(uj, k, slabs[bn], uj.rho[k] + reach, t), h)])
+        need = _ujoint_trim_memo(memo, uj, smp, state_T, t, c, h)
+        uj.rho = (max(uj.rho[0], need[0]), max(uj.rho[1], need[1]))
+        out.append(uj)
+    return out, comp
+
+
+def _own_lines(bn, center, d, axes, s) -> None:
+    """Re-lay (:func:`_own_ends`) every hinge of body ``bn`` on the line through ``center``
+    along ``d``: a yoke whose arm runs along its own hinge's line joins that hinge's end knuckle."""
+    for ax in axes:
+        if bn not in ax.bodies or abs(float(np.dot(ax.direction, d))) < 0.9:
+            continue
+        rel = center - ax.origin
+        b = float(np.dot(rel, ax.direction))
+        if np.linalg.norm(rel - b * ax.direction) < _TOL * s and abs(b) > ax.span / 2:
+            _own_ends(ax, bn)
 
 
 def _own_ends(ax: HingeAxis, bn: str) -> None:
@@ -1758,14 +1956,30 @@ def _uj_plates(uj: UJoint, side: int, sbs, reach, t):
         a0, a1 = lay.plate
         Rm = np.column_stack([v, u, e])
         return [SlabBox(uj.center + v * 0.5 * (a0 + a1) + u * 0.5 * uj.fin, Rm, np.array([a1 - a0, uj.fin, t]), 2)]
+    if lay.holes is not None:   # branch junction: only slabs that pass the knuckle (not the page's far slabs)
+        out = _yoke_plates(sbs, uj.center, uj.axes[side], [lay.plate], reach, t, along=True)
+        if lay.bridge:
+            # over the cap, on the side away from the source (+u), out to the trim radius and
+            # back to the line past the cap (where an arm along the line goes on)
+            u, v = uj.axes
+            b0, b1 = lay.bridge
+            hgt = uj.rho[side] + t
+            out.append(SlabBox(uj.center + v * 0.5 * (b0 + b1) + u * 0.5 * hgt, np.column_stack([v, u, np.cross(v, u)]),
+                               np.array([abs(b1 - b0), hgt, t]), 2))
+        return out
     return _yoke_plates(sbs, uj.center, uj.axes[side], [lay.plate], reach, t)
 
 
-def _yoke_plates(sbs, origin, d, intervals, reach, t):
-    """Plates (as slab boxes) widening a body's slabs over ``intervals`` of an axis."""
+def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False):
+    """Plates (as slab boxes) widening a body's slabs over ``intervals`` of an axis (``along``:
+    only slabs whose extent along the axis overlaps the interval)."""
     out = []
     for sb in sbs:
         rel = sb.center - origin
+        if along:
+            mid, half_d = float(np.dot(rel, d)), 0.5 * float(np.sum(np.abs(sb.R.T @ d) * sb.size))
+            if not any(mid - half_d < a1 and mid + half_d > a0 for a0, a1 in intervals):
+                continue
         perp = rel - np.dot(rel, d) * d
         nrm = sb.R[:, sb.normal_axis]
         w = perp - np.dot(perp, nrm) * nrm

@@ -151,11 +151,12 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
 
     _log("check watertight done")
     # -- part count --------------------------------------------------------------
-    expected = len(asm.scene.bodies) + len(asm.ujoints)
+    n_joint = len({u.part for u in asm.ujoints})     # a branch junction: several joints, one part
+    expected = len(asm.scene.bodies) + n_joint
     split = [f"{i['name']} is in {i['pieces']} pieces" for i in info if i["pieces"] != 1]
     checks.append(Check("part_count", pieces == expected and not split, pieces, expected,
                         f"{pieces} pieces printed, expected {len(asm.scene.bodies)} bodies + "
-                        f"{len(asm.ujoints)} joint parts = {expected}", split))
+                        f"{n_joint} joint parts = {expected}", split))
 
     _log("check part count done")
     # -- min gap at rest -------------------------------------------------------------
@@ -384,7 +385,8 @@ def _retention(asm: Assembly) -> Check:
         mates = [C, O] + ([o for o in uj.host.bodies if o not in (C, O)] if getattr(uj, "host", None) else [])
         # compound junction: C turns in its hinge's stack, held there by the joint and the stack
         hold = [uj.part] + [o for o in mates if o not in (C, O)]
-        for who, partners, d in ((C, hold, uj.axes[0]), (O, [uj.part], uj.axes[1]),
+        # branch junction: a page's knuckle is held by the joint part and its neighbours on the pin
+        for who, partners, d in ((C, hold, uj.axes[0]), (O, [uj.part] + list(getattr(uj, "mates", [])), uj.axes[1]),
                                  (uj.part, mates, uj.axes[0])):
             if getattr(uj, "host", None) is not None and who != O:
                 continue     # compound junction: C and the joint part are tested on C's hinge (above)

@@ -76,7 +76,7 @@ def part_frames(asm) -> list[np.ndarray]:
     from mlc.geometry.rotation import quat_to_matrix
     s = asm.profile.sigma_mm
     bodies = {b.name: b for b in asm.scene.bodies}
-    joints = {u.part: u for u in asm.ujoints}
+    joints = {u.part: u for u in asm.ujoints if getattr(u, "primary", True)}
     out = []
     for p in asm.parts:
         F = np.eye(4)
