@@ -23,7 +23,7 @@ def register(sub):
     p.add_argument("--workers", type=int, default=None,
                    help="worker processes of the local cluster (one thread each; default 1)")
     p.add_argument("--retry-failed", action="store_true", help="run failed runs of the table again")
-    p.add_argument("--kind", default=None, help="plot: response_grid or signal_vs_length (default: the spec's)")
+    p.add_argument("--kind", default=None, help="plot: response_grid, signal_vs_length or reliability_map (default: the spec's)")
     p.add_argument("--json", action="store_true", help="print a JSON summary")
     p.add_argument("--quiet", action="store_true", help="no progress bar")
     p.set_defaults(func=run)
@@ -79,6 +79,11 @@ def _plot(args) -> int:
                 extra = {k: v for k, v in r.items() if k not in ("units", "frequency") and not k.startswith(("rms", "y_", "wall", "seeds"))}
                 print(f"  units {r['units']:>2}  f {r['frequency']:<5g} {extra if extra else ''} RMS deviation "
                       f"{100 * r['rms_dev_mean']:.1f} ± {100 * r['rms_dev_sd']:.1f} % ({r['seeds']} seeds)")
+            elif kind == "reliability_map":
+                p = "failed" if r["p_wrong"] is None else f"{100 * r['p_wrong']:.3g} %"
+                print(f"  tolerance {r['tolerance']:<6g} kT {r['kT']:<7g} P(wrong) {p}"
+                      f"{' (' + str(r['failed_runs']) + ' failed runs)' if r['failed_runs'] else ''}"
+                      f"{'  FAILS' if r['fails'] else ''}")
             else:
                 head = {k: v for k, v in r.items() if k not in ("units", "mean", "var", "var_time", "var_seed_means", "sem", "drift")}
                 print(f"  {head}: signal length " + ", ".join(f"{m:.4f}" for m in r["mean"]))

@@ -19,7 +19,10 @@ Measurements (all lengths in sigma, times in t0):
 * ``steady`` (paper Fig. 5D): constant drives ``inputs``; after ``time`` t0, every
   probe's mean, variance over time (population) and fraction of samples on the wrong
   side of its threshold (``{probe}_mean``, ``{probe}_var``, ``{probe}_wrong``, the
-  expected bit from the scene's truth table) over the last ``window`` of the run, and
+  expected bit from the scene's truth table) over the last ``window`` of the run,
+  ``{probe}_off`` (fraction of samples farther than half the swing |L1 - L0|/2 from the
+  expected state's length: a wrong bit, or no bit at all, e.g. a collapsed chain reading
+  0.3 sigma for a 1.0/1.5 sigma signal, which the threshold alone reads as 0), and
   ``{probe}_drift``: the mean of the window's second half less that of its first half
   (a check that the run was long enough to be stationary).
 """
@@ -156,6 +159,8 @@ def steady(scene, params: dict, seed: int):
         if expected is not None and j < len(expected) and expected[j] in "01":
             bits = np.array([p.bit(v) for v in x])
             row[f"{p.name}_wrong"] = float(np.mean(bits != int(expected[j])))
+            want = p.actuated if expected[j] == "1" else p.rest
+            row[f"{p.name}_off"] = float(np.mean(np.abs(x - want) > 0.5 * abs(p.actuated - p.rest)))
     row["samples"] = int(m.sum())
     row.update({"steps": int(res.steps), "force_evals": int(res.force_evals), "dt_used": float(res.dt)})
     return row, None

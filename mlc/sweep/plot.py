@@ -11,6 +11,9 @@
   (and per value of any other varied parameter), points at the mean over seeds and time,
   bars of +- the variance over seeds and time (as the paper draws them; the variance is
   also in the summary).
+* ``reliability_map`` (beyond the paper, issue 11): the probability that the output reads
+  the wrong bit against kT and joint tolerance, pooled over input rows and seeds, with
+  the failure boundary (P >= 1 % or a failed run) marked.
 
 The summary (JSON) holds the numbers behind each plot.
 """
@@ -176,7 +179,135 @@ def signal_vs_length(d: Path, png: Path):
             "rows": summary}
 
 
-PLOTS = {"response_grid": response_grid, "signal_vs_length": signal_vs_length}
+#: the failure boundary: a cell fails when its probability of a wrong bit reaches this, or a run failed
+FAIL_P = 0.01
+
+
+def _wrong_probe(cols) -> tuple[str, str]:
+    """(probe, column suffix) the map shows: ``out`` if the scene has it, else the last
+    probe (``u{n}``: the far end of a chain); ``_off`` (not the right bit: wrong or no bit)
+    where the table has it, else ``_wrong`` (tables of older sweeps)."""
+    suffix = "_off" if any(c.endswith("_off") for c in cols) else "_wrong"
+    probes = [c[:-len(suffix)] for c in cols if c.endswith(suffix)]
+    if not probes:
+        raise MlcError("a reliability map needs wrong-bit columns ({probe}_wrong: measure steady on a scene "
+                       "with a truth table)", "results.csv")
+    if "out" in probes:
+        return "out", suffix
+    return max(probes, key=lambda p: (p[1:].isdigit(), int(p[1:]) if p[1:].isdigit() else 0, p)), suffix
+
+
+def reliability_map(d: Path, png: Path):
+    """Probability of reading the wrong bit against kT (columns) and joint tolerance (rows).
+
+    Per cell (kT, tolerance): every run (seeds x input rows) is pooled; P(wrong) is the
+    mean over runs of the fraction of the measured window's samples in which the probe
+    (``out``, or the chain's far end) is not the right bit (column ``{probe}_off``: farther
+    than half the swing from the expected state's length, so a wrong bit or no bit; tables
+    without it use ``{probe}_wrong``, the threshold alone), with the worst single run
+    beside it.  A run that failed (the integrator's stability error: bonds torn) counts
+    as a failure of the cell.  A cell fails when P(wrong) >= FAIL_P (1 %) or a run failed;
+    the failure boundary is drawn, for each tolerance, between the largest kT below every
+    failing cell and the next one.  P = 0 is shown as "< 1/n" (n = samples pooled), the
+    resolution of the measurement; samples within a run are correlated, so the number of
+    independent readings is smaller."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    from matplotlib.colors import LogNorm
+    meta_p = d / "sweep.json"
+    if not (d / TABLE).exists() or not meta_p.exists():
+        raise MlcError("not a sweep results directory (no results.csv and sweep.json)", str(d),
+                       "give the directory `mlc sweep SPEC -o DIR` wrote")
+    meta = json.loads(meta_p.read_text("utf-8"))
+    cols, allrows = read_table(d / TABLE)
+    for need in ("kT", "tolerance"):
+        if need not in cols:
+            raise MlcError(f"a reliability map needs the parameter {need!r} in the table", str(d / TABLE))
+    ok = [r for r in allrows if r["status"] == "ok"]
+    probe, suffix = _wrong_probe(cols)
+    col = probe + suffix
+    kts = sorted({float(r["kT"]) for r in allrows})
+    tols = sorted({float(r["tolerance"]) for r in allrows})
+    P = np.full((len(tols), len(kts)), np.nan)
+    worst = np.full_like(P, np.nan)
+    nfail = np.zeros(P.shape, int)
+    nruns = np.zeros(P.shape, int)
+    floor = np.full_like(P, np.nan)
+    cells = []
+    for i, tol in enumerate(tols):
+        for j, kT in enumerate(kts):
+            sel = [r for r in allrows if float(r["kT"]) == kT and float(r["tolerance"]) == tol]
+            good = [r for r in sel if r["status"] == "ok" and r.get(col, "") not in ("", "nan")]
+            nruns[i, j] = len(sel)
+            nfail[i, j] = len(sel) - len(good)
+            samples = sum(int(float(r.get("samples") or 0)) for r in good)
+            if good:
+                w = np.array([float(r[col]) for r in good])
+                P[i, j], worst[i, j] = float(w.mean()), float(w.max())
+                floor[i, j] = 1.0 / max(samples, 1)
+            fails = bool(nfail[i, j]) or (good and P[i, j] >= FAIL_P)
+            cells.append({"tolerance": tol, "kT": kT, "runs": len(sel), "failed_runs": int(nfail[i, j]),
+                          "p_wrong": None if not good else float(P[i, j]),
+                          "p_wrong_worst_run": None if not good else float(worst[i, j]),
+                          "samples": samples, "resolution": None if not good else float(floor[i, j]),
+                          "fails": bool(fails),
+                          "errors": sorted({r["error"][:160] for r in sel if r["status"] != "ok"})[:3]})
+    fails = np.array([[c["fails"] for c in cells[i * len(kts):(i + 1) * len(kts)]] for i in range(len(tols))])
+    # boundary: per tolerance, the first failing kT (all cells from there on are counted failing)
+    boundary = []
+    for i, tol in enumerate(tols):
+        jf = next((j for j in range(len(kts)) if fails[i, j]), None)
+        boundary.append({"tolerance": tol, "last_ok_kT": kts[jf - 1] if jf else (kts[-1] if jf is None else None),
+                         "first_failing_kT": kts[jf] if jf is not None else None})
+    fig, ax = plt.subplots(figsize=(1.0 * len(kts) + 2.8, 0.62 * len(tols) + 2.2))
+    shown = np.where(np.isnan(P), np.nan, np.maximum(P, np.nan_to_num(floor, nan=1e-6) * 0.5))
+    vmin = max(1e-5, float(np.nanmin(shown)) if np.isfinite(shown).any() else 1e-5)
+    im = ax.imshow(shown, origin="lower", aspect="auto", cmap="viridis_r",
+                   norm=LogNorm(vmin=min(vmin, 1e-3), vmax=1.0))
+    for i in range(len(tols)):
+        for j in range(len(kts)):
+            if nfail[i, j] and np.isnan(P[i, j]):
+                txt = f"failed\n{nfail[i, j]}/{nruns[i, j]}"
+            elif np.isnan(P[i, j]):
+                txt = "-"
+            elif P[i, j] == 0:
+                txt = f"<{floor[i, j]:.1e}"
+            else:
+                txt = f"{100 * P[i, j]:.2g} %"
+                if nfail[i, j]:
+                    txt += f"\n{nfail[i, j]} failed"
+            dark = np.isfinite(shown[i, j]) and shown[i, j] > 0.05
+            ax.text(j, i, txt, ha="center", va="center", fontsize=7, color="white" if dark else "black")
+            if nfail[i, j]:
+                ax.add_patch(plt.Rectangle((j - 0.5, i - 0.5), 1, 1, fill=False, hatch="///", ec="0.4", lw=0))
+    # the failure boundary: a staircase between the last good and the first failing column
+    xs, ys = [], []
+    for i, b in enumerate(boundary):
+        x = (kts.index(b["first_failing_kT"]) - 0.5) if b["first_failing_kT"] is not None else len(kts) - 0.5
+        xs += [x, x]
+        ys += [i - 0.5, i + 0.5]
+    ax.plot(xs, ys, color="red", lw=2.5, label=f"failure boundary (P(wrong) >= {100 * FAIL_P:g} % or a failed run)")
+    ax.set_xticks(range(len(kts)), [f"{k:g}" for k in kts], fontsize=8)
+    ax.set_yticks(range(len(tols)), [f"{t:g}" for t in tols], fontsize=8)
+    ax.set_xlabel("kT ($k_0\\sigma^2$)")
+    ax.set_ylabel("joint tolerance ($\\sigma$)")
+    what = "is not the right bit (wrong or no bit)" if suffix == "_off" else "reads the wrong bit"
+    ax.set_title(f"{meta.get('name', d.name)}: probability that {probe} {what}\n"
+                 f"(pooled over input rows and seeds)", fontsize=9)
+    fig.colorbar(im, ax=ax, label="P(wrong bit)")
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.22))
+    fig.tight_layout()
+    fig.savefig(png, dpi=110)
+    plt.close(fig)
+    return {"kind": "reliability_map", "probe": probe, "column": col, "fail_p": FAIL_P,
+            "definition": "P(wrong) = mean over the cell's runs (input rows x seeds) of the fraction of the "
+                          "measured window's samples in which the probe is not the right bit (column); a cell fails at P >= fail_p or when a "
+                          "run failed; resolution = 1/(samples pooled) (samples are correlated in time)",
+            "failed_runs": int(nfail.sum()), "boundary": boundary, "rows": cells}
+
+
+PLOTS = {"response_grid": response_grid, "signal_vs_length": signal_vs_length, "reliability_map": reliability_map}
 
 
 def plot_sweep(d, png=None, kind=None) -> tuple[dict, str]:
@@ -190,4 +321,4 @@ def plot_sweep(d, png=None, kind=None) -> tuple[dict, str]:
     return kind, PLOTS[kind]
 
 
-__all__ = ["PLOTS", "plot_sweep", "response_grid", "signal_vs_length"]
+__all__ = ["PLOTS", "plot_sweep", "reliability_map", "response_grid", "signal_vs_length"]
