@@ -459,8 +459,10 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                 hx.joint, hx.joint_iv = br_uj[0].part, comp["joint_iv"]
                 if comp["o_axis"] is not None:
                     _own_ends(comp["o_axis"], comp["o_body"])
-                for u_ in br_uj:
-                    _own_lines(u_.bodies[1], u_.center, u_.axes[1], axes, s)
+                for u_ in br_uj:      # a page's arm runs along its own hinge's line to the joint point
+                    for ax_ in axes:
+                        if u_.bodies[1] in ax_.bodies:
+                            _own_lines(u_.bodies[1], u_.center, ax_.direction, [ax_], s)
                 features.append((f"knuckle length ({hx.name}, with joint {br_uj[0].part})", hx.knuckle,
                                  prof.min_feature))
                 features.append((f"hub wall ({br_uj[0].part})", br_uj[0].hub_r - r_pin, prof.min_wall))
@@ -1224,6 +1226,8 @@ def _branch(members, S, joints, scene, bodies, axes, slabs, s, prof, R, r_pin, r
     for pg in pages:
         v = _hinge_dir(pg, axes, slabs, center)
         if abs(np.dot(u, v)) > 0.95:
+            if len(vs) < len(pages) - 1 or vs:
+                continue      # a page stacked on the source's line: any pin across u; the others' then
             w = np.mean([sb.center for sb in slabs[pg]], axis=0) - center
             v = np.cross(u, w)
             if np.linalg.norm(v) < 1e-9:
@@ -1278,9 +1282,9 @@ def _branch(members, S, joints, scene, bodies, axes, slabs, s, prof, R, r_pin, r
         last = side[sg][-1] == pg
         f = (lambda iv: (iv[0], iv[1])) if sg > 0 else (lambda iv: (-iv[1], -iv[0]))
         own = f(ivs[pg])
-        plate = f((-R, ivs[pg][1])) if pg == comp["o_body"] else own
+        plate = f((-min(R, v0 - c), ivs[pg][1])) if pg == comp["o_body"] else own
         lay_o = YokeLayout("+" if sg > 0 else "-", [own], [f(caps[sg])] if last else [], f((0.0, caps[sg][1])),
-                           (-ends[-1], ends[1]), plate, holes=[f((ivs[pg][0] - g / 2, ivs[pg][1] + g / 2)) + (r_hole,)],
+                           (-ends[-1] - g, ends[1] + g), plate, holes=[f((ivs[pg][0] - g / 2, ivs[pg][1] + g / 2)) + (r_hole,)],
                            bridge=f((ivs[pg][0], caps[sg][1] + g + t)) if last else ())
         lays = (comp["layout_c"], lay_o)
         uj = UJoint(jn, part, center, (S, pg), (u, v), lays, comp["hub_v"], R, r_pin, r_hole,
@@ -1982,7 +1986,9 @@ def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False):
                 continue
         perp = rel - np.dot(rel, d) * d
         nrm = sb.R[:, sb.normal_axis]
-        w = perp - np.dot(perp, nrm) * nrm
+        # in the slab's plane; a rod (two thin sides: a page's arm) has no plane: straight at it
+        rod = along and sorted(sb.size)[1] <= 2 * t
+        w = perp if rod else perp - np.dot(perp, nrm) * nrm
         if np.linalg.norm(w) < 1e-6:
             continue
         w = w / np.linalg.norm(w)
