@@ -259,9 +259,30 @@ class Simulation:
                 dt = float(f"{dt:.1g}") if dt > 0 else dt
             else:
                 dt = STIFF_DT_DEFAULT
+            lim_r = self._euler_rot_limit()
+            if dt > lim_r:
+                dt = _floor1(lim_r)
         if not (math.isfinite(dt) and dt > 0):
             raise MlcError(f"dt must be a positive number of t0, got {dt}", "--dt")
+        lim_r = self._euler_rot_limit()
+        if dt > lim_r:
+            raise MlcError(f"dt = {dt:g} t0 is too large for Euler with rotational noise at kT = {self.opt.kT:g}: "
+                           f"its rotational noise variance per step 2 kT dt/gamma_r would exceed "
+                           f"{self.opt.rot_var_max:g} rad^2 (the exponential map then biases D_r by more than 1 %)",
+                           "--dt", f"use --dt {_floor1(lim_r):g} or less, or the stiff scheme (it substeps)")
         return float(dt)
+
+    def _euler_rot_limit(self) -> float:
+        """Largest Euler dt (t0) with rotational noise: one step's rotational noise variance
+        2 kT h/gamma_r at most ``rot_var_max`` (rad^2).  The exponential map of a Gaussian
+        rotation vector of per-axis variance s^2 turns a body axis by <u(h).u(0)> =
+        1/3 + (2/3)(1 - s^2) exp(-s^2/2), against the exact exp(-s^2): D_r is overestimated
+        by ~s^2/12 (+0.85 % at s^2 = 0.1, +10 % at s^2 = 1; tests/test_sim_stats.py).  No
+        limit without rotational noise, at kT = 0, or for the stiff scheme (which substeps)."""
+        o = self.opt
+        if not (o.scheme == "euler" and o.rot_noise and o.kT > 0):
+            return math.inf
+        return o.rot_var_max * self.gamma_r / (2.0 * o.kT) / self.t_unit
 
     def _grow_nlist(self):
         """Enlarge the neighbour list after an overflow (the kernels stopped; the caller redoes the work)."""
@@ -468,8 +489,10 @@ class Simulation:
             return {"scheme": "euler", "h_rho": hr, "ratio_min": 1.0, "ratio_max": v,
                     "note": "stiffest mode 1/(1 - h lambda/2); softer modes lie between"}
         if self.opt.fluct:
-            return {"scheme": "stiff-fluct", "h_rho": hr, "ratio_min": 1.0, "ratio_max": 1.0,
-                    "note": "post-processed SK-ROCK with eta = 0: exact for every linear mode"}
+            out = {"scheme": "stiff-fluct", "h_rho": hr, "ratio_min": 1.0, "ratio_max": 1.0,
+                   "note": "post-processed SK-ROCK with eta = 0: exact for every linear mode"}
+            out.update(fluct_pair_bias(self.opt.kT, dt))
+            return out
         lo, hi = skrock_variance_range(hr, self.opt.eta, hr * self.opt.rho_safety)
         return {"scheme": "stiff", "h_rho": hr, "ratio_min": lo, "ratio_max": hi,
                 "note": "SK-ROCK variance ratio over modes with h lambda in (0, h rho]"}
@@ -590,6 +613,58 @@ def _count(done: int, every: int, phase: int) -> int:
         return 0
     first = (-phase) % every
     return 0 if first >= done else (done - 1 - first) // every + 1
+
+
+#: Fluctuation mode, measured bias beyond linear theory (benchmarks/sim_fluct_bias.py,
+#: benchmarks/results/sim_fluct_bias.json): bond-length variance over its exact Boltzmann
+#: value for 200 bonded pairs (one bond, k = 1 k0, rest 1 sigma, between the bodies'
+#: centres, no rotational noise), per kT (k0 sigma^2): (dt in t0, ratio); sampling error
+#: ~0.01 (0.03-0.05 at the largest dt, where only 5-25 steps were measured).
+FLUCT_PAIR_RATIO = {
+    1e-5: ((0.01, 1.002), (0.05, 0.997), (0.2, 0.910), (0.5, 0.998), (2.0, 0.969), (5.0, 1.011), (20.0, 1.031),
+           (100.0, 0.997)),
+    1e-4: ((0.01, 1.013), (0.05, 1.004), (0.2, 0.976), (0.5, 0.993), (2.0, 1.035), (5.0, 1.039), (20.0, 1.022),
+           (100.0, 1.029)),
+    1e-3: ((0.01, 1.020), (0.05, 1.006), (0.2, 1.037), (0.5, 1.063), (2.0, 1.038), (5.0, 1.209), (20.0, 1.187),
+           (100.0, 0.994)),
+    1e-2: ((0.01, 1.100), (0.05, 1.078), (0.2, 1.096), (0.5, 1.185), (2.0, 1.258), (5.0, 1.305), (20.0, 1.176)),
+}
+
+
+def fluct_pair_bias(kT: float, dt: float) -> dict:
+    """The fluctuation mode's measured bias on bonded pairs (:data:`FLUCT_PAIR_RATIO`) at the
+    measured kT nearest ``kT`` (in log) and ``dt`` (t0) interpolated in log dt (clamped to the
+    measured range), with the pair's noise turn per step phi^2 = 4 kT h/(gamma L^2)
+    (h = dt in gamma/k0, L = 1 sigma).  Keys: pair_ratio_measured, pair_ratio_kT,
+    noise_turn_rad2, pair_note.  Empty at kT = 0 (no fluctuations)."""
+    if not (kT > 0 and dt > 0):
+        return {}
+    kk = min(FLUCT_PAIR_RATIO, key=lambda k: abs(math.log10(k) - math.log10(kT)))
+    pts = FLUCT_PAIR_RATIO[kk]
+    x = min(max(math.log10(dt), math.log10(pts[0][0])), math.log10(pts[-1][0]))
+    ratio = pts[-1][1]
+    for (d0, r0), (d1, r1) in zip(pts[:-1], pts[1:]):
+        a, b = math.log10(d0), math.log10(d1)
+        if a <= x <= b:
+            ratio = r0 + (r1 - r0) * (x - a) / (b - a)
+            break
+    far = abs(math.log10(kk) - math.log10(kT)) > 0.5 or not (pts[0][0] <= dt <= pts[-1][0])
+    return {"pair_ratio_measured": round(ratio, 3), "pair_ratio_kT": kk,
+            "noise_turn_rad2": 4.0 * kT * dt * 1e3,
+            "pair_note": "measured bond-length variance / exact of a bonded pair (k = 1 k0, rest 1 sigma) at this "
+                         "dt and the nearest measured kT (benchmarks/sim_fluct_bias.py): the geometric nonlinearity "
+                         "linear theory misses: mostly within 5 % at kT <= 1e-4 up to dt = 100 t0, and at kT = 1e-3 up to "
+                         "dt = 0.2 t0 (single runs of 100 steps; modes near a Chebyshev extremum relax slowly and "
+                         "scatter by up to 10 %); +6 to +21 % at kT = 1e-3 beyond, +8 to +31 % at kT = 1e-2" + ("; outside the measured range: an extrapolation"
+                                                                     if far else "")}
+
+
+def _floor1(x: float) -> float:
+    """``x`` rounded down to one significant digit (a dt to suggest: never above ``x``)."""
+    e = math.floor(math.log10(x))
+    m = math.floor(x / 10.0 ** e * (1 + 1e-12))
+    v = float(f"{m}e{e}")
+    return v if v <= x else float(f"{m - 1}e{e}") if m > 1 else float(f"9e{e - 1}")
 
 
 def skrock_variance_range(h_rho: float, eta: float, h_rho_max: float | None = None) -> tuple[float, float]:
