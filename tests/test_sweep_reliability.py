@@ -88,3 +88,15 @@ def test_reliability_map_prefers_not_a_bit_over_wrong_bit(tmp_path):
     out = reliability_map(d, tmp_path / "map.png")
     assert out["column"] == "out_off"
     assert out["rows"][0]["p_wrong"] == pytest.approx(0.4) and out["rows"][0]["fails"]
+
+
+def test_steady_reports_not_a_bit_fraction():
+    # a real run: the NAND gate in row 11 at the paper's temperature reads its bit all the time
+    from mlc.sweep.measure import steady
+    from mlc.sweep.scenes import gate
+    from mlc.sweep.spec import MEASURE_PARAMS, SIM_PARAMS
+    p = {**SIM_PARAMS, **MEASURE_PARAMS["steady"], "time": 1.0, "window": 0.5, "record": 0.01,
+         "inputs": {"a": 1, "b": 1}}
+    row, _ = steady(gate("NAND"), p, 0)
+    assert row["out_wrong"] == 0.0 and row["out_off"] == 0.0 and row["samples"] >= 10
+    assert abs(row["out_mean"] - 1.0) < 0.05
