@@ -1,16 +1,19 @@
-"""Speed against error of the stiff scheme on the Tetris robot (issue 10, item 6): one row
-from rest at several steps dt, one seed; the joint angles at the end and averaged over
-the last ``--avg`` t0, against the run at the smallest dt (the reference) and against
-the row's targets; wall time.
+"""Speed against error of the stiff scheme on the Tetris robot (issue 10, item 6): rows
+from rest at several steps dt, over several seeds; the joint angles at the end and averaged
+over the last ``--avg`` t0, against the runs at the smallest dt (the reference) and
+against the row's targets; wall time.
 
 At kT = 1e-5 two runs with different dt follow different noise paths (the increments
-are drawn per step), so the angle differences contain the thermal spread of the joints
-(1.4-7 deg for the lever DOFs, docs/robot.md 3.2) on top of the discretisation error.
-The time-averaged angles (mean over the last ``--avg`` t0, sampled every 5 t0) lower the
-noise part.  ``--kT 0`` removes it (deterministic runs).
+are drawn per step), so one seed's angle differences contain the thermal spread of the
+joints (1.4-7 deg for the lever DOFs, docs/robot.md 3.2) on top of the discretisation
+error.  With several seeds per dt (``--seeds``) the comparison is of seed means: for each
+DOF the difference of the seed-averaged time-averaged angle at dt to that at the
+reference dt, with the error bar sqrt(sd_dt^2 / n_dt + sd_ref^2 / n_ref) (sd: the spread
+over seeds, ddof 1); a difference within 2 error bars is not resolved from noise.
+``--kT 0`` removes the noise (deterministic runs).
 
-    python benchmarks/robot_speed_error.py OUT/robot.yaml [--rows 00 01] [--dts 0.4 0.2 0.1 0.05]
-        [--time 400] [--avg 100] [--seed 0] [-o benchmarks/results/robot_speed_error.json]
+    python benchmarks/robot_speed_error.py OUT/robot.yaml [--rows 00 01] [--dts 0.2 0.1 0.05]
+        [--seeds 0 1 2] [--time 300] [--avg 100] [-o benchmarks/results/robot_speed_error.json]
     python benchmarks/robot_speed_error.py --plot benchmarks/results/robot_speed_error.json
 
 Runs are merged into the JSON (keyed by row, dt, kT, seed, time), one at a time.
@@ -74,6 +77,47 @@ def compare(runs: list[dict]) -> list[dict]:
     return out
 
 
+def compare_seeds(runs: list[dict]) -> list[dict]:
+    """Per (row, kT, time, dt): the seed means and spreads (sd over seeds, ddof 1) of every
+    DOF's time-averaged and final angle, and their differences to the smallest dt's seed
+    means with the error bar sqrt(sd^2/n + sd_ref^2/n_ref); ``resolved`` lists the DOFs
+    whose time-averaged difference exceeds 2 error bars (deg and rad)."""
+    out = []
+    keys = sorted({(r["row"], r["kT"], r["time_t0"]) for r in runs})
+    for k in keys:
+        rk = [r for r in runs if (r["row"], r["kT"], r["time_t0"]) == k]
+        dts = sorted({r["dt"] for r in rk})
+        stats = {}
+        for dt in dts:
+            rs = sorted([r for r in rk if r["dt"] == dt], key=lambda r: r["seed"])
+            m = np.array([r["angle_mean_deg"] for r in rs])
+            e = np.array([r["angle_end_deg"] for r in rs])
+            n = len(rs)
+            sd = m.std(0, ddof=1) if n > 1 else np.full(m.shape[1], np.nan)
+            sde = e.std(0, ddof=1) if n > 1 else np.full(e.shape[1], np.nan)
+            stats[dt] = (n, m.mean(0), sd, e.mean(0), sde, [r["seed"] for r in rs],
+                         float(np.mean([r["wall_s"] for r in rs])), rs[0]["dofs"], rs[0]["target_deg"])
+        ref = stats[dts[0]]
+        for dt in dts:
+            n, mu, sd, mue, sde, seeds, wall, dofs, tgt = stats[dt]
+            bar = np.sqrt(sd ** 2 / n + ref[2] ** 2 / ref[0])
+            bare = np.sqrt(sde ** 2 / n + ref[4] ** 2 / ref[0])
+            d = mu - ref[1]
+            de = mue - ref[3]
+            res = [dofs[i] for i in range(len(d)) if abs(d[i]) > 2 * bar[i]]
+            out.append({"row": k[0], "kT": k[1], "time_t0": k[2], "dt": dt, "ref_dt": dts[0], "seeds": seeds,
+                        "wall_s_mean": round(wall, 1), "dofs": dofs, "target_deg": tgt,
+                        "mean_deg": [round(float(x), 3) for x in mu], "sd_seeds_deg": [round(float(x), 3) for x in sd],
+                        "end_deg": [round(float(x), 3) for x in mue], "sd_end_seeds_deg": [round(float(x), 3) for x in sde],
+                        "diff_mean_deg": [round(float(x), 3) for x in d], "bar_mean_deg": [round(float(x), 3) for x in bar],
+                        "diff_end_deg": [round(float(x), 3) for x in de], "bar_end_deg": [round(float(x), 3) for x in bare],
+                        "max_abs_diff_mean_deg": round(float(np.max(np.abs(d))), 3),
+                        "max_abs_diff_mean_rad": round(math.radians(float(np.max(np.abs(d)))), 4),
+                        "max_bar_mean_deg": round(float(np.nanmax(bar)), 3) if np.isfinite(bar).any() else None,
+                        "resolved_2bar": res, "within_2bar": not res})
+    return out
+
+
 def plot(path: str) -> str:
     import matplotlib
     matplotlib.use("Agg")
@@ -81,6 +125,8 @@ def plot(path: str) -> str:
 
     with open(path) as f:
         data = json.load(f)
+    if data.get("seed_comparison"):
+        return plot_seeds(data, path)
     cmp_ = data["comparison"]
     fig, ax = plt.subplots(1, 2, figsize=(9, 3.6))
     for row in sorted({c["row"] for c in cmp_}):
@@ -110,6 +156,48 @@ def plot(path: str) -> str:
     return png
 
 
+def plot_seeds(data: dict, path: str) -> str:
+    """Left: per row, each DOF's seed-averaged time-averaged angle minus the reference dt's,
+    with the error bar (deg); right: wall time per run against dt."""
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    sc = data["seed_comparison"]
+    rows = sorted({c["row"] for c in sc})
+    fig, ax = plt.subplots(1, len(rows) + 1, figsize=(4.2 * (len(rows) + 1), 3.8))
+    marks = {0.05: "o", 0.1: "s", 0.2: "^", 0.4: "v"}
+    for a, row in zip(ax, rows):
+        cs = sorted([c for c in sc if c["row"] == row], key=lambda c: c["dt"])
+        dofs = cs[0]["dofs"]
+        x = np.arange(len(dofs))
+        for j, c in enumerate(cs):
+            off = (j - 0.5 * (len(cs) - 1)) * 0.18
+            a.errorbar(x + off, c["diff_mean_deg"], yerr=[2 * b for b in c["bar_mean_deg"]], fmt=marks.get(c["dt"], "d"),
+                       ms=4, capsize=2, lw=1, label=f"dt {c['dt']:g} ({len(c['seeds'])} seeds)")
+        a.axhline(0, color="k", lw=0.5)
+        for y in (math.degrees(0.05), -math.degrees(0.05)):
+            a.axhline(y, color="grey", ls=":", lw=1)
+        a.set_xticks(x)
+        a.set_xticklabels(dofs, rotation=60, fontsize=7)
+        a.set_ylabel(f"seed-mean angle - dt {cs[0]['ref_dt']:g} (deg), 2 error bars")
+        a.set_title(f"row {row}, {cs[0]['time_t0']:g} t0, mean of last {data.get('avg', 100):g} t0", fontsize=8)
+        a.legend(fontsize=7)
+    runs = [r for r in data["runs"] if "failed" not in r]
+    for row in rows:
+        rr = sorted([r for r in runs if r["row"] == row], key=lambda r: r["dt"])
+        ax[-1].plot([r["dt"] for r in rr], [r["wall_s"] for r in rr], "o", label=f"row {row}", alpha=0.7)
+    ax[-1].set_xscale("log")
+    ax[-1].set_xlabel("dt (t0)")
+    ax[-1].set_ylabel("wall time per run (s)")
+    ax[-1].legend(fontsize=8)
+    fig.suptitle(f"Tetris robot, stiff scheme, kT = {sc[0]['kT']:g}; grey: +-0.05 rad", fontsize=9)
+    fig.tight_layout()
+    png = path.replace(".json", ".png")
+    fig.savefig(png, dpi=120)
+    return png
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("scene", nargs="?")
@@ -117,7 +205,7 @@ def main(argv=None) -> int:
     ap.add_argument("--dts", nargs="*", type=float, default=[0.4, 0.2, 0.1, 0.05])
     ap.add_argument("--time", type=float, default=400.0)
     ap.add_argument("--avg", type=float, default=100.0)
-    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--seeds", nargs="*", type=int, default=[0])
     ap.add_argument("--kT", type=float, default=1e-5)
     ap.add_argument("--plot", default=None)
     ap.add_argument("-o", "--out", default="benchmarks/results/robot_speed_error.json")
@@ -132,26 +220,29 @@ def main(argv=None) -> int:
         with open(a.out) as f:
             data = json.load(f)
     runs = {(r["row"], r["dt"], r["kT"], r["seed"], r["time_t0"]): r for r in data.get("runs", [])}
-    for row in a.rows:
-        for dt in a.dts:
-            try:
-                r = run_one(sc, row, dt, a.time, a.avg, a.seed, a.kT)
-            except Exception as e:             # an unstable step: recorded, not fatal
-                r = {"row": row, "dt": dt, "kT": a.kT, "seed": a.seed, "time_t0": a.time, "failed": str(e)[:300]}
-                print(f"row {row} dt {dt}: FAILED {e}", flush=True)
-                continue
-            runs[(row, dt, a.kT, a.seed, r["time_t0"])] = r
-            print(f"row {row} dt {dt}: wall {r['wall_s']} s, turns {r['turns_read']}, "
-                  f"mean angles {r['angle_mean_deg']}", flush=True)
-            data = {"what": "Tetris robot, stiff scheme: DOF angles against dt (benchmarks/robot_speed_error.py)",
-                    "scene": a.scene, "bodies": len(sc.bodies),
-                    "machine": f"{platform.machine()}, {os.cpu_count()} cores, shared",
-                    "units": "t0, degrees / rad, seconds wall",
-                    "runs": sorted(runs.values(), key=lambda r: (r["row"], r["dt"]))}
-            data["comparison"] = compare([r for r in data["runs"] if "failed" not in r])
-            with open(a.out + ".tmp", "w") as f:
-                json.dump(data, f, indent=1)
-            os.replace(a.out + ".tmp", a.out)
+    for seed in a.seeds:                     # seed-major: every dt of a seed before the next seed
+        for row in a.rows:
+            for dt in a.dts:
+                try:
+                    r = run_one(sc, row, dt, a.time, a.avg, seed, a.kT)
+                except Exception as e:             # an unstable step: recorded, not fatal
+                    r = {"row": row, "dt": dt, "kT": a.kT, "seed": seed, "time_t0": a.time, "failed": str(e)[:300]}
+                    print(f"row {row} dt {dt} seed {seed}: FAILED {e}", flush=True)
+                    continue
+                runs[(row, dt, a.kT, seed, r["time_t0"])] = r
+                print(f"row {row} dt {dt} seed {seed}: wall {r['wall_s']} s, turns {r['turns_read']}, "
+                      f"mean angles {r['angle_mean_deg']}", flush=True)
+                data = {"what": "Tetris robot, stiff scheme: DOF angles against dt (benchmarks/robot_speed_error.py)",
+                        "scene": a.scene, "bodies": len(sc.bodies), "avg": a.avg,
+                        "machine": f"{platform.machine()}, {os.cpu_count()} cores, shared",
+                        "units": "t0, degrees / rad, seconds wall",
+                        "runs": sorted(runs.values(), key=lambda r: (r["row"], r["dt"], r["seed"]))}
+                ok = [r for r in data["runs"] if "failed" not in r]
+                data["comparison"] = compare(ok)
+                data["seed_comparison"] = compare_seeds(ok)
+                with open(a.out + ".tmp", "w") as f:
+                    json.dump(data, f, indent=1)
+                os.replace(a.out + ".tmp", a.out)
     return 0
 
 
