@@ -111,13 +111,59 @@ def _steer(c0, u0, t0, guide, pitch, bmax, free_start, max_half):
     return bends
 
 
+CACHE_SIZE = 512            # solves remembered (see solve_route); 0: none
+_CACHE: dict = {}
+CACHE_HITS = [0, 0]        # [hits, misses] since import (benchmarks report them)
+
+
+def _key(v):
+    """An exact, hashable key of a solve's argument: arrays and numbers by their bytes (so
+    -0.0 and 0.0, or two floats one ulp apart, are different keys), containers item by item."""
+    if isinstance(v, (bool, int, str, type(None))):
+        return v
+    if isinstance(v, (float, np.floating)):
+        return np.float64(v).tobytes()
+    if isinstance(v, np.ndarray):
+        return (v.dtype.str, v.shape, np.ascontiguousarray(v).tobytes())
+    if isinstance(v, (list, tuple)):
+        return tuple(_key(x) for x in v)
+    if isinstance(v, dict):
+        return tuple(sorted((k, _key(x)) for k, x in v.items()))
+    if isinstance(v, ConnectorGeometry):
+        return repr(v)              # a frozen dataclass of numbers: repr round-trips every float
+    raise TypeError(type(v))
+
+
 def solve_route(*args, **kw) -> Route | None:
     """See :func:`_solve_route`; a chain steered far off (a failed length) may overflow on
-    the way, which only means that length does not close: the warnings are not shown."""
+    the way, which only means that length does not close: the warnings are not shown.
+
+    The solve is a pure function of its arguments, so a repeated solve with bit-identical
+    arguments (the circuit builder's second build re-routes most wires exactly as the
+    first did) returns the remembered result (a copy) instead of solving again: the same
+    route, bit for bit."""
     import warnings
+    key = None
+    if CACHE_SIZE > 0:
+        try:
+            key = (_key(args), _key(kw))
+        except TypeError:           # an argument of another kind: solve without the cache
+            key = None
+        if key is not None and key in _CACHE:
+            CACHE_HITS[0] += 1
+            r = _CACHE[key]
+            return None if r is None else Route(r.centre.copy(), r.axis.copy(), r.tangent.copy(), list(r.bends),
+                                                r.error, r.approach_error)
     with np.errstate(all="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)
-        return _solve_route(*args, **kw)
+        r = _solve_route(*args, **kw)
+    if key is not None:
+        CACHE_HITS[1] += 1
+        if len(_CACHE) >= CACHE_SIZE:
+            _CACHE.pop(next(iter(_CACHE)))          # oldest first
+        _CACHE[key] = None if r is None else Route(r.centre.copy(), r.axis.copy(), r.tangent.copy(),
+                                                   list(r.bends), r.error, r.approach_error)
+    return r
 
 
 def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int, *,

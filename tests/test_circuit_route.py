@@ -1,0 +1,51 @@
+"""The router's solve cache (mlc.circuit.route.solve_route): a repeated solve with
+bit-identical arguments returns the same route, as a copy; any bit of difference solves again."""
+import numpy as np
+
+from mlc.circuit import route as R
+from mlc.gates.connector import connector_geometry
+
+
+def _args():
+    geo = connector_geometry("expand")
+    c0, u0 = np.array([0.0, 0.0, 0.0]), np.array([1.0, 0.0, 0.0])
+    P, a = np.array([0.0, -6.0, 9.0]), np.array([1.0, 0.0, 0.0])
+    return (c0, u0, P, a, geo, 0), dict(tangent=np.array([0.0, 0.0, 1.0]), approach=np.array([0.0, 0.0, 1.0]),
+                                        waypoints=[(0.0, -4.0, 4.0)])
+
+
+def test_a_repeated_solve_is_the_same_route_and_a_copy():
+    args, kw = _args()
+    R._CACHE.clear()
+    h0, m0 = R.CACHE_HITS
+    first = R.solve_route(*args, **kw)
+    assert first is not None and first.error < R.EXACT
+    again = R.solve_route(*(np.array(v) if isinstance(v, np.ndarray) else v for v in args), **kw)
+    assert R.CACHE_HITS == [h0 + 1, m0 + 1]
+    assert again is not first and again.bends == first.bends and again.error == first.error
+    assert np.array_equal(again.centre, first.centre) and np.array_equal(again.tangent, first.tangent)
+    # the caller may edit what it got: the remembered route is not changed
+    again.bends[0] += 1.0
+    again.centre[0] += 1.0
+    third = R.solve_route(*args, **kw)
+    assert third.bends == first.bends and np.array_equal(third.centre, first.centre)
+    # the same solve without the cache: bit for bit the same bends
+    R._CACHE.clear()
+    size, R.CACHE_SIZE = R.CACHE_SIZE, 0
+    try:
+        fresh = R.solve_route(*args, **kw)
+    finally:
+        R.CACHE_SIZE = size
+    assert fresh.bends == first.bends
+
+
+def test_one_ulp_or_a_signed_zero_is_another_solve():
+    args, kw = _args()
+    R._CACHE.clear()
+    R.solve_route(*args, **kw)
+    P = args[2].copy()
+    P[2] = np.nextafter(P[2], 10.0)
+    h = R.CACHE_HITS[0]
+    R.solve_route(*args[:2], P, *args[3:], **kw)
+    assert R.CACHE_HITS[0] == h
+    assert R._key(0.0) != R._key(-0.0) and R._key(np.array([0.0])) != R._key(np.array([-0.0]))
