@@ -49,10 +49,11 @@ def compile_spec(spec, level: int = 2, signal: str = "expand") -> Compiled:
     return Compiled(spec, aig, netlist, stats, proof, time.perf_counter() - t0)
 
 
-def build(compiled: Compiled, progress=None) -> Compiled:
-    """Place and route the netlist into one circuit scene (posed in the all-zero row)."""
+def build(compiled: Compiled, progress=None, options=None) -> Compiled:
+    """Place and route the netlist into one circuit scene (posed in the all-zero row);
+    ``options``: a :class:`mlc.circuit.build.CircuitOptions` (default: its defaults)."""
     from mlc.circuit.build import build_circuit
-    compiled.circuit = build_circuit(compiled.netlist, compiled.spec, progress=progress)
+    compiled.circuit = build_circuit(compiled.netlist, compiled.spec, options=options, progress=progress)
     return compiled
 
 

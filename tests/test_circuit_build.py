@@ -126,3 +126,27 @@ def test_clearance_is_checked_in_each_row(tetris):
     b = next(x for x in sc.bodies if x.name.startswith(a.name.split("_")[0]) and x.name.endswith("a_lo"))
     b.position = a.position.copy()                 # a lever slab moved into the core
     assert clearance(sc).min_clearance < 0
+
+
+def test_joint_k_stiffens_connector_bonds_and_narrows_the_thermal_spread():
+    """CircuitOptions.joint_k multiplies every connector bond's k (hinges, joints, stops) and
+    leaves the muscles and the gates at the design k0.  A width carried through a chain of
+    junctions in series has compliance ~ n/k, so its harmonic spread shrinks as 1/sqrt(k)
+    where the chains dominate: 100x stiffer joints must narrow the output's spread by more
+    than 2x and at most 10x (10x: all compliance in the chains; in this small circuit the
+    gates keep about a tenth of the variance, so the ratio is near 2.9)."""
+    from mlc.circuit.build import CircuitOptions
+    from mlc.verify.dynamic import probe_thermal_sd
+
+    c = compile_spec(load(None, "y = (a & b) | c"))
+    soft = build_circuit(c.netlist, c.spec).scene
+    stiff = build_circuit(c.netlist, c.spec, CircuitOptions(joint_k=100.0)).scene
+    assert [b.name for b in soft.bonds] == [b.name for b in stiff.bonds]
+    for a, b in zip(soft.bonds, stiff.bonds):
+        assert b.k == pytest.approx(a.k * (1.0 if a.name.startswith("g") else 100.0)), a.name
+    assert [m.k for m in stiff.muscles] == [m.k for m in soft.muscles]
+    assert stiff.meta["connector"]["joint_k"] == pytest.approx(100.0)
+    s1, s100 = probe_thermal_sd(soft, 1e-5)["y"], probe_thermal_sd(stiff, 1e-5)["y"]
+    assert 2.0 < s1 / s100 <= 10.0 + 1e-9, (s1, s100)
+    rep = verify_static(stiff, clearance=False)
+    assert rep.ok and all(r["thermal_ok"] for r in rep.rows)

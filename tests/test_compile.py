@@ -218,3 +218,12 @@ def test_compile_force_reaches_mlc_stl(monkeypatch, tmp_path):
     _mesh(tmp_path / "circuit.yaml", Staged(), None, "mjp", True)
     _mesh(tmp_path / "circuit.yaml", Staged(), None, "mjp", False)
     assert "--force" in seen[0] and "--force" not in seen[1]
+
+
+@pytest.mark.parametrize("k,words", [("0", "must be > 0"), ("nan", "must be > 0"), ("1e5", "at most 10000"),
+                                     ("-3", "must be > 0")])
+def test_joint_k_is_checked_before_any_work(k, words, tmp_path, capsys):
+    rc = main(["compile", "-e", "y = a & b", "-o", str(tmp_path / "out"), "--joint-k", k])
+    err = capsys.readouterr().err
+    assert rc == 2 and words in err and "--joint-k" in err and err.count("\n") == 1
+    assert not (tmp_path / "out").exists()

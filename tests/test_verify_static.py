@@ -51,3 +51,27 @@ def test_muscle_too_weak_shows_stretch():
     s.muscles[0].actuated = 2.5         # beyond what the lever can reach
     e = equilibrium(s, "10")
     assert e.max_muscle_strain > 1e-3 or e.max_joint_stretch > 1e-3
+
+
+def test_stiff_joints_converge_by_stiffness_homotopy(monkeypatch):
+    """A circuit compiled with 1000x stiffer connector joints: every row reaches the ideal
+    output length with no residual energy; the same equilibrium (to 1e-9 sigma) as a plain
+    Levenberg-Marquardt run at the full stiffness, which needs more iterations (the
+    stiffness continuation, mlc.verify.static module doc)."""
+    import mlc.verify.static as S
+    from mlc.circuit.build import CircuitOptions
+    from mlc.pipeline import build, compile_spec, load
+
+    sc = build(compile_spec(load(None, "y = (a & b) | c")), options=CircuitOptions(joint_k=1000.0)).circuit.scene
+    A = sc.arrays()
+    assert A.bond_k.max() == pytest.approx(1000.0) and A.muscle_k.max() == pytest.approx(1.0)
+    states = sc.states()
+    homotopy = {s: equilibrium(sc, s) for s in states}
+    monkeypatch.setattr(S, "STIFF_CAP", float("inf"))
+    direct = {s: equilibrium(sc, s) for s in states}
+    for s in states:
+        want = 1.5 if sc.truth_table[s] == "1" else 1.0
+        assert homotopy[s].probes["y"] == pytest.approx(want, abs=1e-9), s
+        assert homotopy[s].energy < 1e-20 and homotopy[s].max_joint_stretch < 1e-9
+        assert homotopy[s].probes["y"] == pytest.approx(direct[s].probes["y"], abs=1e-9)
+    assert sum(e.iterations for e in homotopy.values()) < sum(e.iterations for e in direct.values())

@@ -30,7 +30,7 @@ Units: sigma, k0.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import lru_cache
 
 import numpy as np
@@ -80,6 +80,8 @@ class CircuitOptions:
     gap: float = 0.5                 # connector junction gap (sigma)
     level_pitch: float = LEVEL_PITCH
     gate_pitch: float = GATE_PITCH
+    joint_k: float = 1.0             # connector joints' bond stiffness, in units of the design k (k0);
+                                     # the muscles keep the design k (docs/circuits.md, "Thermal spread")
 
 
 @dataclass
@@ -231,7 +233,9 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         raise MlcError(f"netlist has {len(netlist.inputs)} inputs; a circuit scene lists every row of its truth "
                        f"table and holds at most {MAX_INPUTS}", netlist.source, "split the design")
     signal = netlist.signal
-    geo = connector_geometry(signal, gap=opt.gap)
+    design = connector_geometry(signal, gap=opt.gap)
+    k_muscle = design.k                            # muscles: the design stiffness
+    geo = replace(design, k=design.k * opt.joint_k)  # every connector bond (hinges, joints, stops)
     names = [w.name for w in netlist.inputs]
     zero = _wire_values(netlist, {x: 0 for x in names})
 
@@ -314,7 +318,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         c = np.array([xpos[src], 0.0, 0.0])
         parts, pin, pout = half_unit_parts(f"src_{w.name}", c, np.array([0.0, 1.0, 0]), np.array([0, 0, 1.0]),
                                            zero[src], geo)
-        parts.muscles.append(Muscle(f"muscle_{w.name}", w.name, pin.lo, pin.hi, geo.L0, geo.L1, geo.k))
+        parts.muscles.append(Muscle(f"muscle_{w.name}", w.name, pin.lo, pin.hi, geo.L0, geo.L1, k_muscle))
         add(parts)
         taps[src] = (pout, 1)
         if not consumers.get(src):
@@ -504,7 +508,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                   meta={"element": "circuit", "signal": signal, "source": netlist.source,
                         "gates": {g.id: {"type": g.type, "origin": [float(v) for v in origin[g.id]],
                                          "depth": g.depth} for g in netlist.gates},
-                        "connector": {"gap": geo.gap, "side": round(geo.side, 6), "chains": n_chains,
+                        "connector": {"gap": geo.gap, "side": round(geo.side, 6), "joint_k": geo.k, "chains": n_chains,
                                       "half_units": n_half, "planes": 1 + max((k for k, _ in lanes.placed), default=-1),
                                       "tight_chains": [t for t, _ in tight]}})
     scene.check()

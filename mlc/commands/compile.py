@@ -18,6 +18,8 @@ from pathlib import Path
 
 from mlc.errors import MlcError
 
+MAX_JOINT_K = 1e4          # --joint-k upper bound (k0); the stiff scheme's stages grow as sqrt(k)
+
 
 def register(sub):
     p = sub.add_parser("compile", help="compile Boolean logic (.tt .pla .expr .blif .aag or -e) into mechanical gates",
@@ -34,6 +36,9 @@ def register(sub):
     p.add_argument("--draw", metavar="PNG", help="also draw the gate schematic to this PNG file")
     p.add_argument("--no-circuit", action="store_true",
                    help="stop at the netlist (no circuit scene OUTDIR/circuit.yaml and picture OUTDIR/circuit.png)")
+    p.add_argument("--joint-k", dest="joint_k", type=float, default=None, metavar="K",
+                   help="connector joints' stiffness in units of the design k0 (default 1, the paper's; "
+                        "stiffer joints narrow the thermal spread of long chains, docs/circuits.md)")
     p.add_argument("--verify", action="store_true",
                    help="verify the circuit on every row of its truth table (static; with --dynamic by Brownian dynamics)")
     p.add_argument("--dynamic", action="store_true", help="with --verify: Brownian dynamics from rest, until relaxed")
@@ -144,6 +149,13 @@ def run(args) -> int:
         raise MlcError(f"--seeds must be between 1 and 1000, got {args.seeds}", "--seeds")
     if not (args.kT >= 0 and args.kT < float("inf")):
         raise MlcError(f"kT must be finite and >= 0, got {args.kT}", "--kT")
+    joint_k = getattr(args, "joint_k", None)
+    if joint_k is not None:
+        if not want_circuit:
+            raise MlcError("--joint-k only applies to the circuit", "--no-circuit", "drop --no-circuit")
+        if not (0 < joint_k <= MAX_JOINT_K):
+            raise MlcError(f"--joint-k must be > 0 and at most {MAX_JOINT_K:g} (k0), got {joint_k}", "--joint-k",
+                           "use e.g. --joint-k 10 or 100")
     if getattr(args, "robot", None):
         if not want_circuit:
             raise MlcError("--robot needs the circuit", "--no-circuit", "drop --no-circuit")
@@ -161,10 +173,12 @@ def run(args) -> int:
     files = render(c, draw=bool(args.draw))
     report = None
     if want_circuit:
+        from mlc.circuit.build import CircuitOptions
         from mlc.pipeline import build
         from mlc.scene.io import dump_scene
+        opts = CircuitOptions() if joint_k is None else CircuitOptions(joint_k=joint_k)
         with Progress("placing and routing", total=1) as bar:
-            build(c, progress=lambda done, total: (setattr(bar, "total", total), bar.update(done)))
+            build(c, progress=lambda done, total: (setattr(bar, "total", total), bar.update(done)), options=opts)
         scene = c.circuit.scene
         files["circuit.yaml"] = dump_scene(scene).encode()
         from mlc.circuit.draw import render_circuit

@@ -20,6 +20,14 @@ small enough (1e-9 k0) that it biases joint stretch by less than 1e-8 sigma.  Th
 so a circuit of ~10^4 bodies solves in seconds.  The muscles are moved from the starting
 state to the target in a few continuation steps so that the solution stays on the
 mechanism's physical branch.
+
+Stiff joints (a circuit compiled with ``--joint-k``) make the least-squares problem
+ill-conditioned: Levenberg-Marquardt then crawls along the joints' constraint surface and
+its stall test stops it short of equilibrium.  The continuation is therefore run with every
+bond softened to at most ``STIFF_CAP`` times the stiffest muscle (a homotopy in stiffness:
+the equilibrium of a mechanism whose joints hold moves by O(load/k) with k, a fraction of
+the joint stretch, below 1e-3 sigma), and the real stiffnesses are restored for the last
+two minimisations, which start next to their solution and converge in a few steps.
 """
 from __future__ import annotations
 
@@ -37,6 +45,10 @@ GN_MAX_ITER = 60            # Gauss-Newton iterations per continuation step
 GN_TOL = 1e-13              # converged when the largest update (sigma, rad) is below this
 REG = 1e-9                  # k0: weight of the least-motion term on zero-energy modes
 REG_POLISH = 1e-16          # k0: the same in the final polish (removes REG's bias on the pose)
+ACCEL_H = 0.1               # finite-difference step (fraction of dx) for the geodesic acceleration
+ACCEL_RATIO = 1.5           # the acceleration is used while |a| <= this |dx| (|a/2| <= 0.75 |dx|)
+STIFF_CAP = 4.0             # bonds stiffer than this many times the stiffest muscle are softened to it
+                            # for the continuation, then restored for the polish (see equilibrium)
 
 
 @dataclass
@@ -85,6 +97,7 @@ class _Problem:
         self.R = _quat_to_matrix_batch(np.asarray(quat0, float)) if self.N else np.zeros((0, 3, 3))
         self.vec = (A.bond_rest == 0) & (A.bond_tol == 0)   # zero-length bonds: vector residual
         self.iv = np.nonzero(self.vec)[0]
+        self.bond_k = np.array(A.bond_k, float)       # k0: may be softened for a continuation (equilibrium)
         self.isc = np.nonzero(~self.vec)[0]
         self.m = 3 * len(self.iv) + len(self.isc) + len(A.muscle_i)
         self.free = np.arange(1, self.N) if pin_first else np.arange(self.N)
@@ -106,7 +119,7 @@ class _Problem:
         A = self.A
         if p is None:
             p, _ = self.sites()
-        sk = np.sqrt(A.bond_k)
+        sk = np.sqrt(self.bond_k)
         d = p[A.bond_i] - p[A.bond_j]
         out = [(sk[self.iv, None] * d[self.iv]).ravel()]
         if len(self.isc):
@@ -145,7 +158,7 @@ class _Problem:
             r, c = np.broadcast_arrays(r, c)
             rows.append(r.ravel()), cols.append(c.ravel()), vals.append(blk.ravel())
 
-        sk = np.sqrt(A.bond_k)
+        sk = np.sqrt(self.bond_k)
         nv = len(self.iv)
         if nv:
             row0 = 3 * np.arange(nv)
@@ -194,7 +207,16 @@ class _Problem:
 
 
 def _minimise(prob: _Problem, L, reg: float = None) -> int:
-    """Levenberg-Marquardt on 0.5 |r|^2 from the current poses; returns the iteration count."""
+    """Levenberg-Marquardt with geodesic acceleration on 0.5 |r|^2 from the current poses;
+    returns the iteration count.
+
+    The acceleration (Transtrum & Sethna, 2012) adds to each step dx the second-order
+    correction a = -(J^T J + lam D)^-1 J^T r'', with r'' the residuals' second directional
+    derivative along dx (a finite difference, one extra residual evaluation, the same
+    factorisation): moving a floppy chain along its linearised zero mode stretches its
+    joints quadratically, and without the correction the step is cut back to a crawl
+    (module doc).  The corrected step dx + a/2 is tried when |a| <= ACCEL_RATIO |dx|,
+    otherwise dx alone."""
     from scipy.sparse.linalg import splu
 
     reg = REG if reg is None else reg
@@ -219,11 +241,18 @@ def _minimise(prob: _Problem, L, reg: float = None) -> int:
         for _ in range(12):
             M = (H + sp.diags(lam * scale + 1e-14, format="csc")).tocsc()
             try:
-                dx = -splu(M, permc_spec="COLAMD").solve(g)
+                lu = splu(M, permc_spec="COLAMD")
             except RuntimeError:
                 lam *= 10.0
                 continue
+            dx = -lu.solve(g)
             snap = prob.snapshot()
+            prob.apply(ACCEL_H * dx)                     # r'' along dx, by a finite difference
+            rpp = (2.0 / ACCEL_H) * ((prob.residuals(L) - r) / ACCEL_H - J @ dx)
+            prob.restore(snap)
+            acc = -lu.solve(J.T @ rpp)
+            if np.linalg.norm(acc) <= ACCEL_RATIO * np.linalg.norm(dx):
+                dx = dx + 0.5 * acc
             prob.apply(dx)
             r_new = prob.residuals(L)
             c_new = total(r_new)
@@ -260,8 +289,15 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
     nit = 0
     path = [1.0] if np.allclose(L0, L1) else np.linspace(0, 1, steps + 1)[1:]
     if prob.m and prob.n:
+        k_cap = STIFF_CAP * float(np.max(A.muscle_k, initial=1.0))
+        stiff = bool(np.any(prob.bond_k > k_cap))
+        if stiff:                                       # stiffness homotopy (module docstring)
+            prob.bond_k = np.minimum(prob.bond_k, k_cap)
         for t in path:
             nit += _minimise(prob, L0 + t * (L1 - L0))
+        if stiff:
+            prob.bond_k = np.array(A.bond_k, float)
+            nit += _minimise(prob, L1)
         nit += _minimise(prob, L1, reg=REG_POLISH)     # polish: the least-motion bias removed
     pos, R = prob.pos, prob.R
     p, _ = prob.sites()
