@@ -49,3 +49,11 @@ def test_one_ulp_or_a_signed_zero_is_another_solve():
     R.solve_route(*args[:2], P, *args[3:], **kw)
     assert R.CACHE_HITS[0] == h
     assert R._key(0.0) != R._key(-0.0) and R._key(np.array([0.0])) != R._key(np.array([-0.0]))
+
+
+def test_blas_single_thread_sets_one_thread_and_restores():
+    ctl = R._blas_controls()
+    before = [g() for _, g in ctl]
+    with R.blas_single_thread():
+        assert all(g() == 1 for _, g in ctl)
+    assert [g() for _, g in ctl] == before

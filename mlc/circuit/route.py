@@ -111,6 +111,62 @@ def _steer(c0, u0, t0, guide, pitch, bmax, free_start, max_half):
     return bends
 
 
+_BLAS = None                # [(set, get)] of the OpenBLAS libraries loaded (see blas_single_thread)
+
+
+def _blas_controls() -> list:
+    """(set_num_threads, get_num_threads) of every OpenBLAS the process has loaded (numpy's
+    and scipy's wheels each bundle one, with prefixed names); [] where none is found."""
+    global _BLAS
+    if _BLAS is None:
+        import ctypes
+        found = []
+        try:
+            with open("/proc/self/maps") as f:
+                paths = sorted({ln.split()[-1] for ln in f if "openblas" in ln.lower() and ".so" in ln})
+        except OSError:
+            paths = []
+        for path in paths:
+            try:
+                lib = ctypes.CDLL(path)
+            except OSError:
+                continue
+            for pre, suf in (("scipy_", ""), ("scipy_", "64_"), ("", ""), ("", "64_")):
+                st = getattr(lib, f"{pre}openblas_set_num_threads{suf}", None)
+                gt = getattr(lib, f"{pre}openblas_get_num_threads{suf}", None)
+                if st is not None and gt is not None:
+                    st.argtypes, st.restype, gt.restype = [ctypes.c_int], None, ctypes.c_int
+                    found.append((st, gt))
+                    break
+        _BLAS = found
+    return _BLAS
+
+
+class blas_single_thread:
+    """Run the block with every loaded OpenBLAS on one thread, then restore its count.
+
+    The solve's dense SVDs (scipy's trust region, 50-300 rows) gain nothing from a second
+    thread, and on a shared, loaded machine OpenBLAS's threads wait for each other: a
+    277 x 120 SVD took 1.77 s of wall time (0.88 s of CPU) with 2 threads while another
+    process ran, against 6 ms with one.  One thread gives the same bits (the full adder's
+    scene has the same sha256 either way).  Not re-entrant across threads."""
+
+    def __enter__(self):
+        self.saved = []
+        for st, gt in _blas_controls():
+            n = gt()
+            self.saved.append((st, n))
+            if n != 1:
+                st(1)
+        return self
+
+    def __exit__(self, *exc):
+        for st, n in self.saved:
+            if n != 1:
+                st(n)
+        return False
+
+
 CACHE_SIZE = 512            # solves remembered (see solve_route); 0: none
 _CACHE: dict = {}
 CACHE_HITS = [0, 0]        # [hits, misses] since import (benchmarks report them)
@@ -154,7 +210,7 @@ def solve_route(*args, **kw) -> Route | None:
             r = _CACHE[key]
             return None if r is None else Route(r.centre.copy(), r.axis.copy(), r.tangent.copy(), list(r.bends),
                                                 r.error, r.approach_error)
-    with np.errstate(all="ignore"), warnings.catch_warnings():
+    with np.errstate(all="ignore"), warnings.catch_warnings(), blas_single_thread():
         warnings.simplefilter("ignore", RuntimeWarning)
         r = _solve_route(*args, **kw)
     if key is not None:
