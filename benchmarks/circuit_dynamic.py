@@ -9,6 +9,10 @@ k0 sigma^2 by default, the stiff scheme) and record each output's read length, b
 margin, the relaxation time (t0) and the wall time.
 
     python benchmarks/circuit_dynamic.py [--only full_adder.expr ...] [--seeds 3] [--kT 1e-5]
+                                         [--joint-k 100] [--rows 000 101]
+
+``--joint-k K`` builds the circuit as ``mlc compile --joint-k K`` does (connector joints K
+times stiffer); ``--rows`` limits the rows run.
 
 Writes benchmarks/results/circuit_dynamic.json after every run and resumes from it (a
 (example, row, seed) already recorded for the same scene is skipped), so a long
@@ -28,6 +32,7 @@ import subprocess
 import time
 from pathlib import Path
 
+from mlc.circuit.build import CircuitOptions
 from mlc.pipeline import build, compile_spec, load
 from mlc.scene.io import dump_scene
 from mlc.verify.dynamic import check_scene_dynamic_multi
@@ -43,6 +48,8 @@ def main():
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--kT", type=float, default=1e-5)
     ap.add_argument("--scheme", default="stiff", choices=("stiff", "euler"))
+    ap.add_argument("--joint-k", type=float, default=1.0, help="connector joint stiffness (k0), as mlc compile")
+    ap.add_argument("--rows", nargs="*", default=None, help="rows to run (default all)")
     ap.add_argument("--reuse-tau", action="store_true",
                     help="use the scene's tau recorded by an earlier run (default: the verifier's signal_time)")
     args = ap.parse_args()
@@ -50,17 +57,19 @@ def main():
                             text=True).stdout.strip()
     res = json.loads(OUT.read_text()) if OUT.exists() else {"runs": [], "scenes": {}}
     for name in args.only:
-        compiled = build(compile_spec(load(str(ROOT / "examples" / name))))
+        compiled = build(compile_spec(load(str(ROOT / "examples" / name))),
+                         options=CircuitOptions(joint_k=args.joint_k))
         sc = compiled.circuit.scene
         key = hashlib.sha256(dump_scene(sc).encode()).hexdigest()[:16]
         info = res["scenes"].get(key)
         if info is None:
-            info = {"example": name, "bodies": len(sc.bodies), "tau": None, "commit": commit}
+            info = {"example": name, "bodies": len(sc.bodies), "tau": None, "commit": commit,
+                    "joint_k": args.joint_k}
             res["scenes"][key] = info
         done = {(r["scene"], r["state"], r["seed"]) for r in res["runs"] if "tau" in r or args.reuse_tau}
         for seed in range(args.seeds):
             for state in sc.states():
-                if (key, state, seed) in done:
+                if (key, state, seed) in done or (args.rows and state not in args.rows):
                     continue
                 t0 = time.perf_counter()
                 # tau: the one computed for this scene in an earlier session (the eigensolver), or
@@ -68,7 +77,7 @@ def main():
                 entries = check_scene_dynamic_multi(sc, kT=args.kT, seeds=[seed], scheme=args.scheme, rows=[state],
                                                     progress=False, tau=info["tau"] if args.reuse_tau else None)
                 wall = time.perf_counter() - t0
-                run = {"scene": key, "example": name, "state": state, "seed": seed, "kT": args.kT,
+                run = {"scene": key, "example": name, "joint_k": args.joint_k, "state": state, "seed": seed, "kT": args.kT,
                        "scheme": args.scheme, "ok": all(e["ok"] for e in entries),
                        "relax_time": max((e["relax_time"] or float("nan")) for e in entries), "wall_s": wall,
                        "tau": max(e["tau"] for e in entries),

@@ -81,6 +81,7 @@ def test_static_check_reports_the_thermal_spread(tetris):
         assert r.ok and r.rows[0]["thermal_ok"] == want
         assert ("WARNING: thermal spread" in format_report(r)) == (not want)
     assert not hot.rows[0]["thermal_ok"] and "past the threshold" in format_report(hot)
+    assert "recompile with `mlc compile --joint-k " in format_report(hot)
     assert "thermal_sd" not in verify_static(tetris[2].scene, rows=["01"], clearance=False, kT=None).entries[0]
 
 
@@ -150,3 +151,9 @@ def test_joint_k_stiffens_connector_bonds_and_narrows_the_thermal_spread():
     assert 2.0 < s1 / s100 <= 10.0 + 1e-9, (s1, s100)
     rep = verify_static(stiff, clearance=False)
     assert rep.ok and all(r["thermal_ok"] for r in rep.rows)
+    # the suggested joint_k: (3 sd / margin)^2 doubled, times the present k, up to a power of 10
+    from mlc.verify.circuit import suggest_joint_k
+    assert suggest_joint_k(0.252, 0.25, {}) == 100.0          # the full adder's co at k0: 2 x 9.1 -> 100
+    assert suggest_joint_k(0.139, 0.25, {}) == 10.0           # Tetris's g1 output: 2 x 2.8 -> 10
+    assert suggest_joint_k(0.05, 0.25, {"joint_k": 100.0}) == 100.0
+    assert suggest_joint_k(0.3, 0.25, {"joint_k": 100.0}) == 1e4

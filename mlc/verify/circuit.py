@@ -89,7 +89,8 @@ def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_s
     states = select_rows(scene, rows)
     t0 = time.perf_counter()
     rep = Report(scene.name, "static", params={"tol_length": tol_length, "tol_stretch": tol_stretch,
-                                               "require_clearance": require_clearance, "kT": kT})
+                                               "require_clearance": require_clearance, "kT": kT,
+                                               "joint_k": scene.meta.get("connector", {}).get("joint_k", 1.0)})
     for i, state in enumerate(states):
         t_row = time.perf_counter()
         eq = equilibrium(scene, state)
@@ -164,6 +165,16 @@ def verify_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int = 3, sc
     return rep
 
 
+def suggest_joint_k(sd: float, margin: float, params: dict) -> float:
+    """A ``--joint-k`` to recompile with so that ``margin`` holds THERMAL_SDS spreads: the
+    spread of a width carried by a chain falls as 1/sqrt(k) (docs/circuits.md, "Thermal
+    spread"), so k must grow by (THERMAL_SDS sd / margin)^2; doubled, because the gates keep
+    part of the compliance, times the scene's present joint_k, rounded up to a power of 10."""
+    have = float(params.get("joint_k") or 1.0)
+    need = 2.0 * (THERMAL_SDS * sd / max(margin, 1e-9)) ** 2 * have
+    return float(min(10.0 ** math.ceil(math.log10(max(need, 10.0))), 1e4))
+
+
 def format_report(rep: Report) -> str:
     """A table of rows by outputs: the read length (sigma) and margin, then a verdict."""
     outs = list(dict.fromkeys(e["output"] for e in rep.entries))
@@ -211,7 +222,8 @@ def format_report(rep: Report) -> str:
                      f"fluctuates by {w['thermal_sd']:.3f} sigma (harmonic) against a margin of {w['margin']:.3f} "
                      f"sigma (less than {THERMAL_SDS:g} spreads, in {len(rows_t)} of {len(rep.rows)} rows): its "
                      f"instantaneous length is past the threshold about {past:.2g} % of the time, though a "
-                     f"time average reads right; shorter chains or stiffer connector joints narrow it "
+                     f"time average reads right; stiffer connector joints narrow it: recompile with "
+                     f"`mlc compile --joint-k {suggest_joint_k(w['thermal_sd'], w['margin'], rep.params):g}` "
                      f"(docs/circuits.md, 'Thermal spread')")
     for r in rep.rows:
         if rep.mode == "static" and r.get("overlaps"):
