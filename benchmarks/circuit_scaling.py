@@ -11,7 +11,11 @@
     python benchmarks/circuit_scaling.py [--max-width 30] [--skip-dynamic]
 
 Writes benchmarks/results/circuit_scaling.json and .png.  Times are wall seconds on this
-machine in one run; compare ratios, not absolute numbers across machines.
+machine in one run; compare ratios, not absolute numbers across machines.  ``build_cpu_s``
+is the build's CPU time (process_time) and ``load`` the 1-minute load average when the
+build started: on a shared machine wall time is CPU time over the share of a core the
+process gets.  ``route_solves``/``route_repeats``: chains solved / served by the router's
+cache (build_circuit's second build repeats some of the first's solves).
 """
 from __future__ import annotations
 
@@ -35,14 +39,19 @@ OUT = Path(__file__).resolve().parent / "results"
 def adder_point(w: int) -> dict:
     spec = ripple_adder(w)
     c = compile_spec(spec, 2, "expand")
-    t0 = time.perf_counter()
+    from mlc.circuit import route
+    hits0 = list(route.CACHE_HITS)
+    load0 = os.getloadavg()[0]
+    t0, c0 = time.perf_counter(), time.process_time()
     circ = build_circuit(c.netlist, spec)
-    t_build = time.perf_counter() - t0
+    t_build, c_build = time.perf_counter() - t0, time.process_time() - c0
     sc = circ.scene
     row = "1" * len(sc.inputs)
     rep = verify_static(sc, rows=[row])
     return {"width": w, "gates": len(c.netlist.gates), "bodies": len(sc.bodies), "chains": circ.chains,
-            "half_units": circ.half_units, "build_s": t_build, "build_parts_s": circ.seconds,
+            "half_units": circ.half_units, "build_s": t_build, "build_cpu_s": c_build, "load": load0,
+            "route_solves": route.CACHE_HITS[1] - hits0[1], "route_repeats": route.CACHE_HITS[0] - hits0[0],
+            "tight_chains": sc.meta["connector"]["tight_chains"], "build_parts_s": circ.seconds,
             "verify_row_s": rep.rows[0]["seconds"], "row": row, "ok": rep.ok,
             "clearance": rep.rows[0].get("clearance"), "joint_stretch": rep.rows[0]["joint_stretch"]}
 
@@ -107,7 +116,8 @@ def main():
     ax[0].set_xlabel("gates")
     ax[0].set_ylabel("bodies in the scene")
     ax[0].set_title("ripple-carry adders")
-    ax[1].loglog(b, tb, "o-", label="build (place + route + assemble)")
+    ax[1].loglog(b, tb, "o-", label="build (place + route + assemble), wall")
+    ax[1].loglog(b, [p["build_cpu_s"] for p in points], "o--", color="C0", alpha=0.5, label="build, CPU")
     ax[1].loglog(b, tv, "s-", label="static verification, one row")
     ax[1].axhline(2.0, color="C0", ls=":", lw=0.8)
     ax[1].axhline(10.0, color="C1", ls=":", lw=0.8)
