@@ -45,23 +45,11 @@ from pathlib import Path
 import numpy as np
 from scipy.integrate import quad
 
-from mlc.scene.model import Body, Bond, Box, Scene
 from mlc.sim.integrator import SimOptions, Simulation
+from mlc.sim.testscenes import bonded_pairs
 
 RESULTS = Path(__file__).resolve().parent / "results"
 T_UNIT = 1000.0
-
-
-def bonded_pairs(n, rest=1.0, k=1.0, spacing=4.0):
-    bodies, bonds = [], []
-    side = int(math.ceil(math.sqrt(n)))
-    for i in range(n):
-        c = spacing * np.array([i % side, i // side, 0.0])
-        for tag, dx in (("a", -0.5 * rest), ("b", 0.5 * rest)):
-            bodies.append(Body(f"{tag}{i}", c + [dx, 0, 0], np.array([1.0, 0, 0, 0]),
-                               [Box(np.array([0.3, 0.3, 0.01]))], {"c": np.zeros(3)}))
-        bonds.append(Bond(f"u{i}", f"a{i}.c", f"b{i}.c", k, rest, 0.0, "universal", f"u{i}"))
-    return Scene("pairs", bodies, bonds).check()
 
 
 def exact_var(kT, L=1.0, k=1.0):
@@ -98,7 +86,7 @@ def main():
     ap.add_argument("--pairs", type=int, default=200)
     ap.add_argument("--cap", type=float, default=60.0, help="seconds per point before it is cut short")
     args = ap.parse_args()
-    sc = bonded_pairs(args.pairs)
+    sc = bonded_pairs(args.pairs)          # mlc.sim.testscenes: rest 1, tol 0, k 1
     kTs = [1e-5, 1e-4, 1e-3, 1e-2]
     dts = [0.01, 0.05, 0.2, 0.5, 2.0, 5.0, 20.0, 100.0]
     if args.quick:

@@ -16,8 +16,9 @@ import pytest
 from scipy.integrate import quad
 
 from mlc.errors import MlcError
-from mlc.scene.model import Body, Bond, Box, Scene
+from mlc.scene.model import Body, Box, Scene
 from mlc.sim.integrator import SimOptions, Simulation
+from mlc.sim.testscenes import bonded_pairs
 
 T_UNIT = 1000.0      # gamma/k0 per t0 (k0 = gamma = 1)
 
@@ -28,19 +29,6 @@ def free_bodies(n, spacing=3.0):
                    np.array([1.0, 0, 0, 0]), [Box(np.array([0.5, 0.5, 0.01]))], {"c": np.zeros(3)})
               for i in range(n)]
     return Scene("free", bodies).check()
-
-
-def bonded_pairs(n, rest, tol, k=1.0, spacing=4.0):
-    """n pairs of bodies, each pair joined by one bond between their centres (no torques)."""
-    bodies, bonds = [], []
-    side = int(math.ceil(math.sqrt(n)))
-    for i in range(n):
-        c = spacing * np.array([i % side, i // side, 0.0])
-        for tag, dx in (("a", -0.5 * rest), ("b", 0.5 * rest)):
-            bodies.append(Body(f"{tag}{i}", c + [dx, 0, 0], np.array([1.0, 0, 0, 0]),
-                               [Box(np.array([0.3, 0.3, 0.01]))], {"c": np.zeros(3)}))
-        bonds.append(Bond(f"u{i}", f"a{i}.c", f"b{i}.c", k, rest, tol, "universal", f"u{i}"))
-    return Scene("pairs", bodies, bonds).check()
 
 
 def ratio_and_error(x):
