@@ -39,6 +39,13 @@ junction gets one too when it hangs on a half unit, or a tap stop (:func:`_lever
 when it hangs on a gate's output lever.  ``SLACK_FRACTION`` > 0 lengthens the chains so
 that none spans more than that fraction of its length in any row (section 2.4; off).
 
+**Stiffness.**  The coupling chains are connector chains like the circuit's: every bond
+of theirs (half-unit hinges, joins, the universal joints on the lever sites, junction and
+tap stops) gets the circuit's joint stiffness (``mlc compile --joint-k K``, recorded in the
+circuit scene's ``meta["connector"]["joint_k"]``).  The skeleton keeps the design k (k0):
+its hinges, joint stops (``STOP_K`` k0) and locks; the lever arms are rigid parts of its
+bodies.  The circuit's muscles keep k0 too (docs/robot.md section 2.5).
+
 Every DOF has a probe across its tips, named ``dof_u{i}_{side}``, reading the DOF's
 own output (rest d0, actuated d1): the circuit verifier checks the DOF lengths like any
 output, and :mod:`mlc.robot.verify` reads the shape.  Units: sigma, k0, radians.
@@ -46,7 +53,7 @@ output, and :mod:`mlc.robot.verify` reads the shape.  Units: sigma, k0, radians.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -269,7 +276,15 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
     t0 = time.perf_counter()
     meta = circuit.meta if isinstance(circuit.meta, dict) else {}
     signal = meta.get("signal", "expand")
-    geo = connector_geometry(signal, gap=float(meta.get("connector", {}).get("gap", 0.5)))
+    design = connector_geometry(signal, gap=float(meta.get("connector", {}).get("gap", 0.5)))
+    # the circuit's connector stiffness (mlc compile --joint-k): its meta records the joints' k
+    # (design k times K); the coupling chains' bonds get the same, the skeleton keeps the design k
+    joint_k = float(meta.get("connector", {}).get("joint_k", design.k)) / design.k
+    if not (joint_k > 0 and math.isfinite(joint_k)):
+        raise MlcError(f"the circuit scene records connector joint_k {joint_k * design.k}", "circuit meta",
+                       "recompile the circuit (mlc compile --joint-k K, K > 0)")
+    k_skel = design.k                                   # skeleton hinges, joint stops and locks (k0)
+    geo = replace(design, k=design.k * joint_k)         # every coupling-chain bond (hinges, joins, stops, ends)
     if abs(geo.L1 / geo.L0 - (spec.dof_rest + spec.dof_stroke) / spec.dof_rest) > 1e-9:
         need = spec.dof_rest * (geo.L1 / geo.L0 - 1.0)
         raise MlcError(f"the circuit's wires go {geo.L0} -> {geo.L1} sigma ({signal}ing), a ratio the DOFs "
@@ -329,20 +344,20 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
             hw = HINGE_WIDTH
             sites[b1].update(axis_sites(f"h_{name}", W(*O), ez, hw))
             sites[b2].update(axis_sites(f"h_{name}", W(*O), ez, hw))
-            bonds += hinge(f"skel_h_{name}", b1, b2, f"h_{name}", f"h_{name}")
+            bonds += hinge(f"skel_h_{name}", b1, b2, f"h_{name}", f"h_{name}", k_skel)
             for st in stops:                        # the joint's range of motion (section 2.3)
                 for b, r, beta in ((b1, st.r1, st.beta1), (b2, st.r2, st.beta2)):
                     sites[b][f"stop_{st.name}_{name}"] = W(*(O + r * np.array([math.cos(beta), sgn * math.sin(beta)])))
                 rest, tol = st.band
                 bonds.append(Bond(f"skel_stop_{st.name}_{name}", f"{b1}.stop_{st.name}_{name}",
-                                  f"{b2}.stop_{st.name}_{name}", STOP_K * geo.k, rest, tol, "bond", None))
+                                  f"{b2}.stop_{st.name}_{name}", STOP_K * k_skel, rest, tol, "bond", None))
             sites[b1][f"tip_{name}"] = W(*(O + dg.gain * dg.p * dir1))
             sites[b2][f"tip_{name}"] = W(*(O + dg.gain * dg.q * dir2))
             ds = spec.dof(i, side)
             dofs_meta.append({"name": name, "unit": i, "side": side, "hinge": f"skel_h_{name}",
                               "bodies": [b1, b2], "output": ds.output if ds else None})
             if ds is None:                                  # not in the file: locked straight
-                bonds.append(Bond(f"skel_lock_{name}", f"{b1}.tip_{name}", f"{b2}.tip_{name}", geo.k, dg.d0,
+                bonds.append(Bond(f"skel_lock_{name}", f"{b1}.tip_{name}", f"{b2}.tip_{name}", k_skel, dg.d0,
                                   0.0, "bond", None))
                 dofs_meta[-1]["coupling"] = "lock"
                 dofs_meta[-1]["value"] = 0
@@ -360,7 +375,7 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
             probes.append(Probe(f"dof_{name}", ds.output, f"{b1}.tip_{name}", f"{b2}.tip_{name}", dg.d0, dg.d1))
             if coupling == "lock":
                 v = int(col[0]) if len(col) == 1 and col[0] in "01" else 0
-                bonds.append(Bond(f"skel_lock_{name}", f"{b1}.tip_{name}", f"{b2}.tip_{name}", geo.k,
+                bonds.append(Bond(f"skel_lock_{name}", f"{b1}.tip_{name}", f"{b2}.tip_{name}", k_skel,
                                   dg.d1 if v else dg.d0, 0.0, "bond", None))
                 dofs_meta[-1]["value"] = v
                 continue
@@ -548,7 +563,8 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
                                    "alpha1_deg": math.degrees(dg.alpha1)},
                   "stops": {"margin_deg": math.degrees(STOP_MARGIN),
                             "free_turn_deg": [-math.degrees(STOP_MARGIN), 90 + math.degrees(STOP_MARGIN)]},
-                  "dofs": dofs_meta, "chains": n_chains, "half_units": n_half})
+                  "dofs": dofs_meta, "chains": n_chains, "half_units": n_half,
+                  "k": {"chains": geo.k, "skeleton": k_skel, "joint_k": joint_k}})
     scene = Scene(name=f"robot_{spec.name}", bodies=[by_body[b.name] for b in circuit.bodies] + bodies + parts_bodies,
                   bonds=list(circuit.bonds) + bonds + parts_bonds, muscles=list(circuit.muscles),
                   probes=list(circuit.probes) + probes, inputs=list(circuit.inputs), outputs=list(circuit.outputs),
