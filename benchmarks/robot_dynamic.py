@@ -19,6 +19,10 @@ turns are also read every ``--every`` t0, so the JSON holds each fold's history.
     python benchmarks/robot_dynamic.py OUT/robot.yaml [--rows 11] [--seeds 0 1 2]
         [--dt 0.2] [--tau 100] [--max-time 1800] [-o benchmarks/results/robot_dynamic.json]
 
+A scene compiled with stiff joints (``mlc compile --joint-k K``) goes to its own file, e.g.
+``-o benchmarks/results/robot_dynamic_jointk100.json``; every run records the scene's
+``joint_k`` (k0).
+
 Results are merged into the JSON (keyed by row and seed), so runs can be made one at a
 time.  Units: t0 (times), degrees (angles), sigma, seconds (wall).
 """
@@ -89,6 +93,8 @@ def main(argv=None) -> int:
     a = ap.parse_args(argv)
     sc = load_scene(a.scene)
     rows = a.rows or sorted(sc.truth_table)
+    # the chains' joint stiffness (mlc compile --joint-k K, k0): recorded with every run
+    joint_k = float((sc.meta.get("circuit", {}).get("connector", {}) or {}).get("joint_k", 1.0))
     data = {}
     if os.path.exists(a.out):
         with open(a.out) as f:
@@ -98,7 +104,8 @@ def main(argv=None) -> int:
         for seed in a.seeds:
             r = run_one(sc, state, seed, a.dt, a.tau, a.max_time, a.kT, a.every, min_time=a.min_time)
             r.update({"min_time": a.min_time if a.min_time is not None else 3 * a.tau, "dt": a.dt, "tau": a.tau, "kT": a.kT, "max_time": a.max_time, "scheme": "stiff",
-                      "bodies": len(sc.bodies), "load_1min": round(os.getloadavg()[0], 2)})
+                      "bodies": len(sc.bodies), "load_1min": round(os.getloadavg()[0], 2),
+                      "joint_k": joint_k})
             runs[(state, seed)] = r
             print(f"row {state} seed {seed}: {r['shape_read']} (expected {r['shape_expected']}) "
                   f"turns {r['turns_read']}  relaxed {r['relaxed']} at {r['time_t0']} t0, "
