@@ -39,13 +39,19 @@ def _num(s):
         return s
 
 
-def _load(d: Path):
+def _read(d: Path):
+    """(meta, columns, rows) of the sweep results directory ``d``."""
     meta_p = d / "sweep.json"
     if not (d / TABLE).exists() or not meta_p.exists():
         raise MlcError("not a sweep results directory (no results.csv and sweep.json)", str(d),
                        "give the directory `mlc sweep SPEC -o DIR` wrote")
     meta = json.loads(meta_p.read_text("utf-8"))
     cols, rows = read_table(d / TABLE)
+    return meta, cols, rows
+
+
+def _load(d: Path):
+    meta, cols, rows = _read(d)
     ok = [r for r in rows if r["status"] == "ok"]
     if not ok:
         raise MlcError("the sweep has no successful runs to plot", str(d / TABLE))
@@ -215,16 +221,10 @@ def reliability_map(d: Path, png: Path):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     from matplotlib.colors import LogNorm
-    meta_p = d / "sweep.json"
-    if not (d / TABLE).exists() or not meta_p.exists():
-        raise MlcError("not a sweep results directory (no results.csv and sweep.json)", str(d),
-                       "give the directory `mlc sweep SPEC -o DIR` wrote")
-    meta = json.loads(meta_p.read_text("utf-8"))
-    cols, allrows = read_table(d / TABLE)
+    meta, cols, allrows = _read(d)
     for need in ("kT", "tolerance"):
         if need not in cols:
             raise MlcError(f"a reliability map needs the parameter {need!r} in the table", str(d / TABLE))
-    ok = [r for r in allrows if r["status"] == "ok"]
     probe, suffix = _wrong_probe(cols)
     col = probe + suffix
     kts = sorted({float(r["kT"]) for r in allrows})
