@@ -43,22 +43,15 @@ import time
 from pathlib import Path
 
 import numpy as np
-from scipy.integrate import quad
 
 from mlc.sim.integrator import SimOptions, Simulation
-from mlc.sim.testscenes import bonded_pairs
+from mlc.sim.testscenes import bond_length_var, bonded_pairs
 
 RESULTS = Path(__file__).resolve().parent / "results"
 T_UNIT = 1000.0
 
 
-def exact_var(kT, L=1.0, k=1.0):
-    w = lambda r: r * r * math.exp(-k * (r - L) ** 2 / (2 * kT))
-    lo, hi = max(0.0, L - 12 * math.sqrt(kT / k)), L + 12 * math.sqrt(kT / k)
-    z = quad(w, lo, hi)[0]
-    m1 = quad(lambda r: r * w(r), lo, hi)[0] / z
-    m2 = quad(lambda r: r * r * w(r), lo, hi)[0] / z
-    return m2 - m1 * m1
+exact_var = bond_length_var              # mlc.sim.testscenes: the exact theory
 
 
 def point(sc, kT, dt, fluct, seed, cap):

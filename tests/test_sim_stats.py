@@ -18,7 +18,7 @@ from scipy.integrate import quad
 from mlc.errors import MlcError
 from mlc.scene.model import Body, Box, Scene
 from mlc.sim.integrator import SimOptions, Simulation
-from mlc.sim.testscenes import bonded_pairs
+from mlc.sim.testscenes import bond_length_var, bonded_pairs
 
 T_UNIT = 1000.0      # gamma/k0 per t0 (k0 = gamma = 1)
 
@@ -174,13 +174,7 @@ def test_body_moving_freely_inside_a_joint_tolerance():
 
 # -- item 2: bond-length fluctuations ----------------------------------------------------------
 
-def _bond_length_var(kT, L, k=1.0):
-    w = lambda r: r * r * math.exp(-k * (r - L) ** 2 / (2 * kT))
-    lo, hi = max(0.0, L - 12 * math.sqrt(kT / k)), L + 12 * math.sqrt(kT / k)
-    z = quad(w, lo, hi)[0]
-    m1 = quad(lambda r: r * w(r), lo, hi)[0] / z
-    m2 = quad(lambda r: r * r * w(r), lo, hi)[0] / z
-    return m2 - m1 * m1
+_bond_length_var = bond_length_var      # mlc.sim.testscenes: the exact theory
 
 
 def _pair_lengths_from_frames(res):

@@ -107,3 +107,16 @@ def bonded_pairs(n: int, rest: float = 1.0, tol: float = 0.0, k: float = 1.0, sp
                                [Box(np.array([0.3, 0.3, 0.01]))], {"c": np.zeros(3)}))
         bonds.append(Bond(f"u{i}", f"a{i}.c", f"b{i}.c", k, rest, tol, "universal", f"u{i}"))
     return Scene("pairs", bodies, bonds).check()
+
+
+def bond_length_var(kT: float, L: float = 1.0, k: float = 1.0) -> float:
+    """Exact equilibrium variance (sigma^2) of a harmonic bond's length in 3D (rest ``L``
+    sigma, stiffness ``k`` k0, ``kT`` k0 sigma^2): r^2 exp(-k (r-L)^2 / 2kT), by quadrature
+    (the theory the simulator's bond fluctuations are checked against)."""
+    from scipy.integrate import quad
+    w = lambda r: r * r * math.exp(-k * (r - L) ** 2 / (2 * kT))  # noqa: E731
+    lo, hi = max(0.0, L - 12 * math.sqrt(kT / k)), L + 12 * math.sqrt(kT / k)
+    z = quad(w, lo, hi)[0]
+    m1 = quad(lambda r: r * w(r), lo, hi)[0] / z
+    m2 = quad(lambda r: r * r * w(r), lo, hi)[0] / z
+    return m2 - m1 * m1
