@@ -82,6 +82,7 @@ class CircuitOptions:
     gate_pitch: float = GATE_PITCH
     joint_k: float = 1.0             # connector joints' bond stiffness, in units of the design k (k0);
                                      # the muscles keep the design k (docs/circuits.md, "Thermal spread")
+    direct: bool = False             # join a gate's single-sink net by one full unit (mlc.circuit.direct)
 
 
 @dataclass
@@ -247,11 +248,16 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     for o in netlist.outputs:
         if o.kind != "const":
             consumers.setdefault(o.src, []).append(("out", o.name, int(o.half_unit)))
+    consumers_all = consumers
+
+    from mlc.circuit.direct import direct_nets
+    direct = direct_nets(netlist, consumers) if opt.direct else {}   # sink id -> (driver id, pin)
 
     # ---- placement -----------------------------------------------------------------
     levels: dict[int, list] = {}
     for g in netlist.gates:
-        levels.setdefault(g.depth, []).append(g)
+        if g.id not in direct:                   # a direct sink sits on its driver's unit
+            levels.setdefault(g.depth, []).append(g)
     xpos: dict[tuple, float] = {}
     sources = [w for w in netlist.inputs
                if not (len(consumers.get(("input", w.name), [])) == 1
@@ -263,14 +269,19 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     # routes arriving at each level: each gets its own horizontal layer in the gap below it
     arriving: dict[int, int] = {}
     for g in netlist.gates:
-        for p in (g.a, g.b):
-            if not (p.src[0] == "input" and len(consumers.get(p.src, [])) == 1):
+        for pin, p in (("a", g.a), ("b", g.b)):
+            if not (p.src[0] == "input" and len(consumers.get(p.src, [])) == 1) and direct.get(g.id) != (
+                    p.src[1], pin):
                 arriving[g.depth] = arriving.get(g.depth, 0) + 1
     zlevel = {0: 0.0}
-    for d in range(1, max(levels, default=0) + 1):
+    for d in range(1, max((g.depth for g in netlist.gates), default=0) + 1):
         zlevel[d] = zlevel[d - 1] + opt.level_pitch + LAYER_PITCH * arriving.get(d, 0)
     origin: dict[str, np.ndarray] = {}
     for d in sorted(levels):
+        for _ in direct:                         # a direct sink stands over its driver
+            for s_, (drv, _p) in direct.items():
+                if ("gate", drv) in xpos:
+                    xpos[("gate", s_)] = xpos[("gate", drv)]
         gs = levels[d]
         gs.sort(key=lambda g: (0.5 * (xpos.get(g.a.src, 0.0) + xpos.get(g.b.src, 0.0)), g.id))
         for i, g in enumerate(gs):
@@ -298,11 +309,22 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         cons = consumers.get(("input", w.name), [])
         if len(cons) == 1 and cons[0][0] == "pin":
             direct_input[(cons[0][1], cons[0][2])] = w.name
-    for g in netlist.gates:
+    n_direct_half = 0
+    for g in [g for g in netlist.gates if g.id not in direct] + sorted(
+            (g for g in netlist.gates if g.id in direct), key=lambda g: g.depth):
         state = f"{zero[g.a.src]}{zero[g.b.src]}"
         sc, pos, quat = _posed_gate(g.type, signal, state)
-        bs, bd = _gate_bodies(g.id, sc, pos, quat, origin[g.id])
-        add(Parts(bs, bd, []))
+        if g.id in direct:
+            from mlc.circuit.direct import place_direct
+            parts, R, t = place_direct(g.id, *direct[g.id], sc, pos, quat, by_name, zero[("gate", direct[g.id][0])],
+                                       geo, LEVER_STOP, TERMINAL_POST)
+            add(parts)
+            n_direct_half += 2
+            origin[g.id] = t
+            xpos[("gate", g.id)] = float(t[0])
+        else:
+            bs, bd = _gate_bodies(g.id, sc, pos, quat, origin[g.id])
+            add(Parts(bs, bd, []))
         for m in sc.muscles:                     # muscle_a / muscle_b: kept where an input drives the lever
             key = (g.id, m.input)
             if key in direct_input:
@@ -334,6 +356,11 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     space_clear = 2.0 * LAYER_RADIUS
     tight: list = []                        # chains that could not be kept apart by the lanes
     depth_of = {g.id: g.depth for g in netlist.gates}
+    if direct:                                  # the direct nets need no chain
+        consumers = {w: c for w, c in consumers_all.items()
+                     if not (w[0] == "gate" and len(c) == 1 and c[0][0] == "pin"
+                             and direct.get(c[0][1], (None,))[0] == w[1])}
+    n_half += n_direct_half
     wires = [w for w in taps if consumers.get(w)]
     wires.sort(key=lambda w: w[1] not in first_wires)          # stable: the rest keep their order
     for wi, wire in enumerate(wires):
@@ -511,6 +538,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                         "connector": {"gap": geo.gap, "side": round(geo.side, 6), "joint_k": geo.k, "chains": n_chains,
                                       "half_units": n_half, "planes": 1 + max((k for k, _ in lanes.placed), default=-1),
                                       "tight_chains": [t for t, _ in tight]}})
+    if opt.direct:
+        scene.meta["connector"]["direct"] = [[d, s, p] for s, (d, p) in direct.items()]
     scene.check()
     t_end = time.perf_counter()
     return Circuit(scene, origin, n_chains, n_half,

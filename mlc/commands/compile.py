@@ -39,6 +39,9 @@ def register(sub):
     p.add_argument("--joint-k", dest="joint_k", type=float, default=None, metavar="K",
                    help="connector joints' stiffness in units of the design k0 (default 1, the paper's; "
                         "stiffer joints narrow the thermal spread of long chains, docs/circuits.md)")
+    p.add_argument("--direct", action="store_true",
+                   help="join a gate whose output feeds exactly one gate input by one full connector unit, "
+                        "the sink placed on it (docs/circuits.md section 3, 'Direct connection')")
     p.add_argument("--verify", action="store_true",
                    help="verify the circuit on every row of its truth table (static; with --dynamic by Brownian dynamics)")
     p.add_argument("--dynamic", action="store_true", help="with --verify: Brownian dynamics from rest, until relaxed")
@@ -156,6 +159,8 @@ def run(args) -> int:
         if not (0 < joint_k <= MAX_JOINT_K):
             raise MlcError(f"--joint-k must be > 0 and at most {MAX_JOINT_K:g} (k0), got {joint_k}", "--joint-k",
                            "use e.g. --joint-k 10 or 100")
+    if getattr(args, "direct", False) and not want_circuit:
+        raise MlcError("--direct only applies to the circuit", "--no-circuit", "drop --no-circuit")
     if getattr(args, "robot", None):
         if not want_circuit:
             raise MlcError("--robot needs the circuit", "--no-circuit", "drop --no-circuit")
@@ -177,6 +182,7 @@ def run(args) -> int:
         from mlc.pipeline import build
         from mlc.scene.io import dump_scene
         opts = CircuitOptions() if joint_k is None else CircuitOptions(joint_k=joint_k)
+        opts.direct = bool(getattr(args, "direct", False))
         with Progress("placing and routing", total=1) as bar:
             build(c, progress=lambda done, total: (setattr(bar, "total", total), bar.update(done)), options=opts)
         scene = c.circuit.scene
