@@ -611,7 +611,12 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     fat_guard: dict[str, tuple] = {}     # reuse only: (hard, soft or None) guards grown by GUARD_PAD
     for b in scene.bodies:
         bn = b.name
-        solid = union([box(sb.center, sb.R, sb.size) for sb in shapes[bn]])
+        # large assemblies: every boolean of the body in its own frame (its first slab's), so
+        # that congruent bodies come out as the same mesh moved (the same triangles, whatever
+        # their place in the world) and share every exact result of the checks (congruence)
+        Fb = _frame(slabs[bn][0].center, slabs[bn][0].R) if reuse and LOCAL_BUILD and slabs.get(bn) else None
+        L = _localizer(Fb)
+        solid = union(L([box(sb.center, sb.R, sb.size) for sb in shapes[bn]]))
         my_axes = [ax for ax in axes if bn in ax.bodies]
         my_uj = [(uj, 0 if uj.bodies[0] == bn else 1) for uj in ujoints if bn in uj.bodies]
         # 1. clear the other bodies' knuckles
@@ -626,6 +631,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         for uj in ujoints:      # compound junction: the other bodies of its hinge clear the yoke too
             if uj.host is not None and bn in uj.host.bodies and bn not in uj.bodies:
                 cuts.append(cylinder(uj.center, uj.axes[0], *uj.layouts[0].cut, uj.rho[0], n, cutter=True))
+        cuts = L(cuts)
         cut_solid = _clean(subtract(solid, cuts))
         if len(cut_solid.decompose()) > len(_clean(solid).decompose()):
             # a slab running along an axis is severed by the clearance around another body's
@@ -634,8 +640,8 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
             base_n = len(_clean(solid).decompose())
             for ax in my_axes:
                 own = ax.intervals[bn]
-                axis_cuts = [cylinder(ax.origin, ax.direction, a0, a1, ax.rho, n, cutter=True)
-                             for a0, a1 in _ext(_complement(own, -ax.span / 2, ax.span / 2), ax.span, t)]
+                axis_cuts = L([cylinder(ax.origin, ax.direction, a0, a1, ax.rho, n, cutter=True)
+                               for a0, a1 in _ext(_complement(own, -ax.span / 2, ax.span / 2), ax.span, t)])
                 if len(_clean(subtract(solid, axis_cuts)).decompose()) <= base_n:
                     continue
                 for a0, a1 in _complement(own, -ax.span / 2, ax.span / 2):
@@ -643,7 +649,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                         bridges.append(_bridge(ax, bn, a0, a1, samples, state_T, t, prof))
                         notes.append(f"hinge {ax.name}: {bn} bridges around the other knuckles "
                                      f"({np.degrees(bridges[-1][1]):.0f} degrees from them)")
-            solid = _clean(subtract(union([solid] + [x for x, _ in bridges]), cuts)) if bridges else cut_solid
+            solid = _clean(subtract(union([solid] + L([x for x, _ in bridges])), cuts)) if bridges else cut_solid
         else:
             solid = cut_solid
         # 2. own knuckles, attachment rings
@@ -672,7 +678,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                         recess.append(cone(ax.origin, ax.direction, face - 1e-3, face + cr, cr + 1e-3, 0.0, n,
                                            cutter=True))
         keep += male
-        solid = union([solid] + keep + rings)
+        solid = union([solid] + L(keep + rings))
         # 3. holes: non-owner knuckles, yoke knuckles, attachment holes
         holes = []
         holes += recess
@@ -688,15 +694,18 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         for x in lugs[bn]:
             if x[2]:
                 holes.append(cylinder(x[0], x[1], -t - 1, t + 1, lug_hole, n, cutter=True))
-        solid = subtract(solid, holes)
+        solid = subtract(solid, L(holes))
         # 4. the owner's pin
         pins = [cylinder(ax.origin, ax.direction, -ax.span / 2, ax.span / 2, r_pin, n)
                 for ax in my_axes if ax.pin_owner == bn and not cones]
-        solid = _clean(union([solid] + pins))
+        solid = _clean(union([solid] + L(pins)))
         protected[bn] = union(keep + pins + rings)
         if reuse:
             cores[bn] = union([subtract(union(keep + rings), holes)] + pins)
-        solid = _drop_scraps(solid, protected[bn], bn, notes)
+        if Fb is None:
+            solid = _drop_scraps(solid, protected[bn], bn, notes)
+        else:
+            solid = transform_solid(_drop_scraps(solid, union(L(keep + pins + rings)), bn, notes), Fb)
         # the spot where the attachment hole would go (0.85 mm in from the site), kept if possible
         spots = [cylinder(_spot(x[4], x[0], lug_out), x[1], -t, t, lug_out + c, n) for x in lugs[bn] if not x[2]]
         soft[bn] = union([protected[bn]] + spots)
@@ -771,6 +780,29 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
 
 
 # --------------------------------------------------------------------------- helpers
+LOCAL_Q = 1e-9    # mm: vertex rounding of a primitive moved into its body's frame
+LOCAL_BUILD = True   # large assemblies: bodies built in their own frames (False: in the world, as before)
+
+
+def _localizer(F):
+    """A function taking a list of solids (world, mm) into the frame ``F`` (4x4), their vertices
+    rounded to :data:`LOCAL_Q` mm: two congruent bodies then give their booleans the same input
+    to the last bit (the same output mesh), not inputs differing by rounding in the 16th digit.
+    ``F`` None: the identity (the solids as they are)."""
+    if F is None:
+        return lambda items: list(items)
+    Fi = np.linalg.inv(F)
+
+    def move(items):
+        out = []
+        for m in items:
+            g = transform_solid(m, Fi).to_mesh64()
+            V = (np.round(np.asarray(g.vert_properties, float)[:, :3] / LOCAL_Q) * LOCAL_Q).copy()
+            out.append(mf.Manifold(mf.Mesh64(vert_properties=V, tri_verts=np.asarray(g.tri_verts, np.uint64).copy())))
+        return out
+    return move
+
+
 def _complement(own, lo, hi):
     """Intervals of ``[lo, hi]`` not covered by a body's own knuckles (gaps included): the
     cut reaches exactly to the faces of its own knuckles."""
@@ -1489,7 +1521,15 @@ def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t) -> None:
     """Drill each attachment hole inside its slab, at the spot nearest to the site where a
     full ring of material (``min_wall``) surrounds the hole."""
     n = asm.profile.circular_segments
-    for part in asm.parts:
+    cong = getattr(asm, "congruence", None)
+
+    def cut(solid, add, hole, k):
+        if cong is None:
+            return subtract(union([solid] + add), [hole])
+        # large assemblies: in the part's own frame, as it was built (congruent parts stay the same mesh)
+        L = _localizer(cong.frames[k])
+        return transform_solid(subtract(union(L([solid] + add)), L([hole])), cong.frames[k])
+    for k_part, part in enumerate(asm.parts):
         for site, nrm, ring, _, sb, label in lugs.get(part.name, []):
             if ring:
                 continue
@@ -1512,7 +1552,7 @@ def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t) -> None:
             for k in order[:400]:
                 c = cands[k]
                 if (disc.translate(c.tolist()) - part.solid).volume() <= 1e-3 * full:
-                    part.solid = subtract(part.solid, [cylinder(c, nrm, -t - 1, t + 1, lug_hole, n, cutter=True)])
+                    part.solid = cut(part.solid, [], cylinder(c, nrm, -t - 1, t + 1, lug_hole, n, cutter=True), k_part)
                     off = float(np.linalg.norm(c - site))
                     if off > 1e-6:
                         asm.notes.append(f"{label}: attachment hole {off:.2f} mm from the site, inside the slab")
@@ -1526,8 +1566,8 @@ def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t) -> None:
                 for c in [site] + along[:10]:
                     ringd = cylinder(c, nrm, -t / 2, t / 2, lug_out, n)
                     if _ring_clear(asm, part, ringd):
-                        part.solid = subtract(union([part.solid, ringd]),
-                                              [cylinder(c, nrm, -t - 1, t + 1, lug_hole, n, cutter=True)])
+                        part.solid = cut(part.solid, [ringd], cylinder(c, nrm, -t - 1, t + 1, lug_hole, n, cutter=True),
+                                         k_part)
                         asm.notes.append(f"{label}: no room inside the trimmed slab; a ring lug "
                                          f"{np.linalg.norm(c - site):.2f} mm from the site instead")
                         break
