@@ -14,7 +14,8 @@ windows of ``tau/20`` t0, and the run stops when
 * it reaches ``--max-time`` (1800 t0, the paper's fold time; not relaxed).
 
 The shape is read from the final body poses (:func:`mlc.robot.verify.read_shape`).  The
-turns are also read every ``--every`` t0, so the JSON holds each fold's history.
+turns are also read every ``--every`` t0, so the JSON holds each fold's history, and the
+final pose gets the slab-overlap test (``clearance_end``, sigma; negative: interpenetration).
 
     python benchmarks/robot_dynamic.py OUT/robot.yaml [--rows 11] [--seeds 0 1 2]
         [--dt 0.2] [--tau 100] [--max-time 1800] [-o benchmarks/results/robot_dynamic.json]
@@ -58,6 +59,8 @@ def run_one(scene, state: str, seed: int, dt: float, tau: float, max_time: float
         if b in "01" and pr.bit(pm[pr.name]) != int(b):
             bad.append(pr.name)
     noise = detail.get("noise_deg", [])
+    from mlc.robot.verify import _clearance_row
+    cl = _clearance_row(scene, sim.pos, sim.quat)         # slab overlap in the final pose (sigma; docs/robot.md 6)
     return {"row": state, "seed": seed, "shape_read": sh["shape_read"], "shape_expected": sh["shape_expected"],
             "shape_ok": sh["shape_ok"], "probes_ok": not bad, "wrong_probes": bad,
             "ok": bool(sh["shape_ok"] and not bad), "turns_read": sh["turns_read"],
@@ -71,6 +74,8 @@ def run_one(scene, state: str, seed: int, dt: float, tau: float, max_time: float
                            "noise_deg": [round(v, 2) for v in noise],
                            "kappa_est_k0sigma2": [round(kT / math.radians(v) ** 2, 6) if v > 0 else None
                                                   for v in noise]},
+            "clearance_end": round(cl["clearance"], 4), "clearance_pair_end": cl["clearance_pair"],
+            "n_overlaps_end": cl["n_overlaps"],
             "history": hist}
 
 

@@ -10,13 +10,18 @@ error.  With several seeds per dt (``--seeds``) the comparison is of seed means:
 DOF the difference of the seed-averaged time-averaged angle at dt to that at the
 reference dt, with the error bar sqrt(sd_dt^2 / n_dt + sd_ref^2 / n_ref) (sd: the spread
 over seeds, ddof 1); a difference within 2 error bars is not resolved from noise.
-``--kT 0`` removes the noise (deterministic runs).
+``--kT 0`` removes the noise (deterministic runs).  ``--scheme euler`` runs the Euler
+reference (at a dt below its stability limit); a comparison's reference is then its
+smallest-dt Euler run.  The scene's coupling-joint stiffness (``mlc compile --joint-k K``)
+is recorded as ``joint_k``; a stiff-joint scene goes to its own file, e.g.
+``-o benchmarks/results/robot_speed_error_jointk100.json``.
 
     python benchmarks/robot_speed_error.py OUT/robot.yaml [--rows 00 01] [--dts 0.2 0.1 0.05]
-        [--seeds 0 1 2] [--time 300] [--avg 100] [-o benchmarks/results/robot_speed_error.json]
+        [--seeds 0 1 2] [--time 300] [--avg 100] [--kT 1e-5] [--scheme stiff]
+        [-o benchmarks/results/robot_speed_error.json]
     python benchmarks/robot_speed_error.py --plot benchmarks/results/robot_speed_error.json
 
-Runs are merged into the JSON (keyed by row, dt, kT, seed, time), one at a time.
+Runs are merged into the JSON (keyed by row, scheme, dt, kT, seed, time), one at a time.
 Units: t0, degrees (and rad), seconds wall.
 """
 from __future__ import annotations
@@ -32,13 +37,13 @@ import time
 import numpy as np
 
 
-def run_one(scene, row: str, dt: float, T: float, avg: float, seed: int, kT: float) -> dict:
+def run_one(scene, row: str, dt: float, T: float, avg: float, seed: int, kT: float, scheme: str = "stiff") -> dict:
     from mlc.robot.verify import read_shape
     from mlc.sim.drive import Drive
     from mlc.sim.integrator import SimOptions, Simulation
 
     drives = {inp: Drive.constant(int(b)) for inp, b in zip(scene.inputs, row)}
-    sim = Simulation(scene, drives, SimOptions(scheme="stiff", kT=kT, seed=seed, dt=dt))
+    sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed, dt=dt))
     wall = time.perf_counter()
     samples, t, every = [], 0.0, 5.0
     while t < T - 1e-9:
@@ -48,7 +53,7 @@ def run_one(scene, row: str, dt: float, T: float, avg: float, seed: int, kT: flo
             samples.append([d["angle"] for d in read_shape(scene, sim.pos, sim.quat, row)["dofs"]])
     wall = time.perf_counter() - wall
     sh = read_shape(scene, sim.pos, sim.quat, row)
-    return {"row": row, "dt": dt, "kT": kT, "seed": seed, "time_t0": round(t, 3), "wall_s": round(wall, 1),
+    return {"row": row, "scheme": scheme, "dt": dt, "kT": kT, "seed": seed, "time_t0": round(t, 3), "wall_s": round(wall, 1),
             "quarter_turns": sh["quarter_turns"], "turns_read": [round(x, 2) for x in sh["turns"]],
             "dofs": [d["name"] for d in sh["dofs"]],
             "angle_end_deg": [round(d["angle"], 3) for d in sh["dofs"]],
@@ -57,19 +62,29 @@ def run_one(scene, row: str, dt: float, T: float, avg: float, seed: int, kT: flo
             "load_1min": round(os.getloadavg()[0], 2)}
 
 
+def _scheme(r: dict) -> str:
+    return r.get("scheme", "stiff")
+
+
+def _ref_order(r: dict):
+    """The reference of a comparison: the smallest-dt Euler run if there is one, else the smallest dt."""
+    return (_scheme(r) != "euler", r["dt"])
+
+
 def compare(runs: list[dict]) -> list[dict]:
     """Per (row, kT, seed, time): each run's largest angle difference to the smallest-dt run
     (end and mean, deg and rad) and to the targets."""
     out = []
     keys = sorted({(r["row"], r["kT"], r["seed"], r["time_t0"]) for r in runs})
     for k in keys:
-        rs = sorted([r for r in runs if (r["row"], r["kT"], r["seed"], r["time_t0"]) == k], key=lambda r: r["dt"])
+        rs = sorted([r for r in runs if (r["row"], r["kT"], r["seed"], r["time_t0"]) == k], key=_ref_order)
         ref = rs[0]
         for r in rs:
             e_end = max(abs(a - b) for a, b in zip(r["angle_end_deg"], ref["angle_end_deg"]))
             e_mean = max(abs(a - b) for a, b in zip(r["angle_mean_deg"], ref["angle_mean_deg"]))
             e_tgt = max(abs(a - b) for a, b in zip(r["angle_mean_deg"], r["target_deg"]))
-            out.append({"row": k[0], "kT": k[1], "seed": k[2], "time_t0": k[3], "dt": r["dt"], "ref_dt": ref["dt"],
+            out.append({"row": k[0], "kT": k[1], "seed": k[2], "time_t0": k[3], "scheme": _scheme(r), "dt": r["dt"],
+                        "ref_scheme": _scheme(ref), "ref_dt": ref["dt"],
                         "wall_s": r["wall_s"],
                         "max_err_end_deg": round(e_end, 3), "max_err_end_rad": round(math.radians(e_end), 4),
                         "max_err_mean_deg": round(e_mean, 3), "max_err_mean_rad": round(math.radians(e_mean), 4),
@@ -86,10 +101,10 @@ def compare_seeds(runs: list[dict]) -> list[dict]:
     keys = sorted({(r["row"], r["kT"], r["time_t0"]) for r in runs})
     for k in keys:
         rk = [r for r in runs if (r["row"], r["kT"], r["time_t0"]) == k]
-        dts = sorted({r["dt"] for r in rk})
+        dts = sorted({(_scheme(r), r["dt"]) for r in rk}, key=lambda sd: (sd[0] != "euler", sd[1]))
         stats = {}
         for dt in dts:
-            rs = sorted([r for r in rk if r["dt"] == dt], key=lambda r: r["seed"])
+            rs = sorted([r for r in rk if (_scheme(r), r["dt"]) == dt], key=lambda r: r["seed"])
             m = np.array([r["angle_mean_deg"] for r in rs])
             e = np.array([r["angle_end_deg"] for r in rs])
             n = len(rs)
@@ -105,7 +120,8 @@ def compare_seeds(runs: list[dict]) -> list[dict]:
             d = mu - ref[1]
             de = mue - ref[3]
             res = [dofs[i] for i in range(len(d)) if abs(d[i]) > 2 * bar[i]]
-            out.append({"row": k[0], "kT": k[1], "time_t0": k[2], "dt": dt, "ref_dt": dts[0], "seeds": seeds,
+            out.append({"row": k[0], "kT": k[1], "time_t0": k[2], "scheme": dt[0], "dt": dt[1],
+                        "ref_scheme": dts[0][0], "ref_dt": dts[0][1], "seeds": seeds,
                         "wall_s_mean": round(wall, 1), "dofs": dofs, "target_deg": tgt,
                         "mean_deg": [round(float(x), 3) for x in mu], "sd_seeds_deg": [round(float(x), 3) for x in sd],
                         "end_deg": [round(float(x), 3) for x in mue], "sd_end_seeds_deg": [round(float(x), 3) for x in sde],
@@ -207,6 +223,9 @@ def main(argv=None) -> int:
     ap.add_argument("--avg", type=float, default=100.0)
     ap.add_argument("--seeds", nargs="*", type=int, default=[0])
     ap.add_argument("--kT", type=float, default=1e-5)
+    ap.add_argument("--scheme", default="stiff", choices=["stiff", "euler"],
+                    help="integrator (euler: the reference; a comparison's reference is its smallest-dt Euler run "
+                         "if any, else its smallest dt)")
     ap.add_argument("--plot", default=None)
     ap.add_argument("-o", "--out", default="benchmarks/results/robot_speed_error.json")
     a = ap.parse_args(argv)
@@ -219,24 +238,27 @@ def main(argv=None) -> int:
     if os.path.exists(a.out):
         with open(a.out) as f:
             data = json.load(f)
-    runs = {(r["row"], r["dt"], r["kT"], r["seed"], r["time_t0"]): r for r in data.get("runs", [])}
+    runs = {(r["row"], _scheme(r), r["dt"], r["kT"], r["seed"], r["time_t0"]): r for r in data.get("runs", [])}
+    # the coupling chains' joint stiffness (mlc compile --joint-k K, k0), recorded with the results
+    joint_k = float((sc.meta.get("circuit", {}).get("connector", {}) or {}).get("joint_k", 1.0))
     for seed in a.seeds:                     # seed-major: every dt of a seed before the next seed
         for row in a.rows:
             for dt in a.dts:
                 try:
-                    r = run_one(sc, row, dt, a.time, a.avg, seed, a.kT)
+                    r = run_one(sc, row, dt, a.time, a.avg, seed, a.kT, a.scheme)
                 except Exception as e:             # an unstable step: recorded, not fatal
                     r = {"row": row, "dt": dt, "kT": a.kT, "seed": seed, "time_t0": a.time, "failed": str(e)[:300]}
                     print(f"row {row} dt {dt} seed {seed}: FAILED {e}", flush=True)
                     continue
-                runs[(row, dt, a.kT, seed, r["time_t0"])] = r
+                r["joint_k"] = joint_k
+                runs[(row, a.scheme, dt, a.kT, seed, r["time_t0"])] = r
                 print(f"row {row} dt {dt} seed {seed}: wall {r['wall_s']} s, turns {r['turns_read']}, "
                       f"mean angles {r['angle_mean_deg']}", flush=True)
                 data = {"what": "Tetris robot, stiff scheme: DOF angles against dt (benchmarks/robot_speed_error.py)",
-                        "scene": a.scene, "bodies": len(sc.bodies), "avg": a.avg,
+                        "scene": a.scene, "bodies": len(sc.bodies), "joint_k": joint_k, "avg": a.avg,
                         "machine": f"{platform.machine()}, {os.cpu_count()} cores, shared",
                         "units": "t0, degrees / rad, seconds wall",
-                        "runs": sorted(runs.values(), key=lambda r: (r["row"], r["dt"], r["seed"]))}
+                        "runs": sorted(runs.values(), key=lambda r: (r["row"], _scheme(r), r["dt"], r["seed"]))}
                 ok = [r for r in data["runs"] if "failed" not in r]
                 data["comparison"] = compare(ok)
                 data["seed_comparison"] = compare_seeds(ok)
