@@ -80,7 +80,22 @@ def _perp_frame(d) -> np.ndarray:
     return np.column_stack([e1, e2, d])
 
 
+#: large assemblies: the frame (inverse, 4x4) every primitive is built in while a body is built
+#: in its own frame (see build_assembly), or None (the world)
+_LOCAL: list = [None]
+LOCAL_BUILD = True    # large assemblies: bodies built in their own frames (False: in the world, as before)
+LOCAL_Q = 1e-12       # mm: rounding of a primitive's position in its body's frame
+LOCAL_QR = 1e-14      # and of its rotation matrix's entries (coarser roundings leave slivers: 1e-9 gave 25 times the degenerate triangles)
+
+
 def _affine(R, t) -> np.ndarray:
+    """The 3x4 placement (R, t) of a primitive; while a body is built in its own frame, that
+    placement seen from the frame, rounded to LOCAL_Q: congruent bodies give their booleans the
+    same primitives to the last bit (an exact affine image of the same primitive: faces stay flat)."""
+    Fi = _LOCAL[0]
+    if Fi is not None:
+        R = np.round(Fi[:3, :3] @ np.asarray(R, float) / LOCAL_QR) * LOCAL_QR
+        t = np.round((Fi[:3, :3] @ np.asarray(t, float) + Fi[:3, 3]) / LOCAL_Q) * LOCAL_Q
     m = np.zeros((3, 4))
     m[:, :3] = R
     m[:, 3] = t
@@ -306,6 +321,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     default on for assemblies of at least :data:`REUSE_MIN_PARTS` parts (compiled circuits),
     off for the library gates, whose meshes stay exactly as they were."""
     prof = profile
+    _LOCAL[0] = None
     s = prof.sigma_mm
     n = prof.circular_segments
     c = prof.clearance
@@ -611,12 +627,12 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     fat_guard: dict[str, tuple] = {}     # reuse only: (hard, soft or None) guards grown by GUARD_PAD
     for b in scene.bodies:
         bn = b.name
-        # large assemblies: every boolean of the body in its own frame (its first slab's), so
-        # that congruent bodies come out as the same mesh moved (the same triangles, whatever
-        # their place in the world) and share every exact result of the checks (congruence)
+        # large assemblies: every primitive and boolean of the body in its own frame (its first
+        # slab's), the results moved back at the end: congruent bodies come out as the same mesh
+        # moved (the same triangles wherever they are) and share every cached exact result
         Fb = _frame(slabs[bn][0].center, slabs[bn][0].R) if reuse and LOCAL_BUILD and slabs.get(bn) else None
-        L = _localizer(Fb)
-        solid = union(L([box(sb.center, sb.R, sb.size) for sb in shapes[bn]]))
+        _LOCAL[0] = None if Fb is None else np.linalg.inv(Fb)
+        solid = union([box(sb.center, sb.R, sb.size) for sb in shapes[bn]])
         my_axes = [ax for ax in axes if bn in ax.bodies]
         my_uj = [(uj, 0 if uj.bodies[0] == bn else 1) for uj in ujoints if bn in uj.bodies]
         # 1. clear the other bodies' knuckles
@@ -631,7 +647,6 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         for uj in ujoints:      # compound junction: the other bodies of its hinge clear the yoke too
             if uj.host is not None and bn in uj.host.bodies and bn not in uj.bodies:
                 cuts.append(cylinder(uj.center, uj.axes[0], *uj.layouts[0].cut, uj.rho[0], n, cutter=True))
-        cuts = L(cuts)
         cut_solid = _clean(subtract(solid, cuts))
         if len(cut_solid.decompose()) > len(_clean(solid).decompose()):
             # a slab running along an axis is severed by the clearance around another body's
@@ -640,8 +655,8 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
             base_n = len(_clean(solid).decompose())
             for ax in my_axes:
                 own = ax.intervals[bn]
-                axis_cuts = L([cylinder(ax.origin, ax.direction, a0, a1, ax.rho, n, cutter=True)
-                               for a0, a1 in _ext(_complement(own, -ax.span / 2, ax.span / 2), ax.span, t)])
+                axis_cuts = [cylinder(ax.origin, ax.direction, a0, a1, ax.rho, n, cutter=True)
+                             for a0, a1 in _ext(_complement(own, -ax.span / 2, ax.span / 2), ax.span, t)]
                 if len(_clean(subtract(solid, axis_cuts)).decompose()) <= base_n:
                     continue
                 for a0, a1 in _complement(own, -ax.span / 2, ax.span / 2):
@@ -649,7 +664,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                         bridges.append(_bridge(ax, bn, a0, a1, samples, state_T, t, prof))
                         notes.append(f"hinge {ax.name}: {bn} bridges around the other knuckles "
                                      f"({np.degrees(bridges[-1][1]):.0f} degrees from them)")
-            solid = _clean(subtract(union([solid] + L([x for x, _ in bridges])), cuts)) if bridges else cut_solid
+            solid = _clean(subtract(union([solid] + [x for x, _ in bridges]), cuts)) if bridges else cut_solid
         else:
             solid = cut_solid
         # 2. own knuckles, attachment rings
@@ -678,7 +693,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                         recess.append(cone(ax.origin, ax.direction, face - 1e-3, face + cr, cr + 1e-3, 0.0, n,
                                            cutter=True))
         keep += male
-        solid = union([solid] + L(keep + rings))
+        solid = union([solid] + keep + rings)
         # 3. holes: non-owner knuckles, yoke knuckles, attachment holes
         holes = []
         holes += recess
@@ -694,18 +709,15 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         for x in lugs[bn]:
             if x[2]:
                 holes.append(cylinder(x[0], x[1], -t - 1, t + 1, lug_hole, n, cutter=True))
-        solid = subtract(solid, L(holes))
+        solid = subtract(solid, holes)
         # 4. the owner's pin
         pins = [cylinder(ax.origin, ax.direction, -ax.span / 2, ax.span / 2, r_pin, n)
                 for ax in my_axes if ax.pin_owner == bn and not cones]
-        solid = _clean(union([solid] + L(pins)))
+        solid = _clean(union([solid] + pins))
         protected[bn] = union(keep + pins + rings)
         if reuse:
             cores[bn] = union([subtract(union(keep + rings), holes)] + pins)
-        if Fb is None:
-            solid = _drop_scraps(solid, protected[bn], bn, notes)
-        else:
-            solid = transform_solid(_drop_scraps(solid, union(L(keep + pins + rings)), bn, notes), Fb)
+        solid = _drop_scraps(solid, protected[bn], bn, notes)
         # the spot where the attachment hole would go (0.85 mm in from the site), kept if possible
         spots = [cylinder(_spot(x[4], x[0], lug_out), x[1], -t, t, lug_out + c, n) for x in lugs[bn] if not x[2]]
         soft[bn] = union([protected[bn]] + spots)
@@ -725,6 +737,14 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
             fat_guard[bn] = (union(fat), union(fat + spots) if spots else None)
         partners = sorted({o for ax in my_axes for o in ax.bodies if o != bn}
                           | {uj.part for uj, _ in my_uj} | {ax.joint for ax in my_axes if ax.joint is not None})
+        _LOCAL[0] = None
+        if Fb is not None:
+            solid = transform_solid(solid, Fb)
+            for tab in (protected, soft, cores):
+                if bn in tab:
+                    tab[bn] = transform_solid(tab[bn], Fb)
+            if bn in fat_guard:
+                fat_guard[bn] = tuple(None if x is None else transform_solid(x, Fb) for x in fat_guard[bn])
         parts.append(Part(bn, "body", solid, partners))
 
     for uj in ujoints:
@@ -780,29 +800,6 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
 
 
 # --------------------------------------------------------------------------- helpers
-LOCAL_Q = 1e-9    # mm: vertex rounding of a primitive moved into its body's frame
-LOCAL_BUILD = True   # large assemblies: bodies built in their own frames (False: in the world, as before)
-
-
-def _localizer(F):
-    """A function taking a list of solids (world, mm) into the frame ``F`` (4x4), their vertices
-    rounded to :data:`LOCAL_Q` mm: two congruent bodies then give their booleans the same input
-    to the last bit (the same output mesh), not inputs differing by rounding in the 16th digit.
-    ``F`` None: the identity (the solids as they are)."""
-    if F is None:
-        return lambda items: list(items)
-    Fi = np.linalg.inv(F)
-
-    def move(items):
-        out = []
-        for m in items:
-            g = transform_solid(m, Fi).to_mesh64()
-            V = (np.round(np.asarray(g.vert_properties, float)[:, :3] / LOCAL_Q) * LOCAL_Q).copy()
-            out.append(mf.Manifold(mf.Mesh64(vert_properties=V, tri_verts=np.asarray(g.tri_verts, np.uint64).copy())))
-        return out
-    return move
-
-
 def _complement(own, lo, hi):
     """Intervals of ``[lo, hi]`` not covered by a body's own knuckles (gaps included): the
     cut reaches exactly to the faces of its own knuckles."""
@@ -1521,15 +1518,7 @@ def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t) -> None:
     """Drill each attachment hole inside its slab, at the spot nearest to the site where a
     full ring of material (``min_wall``) surrounds the hole."""
     n = asm.profile.circular_segments
-    cong = getattr(asm, "congruence", None)
-
-    def cut(solid, add, hole, k):
-        if cong is None:
-            return subtract(union([solid] + add), [hole])
-        # large assemblies: in the part's own frame, as it was built (congruent parts stay the same mesh)
-        L = _localizer(cong.frames[k])
-        return transform_solid(subtract(union(L([solid] + add)), L([hole])), cong.frames[k])
-    for k_part, part in enumerate(asm.parts):
+    for part in asm.parts:
         for site, nrm, ring, _, sb, label in lugs.get(part.name, []):
             if ring:
                 continue
@@ -1552,7 +1541,7 @@ def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t) -> None:
             for k in order[:400]:
                 c = cands[k]
                 if (disc.translate(c.tolist()) - part.solid).volume() <= 1e-3 * full:
-                    part.solid = cut(part.solid, [], cylinder(c, nrm, -t - 1, t + 1, lug_hole, n, cutter=True), k_part)
+                    part.solid = subtract(part.solid, [cylinder(c, nrm, -t - 1, t + 1, lug_hole, n, cutter=True)])
                     off = float(np.linalg.norm(c - site))
                     if off > 1e-6:
                         asm.notes.append(f"{label}: attachment hole {off:.2f} mm from the site, inside the slab")
@@ -1566,8 +1555,8 @@ def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t) -> None:
                 for c in [site] + along[:10]:
                     ringd = cylinder(c, nrm, -t / 2, t / 2, lug_out, n)
                     if _ring_clear(asm, part, ringd):
-                        part.solid = cut(part.solid, [ringd], cylinder(c, nrm, -t - 1, t + 1, lug_hole, n, cutter=True),
-                                         k_part)
+                        part.solid = subtract(union([part.solid, ringd]),
+                                              [cylinder(c, nrm, -t - 1, t + 1, lug_hole, n, cutter=True)])
                         asm.notes.append(f"{label}: no room inside the trimmed slab; a ring lug "
                                          f"{np.linalg.norm(c - site):.2f} mm from the site instead")
                         break
