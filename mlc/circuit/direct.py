@@ -167,13 +167,15 @@ def place_direct(sid: str, drv: str, pin: str, sc, pos, quat, by_name: dict, sta
     Returns (parts: the unit's and the sink's bodies and bonds, R, t: the sink's frame)."""
     from mlc.circuit.build import _pair
     tap = _pair(by_name, f"{drv}_out_lo.out", f"{drv}_out_hi.out")
-    up = np.array([0.0, 0.0, 1.0])
+    z = np.array([0.0, 0.0, 1.0])
+    up = z - float(z @ tap.axis) * tap.axis        # up, normal to the pair (a posed pair may tilt a little)
+    up /= np.linalg.norm(up)
     tag = f"d_{drv}"
     parts, in0, mid, end = unit_parts(tag, tap, up, state, geo, lever_stop, terminal_post)
     local = {b.name: Body(b.name, np.asarray(p, float), np.asarray(q, float), b.boxes, dict(b.sites))
              for b, p, q in zip(sc.bodies, pos, quat)}
     inp = _pair(local, f"{pin}_lo.in", f"{pin}_hi.in")
-    R, t = place_on_pair(inp, up, end, up)
+    R, t = place_on_pair(inp, z, end, up)
     bodies, bonds = moved_bodies(sid, sc, pos, quat, R, t)
     parts.bodies += bodies
     parts.bonds += bonds

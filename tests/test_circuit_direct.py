@@ -1,0 +1,62 @@
+"""Direct gate-to-gate connection (CircuitOptions.direct, docs/circuits.md section 3):
+a gate whose output feeds exactly one gate input is joined to it by one full unit and the
+sink placed on it, instead of a routed chain; nets with fan-out or read by an output are
+not."""
+import numpy as np
+import pytest
+
+from mlc.circuit.build import CircuitOptions, build_circuit
+from mlc.front.load import load
+from mlc.pipeline import compile_spec
+from mlc.verify.circuit import TOL_STRETCH, verify_static
+
+
+def _build(expr: str, direct: bool):
+    spec = load(None, expr)
+    c = compile_spec(spec)
+    return c.netlist, build_circuit(c.netlist, spec, options=CircuitOptions(direct=direct))
+
+
+@pytest.fixture(scope="module")
+def two_gates():
+    return _build("f = ~(a & b) & c", True), _build("f = ~(a & b) & c", False)
+
+
+def test_direct_joins_the_pairs(two_gates):
+    (net, circ), (_, base) = two_gates
+    sc = circ.scene
+    drv, sink, pin = sc.meta["connector"]["direct"][0]
+    assert len(sc.meta["connector"]["direct"]) == 1 and sc.meta["connector"]["chains"] == 0
+    assert "direct" not in base.scene.meta["connector"]                # the default build is unchanged
+    assert len(sc.bodies) < len(base.scene.bodies) // 5                 # 24 bodies instead of 240
+    bonds = {b.name: b for b in sc.bonds}
+    by = {b.name: b for b in sc.bodies}
+    for e in ("lo", "hi"):                                              # the unit's end on the sink's pair
+        b = bonds[f"d_{drv}_end_{e}"]
+        assert b.kind == "universal" and b.b == f"{sink}_{pin}_{e}.in"
+        pa, sa = b.a.split(".")
+        pb, sb = b.b.split(".")
+        assert np.linalg.norm(by[pa].world(sa) - by[pb].world(sb)) < 1e-9      # closed at build
+        j = bonds[f"d_{drv}_j0_{e}"]                                    # ... and its start on the driver's
+        assert j.a == f"{drv}_out_{e}.out"
+    for k in range(3):                                                  # a stop per junction
+        assert bonds[f"d_{drv}_s{k}"].kind == "bond" and bonds[f"d_{drv}_s{k}"].tolerance > 0
+    # the sink stands upright over its driver, clear of it
+    assert by[f"{sink}_core_ab"].position[2] > by[f"{drv}_out_lo"].position[2] + 2.0
+
+
+def test_direct_two_gates_static_every_row(two_gates):
+    (net, circ), _ = two_gates
+    rep = verify_static(circ.scene, kT=None)
+    assert rep.ok and len(rep.rows) == 8
+    for r in rep.rows:
+        assert r["joint_stretch"] < TOL_STRETCH and r["clearance"] > 0.0
+
+
+@pytest.mark.parametrize("expr", ["f = ~(a & b) & c; g = ~(a & b)",       # the net is also read by an output
+                                  "f = ~(a & b) & c; g = ~(a & b) | d"])  # the net fans out to two gates
+def test_fanout_or_output_is_not_direct(expr):
+    net, circ = _build(expr, True)
+    assert circ.scene.meta["connector"]["direct"] == []
+    assert not any(b.name.startswith("d_") for b in circ.scene.bodies)
+    assert circ.scene.meta["connector"]["chains"] >= 1
