@@ -7,11 +7,12 @@ the router flagged tight, the build and verification wall times, the rows read r
 the largest joint stretch and the smallest slab clearance per row (exact oriented-box
 test) with the pair of bodies that sets it.
 
-    python benchmarks/circuit_examples.py [--only tetris.tt ...]
+    python benchmarks/circuit_examples.py [--only tetris.tt ...] [--joint-k K]
 
 With ``--only`` the other examples' last entries are kept (each entry names its commit).
+``--joint-k K`` builds with connector joints K times k0 (``mlc compile --joint-k``).
 
-Writes benchmarks/results/circuit_examples.json.  Wall seconds on this machine in one
+Writes benchmarks/results/circuit_examples.json (``circuit_examples_jointk{K}.json`` with ``--joint-k``).  Wall seconds on this machine in one
 run (shared, noisy): compare ratios, not absolute numbers across machines.
 """
 from __future__ import annotations
@@ -24,6 +25,7 @@ import subprocess
 import time
 from pathlib import Path
 
+from mlc.circuit.build import CircuitOptions
 from mlc.pipeline import build, compile_spec, load
 from mlc.verify.circuit import verify_static
 
@@ -32,11 +34,11 @@ OUT = ROOT / "benchmarks" / "results"
 SUFFIXES = (".tt", ".pla", ".expr", ".blif", ".aag")
 
 
-def example_point(path: Path) -> dict:
+def example_point(path: Path, joint_k: float | None = None) -> dict:
     t0 = time.perf_counter()
     compiled = compile_spec(load(str(path)))
     t1 = time.perf_counter()
-    compiled = build(compiled)
+    compiled = build(compiled, options=None if joint_k is None else CircuitOptions(joint_k=joint_k))
     t2 = time.perf_counter()
     circ = compiled.circuit
     sc = circ.scene
@@ -44,7 +46,7 @@ def example_point(path: Path) -> dict:
     t3 = time.perf_counter()
     rows = [{"state": r["state"], "ok": r["ok"], "clearance": r.get("clearance"),
              "clearance_pair": r.get("clearance_pair"), "joint_stretch": r["joint_stretch"]} for r in rep.rows]
-    return {"example": path.name, "inputs": len(sc.inputs), "outputs": len(sc.outputs),
+    return {"example": path.name, "joint_k": sc.meta["connector"]["joint_k"], "inputs": len(sc.inputs), "outputs": len(sc.outputs),
             "gates": len(compiled.netlist.gates), "bodies": len(sc.bodies), "chains": circ.chains,
             "half_units": circ.half_units, "tight_chains": sc.meta["connector"]["tight_chains"],
             "compile_s": t1 - t0, "build_s": t2 - t1, "verify_all_rows_s": t3 - t2,
@@ -57,7 +59,9 @@ def example_point(path: Path) -> dict:
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--only", nargs="*", help="example file names (default: all)")
+    ap.add_argument("--joint-k", type=float, default=None, help="connector joint stiffness, in k0 (default: mlc's)")
     args = ap.parse_args()
+    res_path = OUT / ("circuit_examples.json" if args.joint_k is None else f"circuit_examples_jointk{args.joint_k:g}.json")
     paths = sorted(p for p in (ROOT / "examples").iterdir() if p.suffix in SUFFIXES)
     if args.only:
         paths = [p for p in paths if p.name in args.only]
@@ -69,11 +73,11 @@ def main():
     points = []
     OUT.mkdir(parents=True, exist_ok=True)
     old = {}
-    if args.only and (OUT / "circuit_examples.json").exists():      # keep the other examples' last results
-        prev = json.loads((OUT / "circuit_examples.json").read_text())
+    if args.only and res_path.exists():      # keep the other examples' last results
+        prev = json.loads(res_path.read_text())
         old = {e["example"]: e for e in prev.get("examples", []) if e["example"] not in args.only}
     for p in paths:
-        pt = example_point(p)
+        pt = example_point(p, args.joint_k)
         pt["commit"] = commit
         points.append(pt)
         print(f"{pt['example']:>18}: {pt['gates']} gates, {pt['bodies']} bodies, build {pt['build_s']:.1f} s, "
@@ -85,8 +89,8 @@ def main():
                "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
                "examples": sorted(points + list(old.values()), key=lambda e: e["example"]),
                "complete": len(points) == len(paths)}
-        (OUT / "circuit_examples.json").write_text(json.dumps(res, indent=1))     # after each example
-    print(f"wrote {OUT / 'circuit_examples.json'}")
+        res_path.write_text(json.dumps(res, indent=1))     # after each example
+    print(f"wrote {res_path}")
 
 
 if __name__ == "__main__":
