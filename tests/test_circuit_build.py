@@ -140,8 +140,9 @@ def test_joint_k_stiffens_connector_bonds_and_narrows_the_thermal_spread():
     from mlc.verify.dynamic import probe_thermal_sd
 
     c = compile_spec(load(None, "y = (a & b) | c"))
-    soft = build_circuit(c.netlist, c.spec).scene
-    stiff = build_circuit(c.netlist, c.spec, CircuitOptions(joint_k=100.0)).scene
+    soft = build_circuit(c.netlist, c.spec, CircuitOptions(joint_k=1.0)).scene     # the paper's joints
+    stiff = build_circuit(c.netlist, c.spec).scene                                  # the default: 100 k0
+    assert CircuitOptions().joint_k == 100.0
     assert [b.name for b in soft.bonds] == [b.name for b in stiff.bonds]
     for a, b in zip(soft.bonds, stiff.bonds):
         assert b.k == pytest.approx(a.k * (1.0 if a.name.startswith("g") else 100.0)), a.name

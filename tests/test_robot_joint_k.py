@@ -1,4 +1,4 @@
-"""Stiff connector joints in a robot (``mlc compile --joint-k K``, docs/robot.md 2.5): the
+"""Stiff connector joints in a robot (``mlc compile``, default K = 100; ``--joint-k K``, docs/robot.md 2.5): the
 coupling chains get the circuit's joint stiffness K k0 on every bond, like the circuit's own
 chains; the skeleton's hinges, joint stops and locks and the circuit's muscles keep k0."""
 import pytest
@@ -14,7 +14,7 @@ def stiff(tmp_path_factory, tiny_robot_yaml):
     d = tmp_path_factory.mktemp("tinyk")
     (d / "tiny.robot.yaml").write_text(tiny_robot_yaml)
     rc = main(["compile", "-e", "u1_up = a; u2_dn = a", "--robot", str(d / "tiny.robot.yaml"),
-               "--joint-k", f"{K:g}", "-o", str(d / "out")])
+               "-o", str(d / "out")])                      # the default joints: K = 100 k0
     assert rc == 0
     return load_scene(d / "out" / "robot.yaml")
 
@@ -38,10 +38,10 @@ def test_chain_bonds_carry_joint_k_skeleton_and_muscles_k0(stiff):
     assert any(b.k == K for b in stiff.bonds if not b.name.startswith(("rc_", "skel_")))
 
 
-def test_default_build_is_k0(tmp_path, tiny_robot_yaml):
+def test_paper_joints_build_is_k0(tmp_path, tiny_robot_yaml):
     (tmp_path / "tiny.robot.yaml").write_text(tiny_robot_yaml)
     assert main(["compile", "-e", "u1_up = a; u2_dn = a", "--robot", str(tmp_path / "tiny.robot.yaml"),
-                 "-o", str(tmp_path / "out")]) == 0
+                 "--joint-k", "1", "-o", str(tmp_path / "out")]) == 0
     sc = load_scene(tmp_path / "out" / "robot.yaml")
     assert sc.meta["robot"]["k"]["joint_k"] == 1.0
     assert all(b.k == 1.0 for b in sc.bonds if b.name.startswith("rc_"))

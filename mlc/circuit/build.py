@@ -80,8 +80,9 @@ class CircuitOptions:
     gap: float = 0.5                 # connector junction gap (sigma)
     level_pitch: float = LEVEL_PITCH
     gate_pitch: float = GATE_PITCH
-    joint_k: float = 1.0             # connector joints' bond stiffness, in units of the design k (k0);
-                                     # the muscles keep the design k (docs/circuits.md, "Thermal spread")
+    joint_k: float = 100.0           # connector joints' bond stiffness, in units of the design k (k0); 1 is
+                                     # the paper's; muscles and gates keep the design k (docs/circuits.md,
+                                     # "Thermal spread": 100 k0 joints give 12 spreads of margin, not 1.8)
     direct: bool = False             # join a gate's single-sink net by one full unit (mlc.circuit.direct)
 
 

@@ -37,8 +37,8 @@ def register(sub):
     p.add_argument("--no-circuit", action="store_true",
                    help="stop at the netlist (no circuit scene OUTDIR/circuit.yaml and picture OUTDIR/circuit.png)")
     p.add_argument("--joint-k", dest="joint_k", type=float, default=None, metavar="K",
-                   help="connector joints' stiffness in units of the design k0 (default 1, the paper's; "
-                        "stiffer joints narrow the thermal spread of long chains, docs/circuits.md)")
+                   help="connector joints' stiffness in units of the design k0 (default 100; 1 is the paper's, "
+                        "whose long chains spread thermally over a third of the logic margin, docs/circuits.md)")
     p.add_argument("--direct", action="store_true",
                    help="join a gate whose output feeds exactly one gate input by one full connector unit, "
                         "the sink placed on it (docs/circuits.md section 3, 'Direct connection')")
