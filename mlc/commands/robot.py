@@ -37,6 +37,9 @@ def register(sub):
     a.add_argument("--dynamic", action="store_true", help="final poses of Brownian dynamics instead of statics")
     a.add_argument("--kT", type=float, default=1e-5)
     a.add_argument("--seed", type=int, default=0)
+    a.add_argument("--dt", type=float, metavar="DT",
+                   help="--dynamic: the integrator's step (t0; default mlc.robot.verify.ROBOT_DT, "
+                        "0.2 is within the noise of it for the Tetris robot: docs/robot.md 3.5)")
     a.add_argument("--json", metavar="JSON", help="also write the verification report here")
     a.set_defaults(func=run_shapes)
     b = rs.add_parser("fold", help="one fold by Brownian dynamics: GIF, PNG frames, GSD")
@@ -58,13 +61,21 @@ def run_shapes(args) -> int:
     from mlc.robot.verify import format_robot_report, verify_robot_dynamic, verify_robot_static
     from mlc.scene.io import load_scene
 
+    from mlc.errors import MlcError
+
+    if args.dt is not None:
+        if not args.dynamic:
+            raise MlcError("--dt needs --dynamic (it sets the Brownian-dynamics run)", "--dt",
+                           "add --dynamic or leave --dt out")
+        if not (args.dt > 0 and args.dt < float("inf")):
+            raise MlcError(f"--dt must be a finite time > 0 (t0), got {args.dt}", "--dt", "e.g. --dt 0.2")
     outs = Outputs(inputs=[args.scene])
     png = outs.file(args.out, "-o", suffixes=(".png",), parents=True)
     js = outs.file(args.json, "--json", suffixes=(".json",), parents=True)
     outs.check()
     scene = load_scene(args.scene)
     if args.dynamic:
-        rep = verify_robot_dynamic(scene, kT=args.kT, seeds=1, keep_poses=True)
+        rep = verify_robot_dynamic(scene, kT=args.kT, seeds=1, keep_poses=True, dt=args.dt)
         poses = {s: v for (s, seed), v in rep.poses.items()}
     else:
         rep = verify_robot_static(scene, keep_poses=True)
