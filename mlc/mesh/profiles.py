@@ -172,7 +172,8 @@ MAX_SIGMA_MM = 1000.0
 #: most polygon segments per circle (a 3 mm pin at 256 segments is within 0.0001 mm of a circle)
 MAX_SEGMENTS = 256
 MAX_MECHANISM_BODIES = 2000  # larger mechanisms are refused (check_against_scene): the Tetris circuit, 1631
-                             # bodies, was measured at 1.8 GB peak in 25 min of build (docs/printing.md)
+                             # bodies, takes about 7 min and 3.3 GB; the Tetris robot's 2221-body mechanism
+                             # did not finish its checks in 25 min (docs/printing.md)
 #: memory an export may always plan to use (bytes); see :func:`memory_budget`
 MEMORY_BUDGET = 2 * 2 ** 30
 
@@ -381,8 +382,9 @@ def check_against_scene(prof: Profile, scene, where: str = "--profile", options:
     largest = max((len(b) for b in reps), default=0)
     if largest > MAX_MECHANISM_BODIES:
         raise MlcError(f"one mechanism of this scene has {largest} bodies; mlc meshes mechanisms of at most "
-                       f"{MAX_MECHANISM_BODIES} (measured up to the Tetris circuit, 1631 bodies: 25 min of build "
-                       f"at 1.8 GB; larger ones are untested; docs/printing.md, 'Compiled circuits')",
+                       f"{MAX_MECHANISM_BODIES} (the Tetris circuit, 1631 bodies, takes about 7 min at 3.3 GB; the "
+                       f"Tetris robot's mechanism of 2221 bodies did not finish its checks in 25 min; "
+                       f"docs/printing.md, 'Compiled circuits')",
                        "TARGET", "mesh the library gates on their own (mlc stl NAND), or a circuit of fewer gates")
     est = estimate_memory(prof, scene)
     budget = memory_budget()
