@@ -320,6 +320,13 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     each pair of congruent parts once per relative pose (:mod:`mlc.mesh.congruence`); by
     default on for assemblies of at least :data:`REUSE_MIN_PARTS` parts (compiled circuits),
     off for the library gates, whose meshes stay exactly as they were."""
+    try:
+        return _build_assembly(scene, profile, poses, resolve, reuse)
+    finally:
+        _LOCAL[0] = None     # primitives are built in the world again, whatever happened
+
+
+def _build_assembly(scene, profile, poses, resolve, reuse) -> Assembly:
     prof = profile
     _LOCAL[0] = None
     s = prof.sigma_mm
