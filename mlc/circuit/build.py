@@ -36,7 +36,7 @@ from functools import lru_cache
 import numpy as np
 
 from mlc.errors import MlcError
-from mlc.gates.connector import (POST_WIDTH, ConnectorGeometry, Pair, Parts, branch_angles, chain_parts, connector_geometry,
+from mlc.gates.connector import (POST_WIDTH, Pair, Parts, branch_angles, chain_parts, connector_geometry,
                                  half_unit_parts, half_unit_prefix, join, junction_stops, max_bend, rotate)
 from mlc.gates.parts import slab_body
 from mlc.scene.model import Body, Bond, Muscle, Probe, Scene
@@ -172,18 +172,10 @@ def _truth_table(spec, netlist) -> dict[str, str]:
 
 
 def _gate_bodies(gid: str, sc: Scene, pos, quat, offset) -> tuple[list[Body], list[Bond]]:
-    """The gate's bodies and bonds, renamed ``{gid}_{name}`` and moved by ``offset``."""
-    from mlc.geometry.rotation import matrix_to_quat, quat_to_matrix
-    bodies = [Body(f"{gid}_{b.name}", _ROT @ np.asarray(p, float) + offset,
-                   matrix_to_quat(_ROT @ quat_to_matrix(q)), b.boxes, dict(b.sites))
-              for b, p, q in zip(sc.bodies, pos, quat)]
-    bonds = []
-    for b in sc.bonds:
-        ba, sa = b.a.split(".", 1)
-        bb, sb = b.b.split(".", 1)
-        bonds.append(Bond(f"{gid}_{b.name}", f"{gid}_{ba}.{sa}", f"{gid}_{bb}.{sb}", b.k, b.rest, b.tolerance,
-                          b.kind, f"{gid}_{b.joint}" if b.joint else None))
-    return bodies, bonds
+    """The gate's bodies and bonds, renamed ``{gid}_{name}``, turned by the placement's
+    rotation and moved by ``offset``."""
+    from mlc.circuit.direct import moved_bodies
+    return moved_bodies(gid, sc, pos, quat, _ROT, np.asarray(offset, float))
 
 
 def _world(bodies_by_name, ref: str) -> np.ndarray:
