@@ -49,6 +49,8 @@ def register(sub):
     b.add_argument("--frames", type=int, default=40, help="frames (default 40)")
     b.add_argument("--kT", type=float, default=1e-5)
     b.add_argument("--seed", type=int, default=0)
+    b.add_argument("--dt", type=float, metavar="DT",
+                   help="the integrator's step (t0; default mlc.robot.verify.ROBOT_DT, the stiff scheme's)")
     b.add_argument("--gif", metavar="GIF")
     b.add_argument("--png-dir", metavar="DIR", help="write the frames as DIR/frame_000.png ...")
     b.add_argument("--gsd", metavar="GSD", help="GSD trajectory of the whole robot (slab shapes)")
@@ -75,7 +77,7 @@ def run_shapes(args) -> int:
     outs.check()
     scene = load_scene(args.scene)
     if args.dynamic:
-        rep = verify_robot_dynamic(scene, kT=args.kT, seeds=1, keep_poses=True, dt=args.dt)
+        rep = verify_robot_dynamic(scene, kT=args.kT, seeds=1, keep_poses=True, dt=args.dt, first_seed=args.seed)
         poses = {s: v for (s, seed), v in rep.poses.items()}
     else:
         rep = verify_robot_static(scene, keep_poses=True)
@@ -95,7 +97,7 @@ def run_fold(args) -> int:
     from mlc.errors import MlcError
     from mlc.io.outputs import Outputs
     from mlc.robot.draw import gif_bytes, render_frames
-    from mlc.robot.verify import _shape_row, robot_meta
+    from mlc.robot.verify import ROBOT_DT, _shape_row, robot_meta
     from mlc.scene.io import load_scene
     from mlc.sim.drive import Drive
     from mlc.sim.integrator import SimOptions, Simulation
@@ -103,6 +105,8 @@ def run_fold(args) -> int:
 
     if not args.time > 0:
         raise MlcError(f"--time must be > 0, got {args.time}", "--time")
+    if args.dt is not None and not (args.dt > 0 and args.dt < float("inf")):
+        raise MlcError(f"--dt must be a finite time > 0 (t0), got {args.dt}", "--dt", "e.g. --dt 0.05")
     if args.frames < 2:
         raise MlcError(f"need at least 2 frames, got {args.frames}", "--frames")
     outs = Outputs(inputs=[args.scene])
@@ -115,7 +119,8 @@ def run_fold(args) -> int:
     if args.row not in scene.states():
         raise MlcError(f"row {args.row!r} is not an input state (inputs {scene.inputs})", "--row")
     drives = {n: Drive.constant(int(b)) for n, b in zip(scene.inputs, args.row)}
-    sim = Simulation(scene, drives, SimOptions(scheme="stiff", kT=args.kT, seed=args.seed, dt=0.01))
+    sim = Simulation(scene, drives, SimOptions(scheme="stiff", kT=args.kT, seed=args.seed,
+                                               dt=ROBOT_DT if args.dt is None else args.dt))
     res = sim.run(args.time, frames=args.frames, quiet=True)
     shape = _shape_row(scene, rm, args.row, res.frame_pos[-1], res.frame_quat[-1])
     title = f"{scene.name} row {args.row}"

@@ -284,7 +284,7 @@ def verify_robot_static(scene: Scene, rows=None, steps: int = STEPS, progress=No
 
 def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
                          max_time: float | None = None, progress=None, keep_poses: bool = False,
-                         tau: float | None = None, dt: float | None = None) -> Report:
+                         tau: float | None = None, dt: float | None = None, first_seed: int = 0) -> Report:
     """Brownian dynamics from rest into each row, ``seeds`` seeds, until relaxed
     (:func:`run_fold`: at least 3 tau, circuit outputs on a plateau, joint angles within
     their thermal noise) or ``max_time`` t0 (default the paper's 1800 t0); the shape is
@@ -292,7 +292,7 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
     ``dt`` (t0): the scheme's step (default ``ROBOT_DT``); ``tau`` (t0): the slowest
     relaxation time (default ``ROBOT_TAU``, measured on the robots' folds, docs/robot.md
     section 3; ``"compute"`` runs :func:`mlc.verify.dynamic.relaxation_time`, which takes
-    more than 8 min for a 2000-body robot)."""
+    more than 8 min for a 2000-body robot).  Seeds are ``first_seed``, ``first_seed + 1``, ..."""
     from mlc.io.progress import Progress
     from mlc.sim.drive import Drive
     from mlc.sim.integrator import SimOptions, Simulation
@@ -314,8 +314,8 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
         tau = relaxation_time(scene, gamma_r=opt0.gamma_r)
     tau = ROBOT_TAU if tau is None else float(tau)
     dt = ROBOT_DT if (dt is None and scheme == "stiff") else dt
-    rep = Report(scene.name, "dynamic", params={"kT": kT, "seeds": int(seeds), "scheme": scheme, "tau": tau,
-                                                "dt": dt, "robot": True})
+    rep = Report(scene.name, "dynamic", params={"kT": kT, "seeds": int(seeds), "first_seed": int(first_seed),
+                                                "scheme": scheme, "tau": tau, "dt": dt, "robot": True})
     poses = {}
     total, done = len(states) * int(seeds), 0
     bar = Progress(f"dynamic check of {scene.name}", total=total, show=None if progress is None else False)
@@ -325,7 +325,7 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
             drives = {inp: Drive.constant(int(b)) for inp, b in zip(scene.inputs, state)}
             t_max = float(max_time) if max_time is not None else FOLD_TIME
             per = []
-            for seed in range(int(seeds)):
+            for seed in range(int(first_seed), int(first_seed) + int(seeds)):
                 sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed,
                                                      dt=None if dt is None else float(dt)))
                 means, t_rel, relaxed, _, _ = run_fold(sim, scene, state, kT, tau, t_max)
@@ -359,7 +359,7 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
                                 "max_dof_error_deg": sh["max_dof_error_deg"],
                                 "max_dof_mean_error_deg": sh.get("max_dof_mean_error_deg"), "time": t,
                                 "dof_angles": sh["dof_angles"]}
-                               for s, (_, t, _, sh) in enumerate(per)]
+                               for s, (_, t, _, sh) in enumerate(per, start=int(first_seed))]
             row["shape_ok"] = all(sh["shape_ok"] for sh in shapes)
             row["ok"] = bool(row_ok and row["shape_ok"])
             rep.rows.append(row)
