@@ -271,8 +271,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         zlevel[d] = zlevel[d - 1] + opt.level_pitch + LAYER_PITCH * arriving.get(d, 0)
     origin: dict[str, np.ndarray] = {}
     for d in sorted(levels):
-        for _ in direct:                         # a direct sink stands over its driver
-            for s_, (drv, _p) in direct.items():
+        for _ in direct:                         # a direct sink stands over its driver; repeated
+            for s_, (drv, _p) in direct.items():  # len(direct) times: a sink may drive another sink
                 if ("gate", drv) in xpos:
                     xpos[("gate", s_)] = xpos[("gate", drv)]
         gs = levels[d]
