@@ -31,6 +31,8 @@ from mlc.gates.connector import STOP_ARM, ConnectorGeometry, Pair, Parts, half_u
 from mlc.geometry.rotation import matrix_to_quat, quat_to_matrix
 from mlc.scene.model import Body, Bond
 
+__all__ = ["DIRECT_FREE", "direct_nets", "moved_bodies", "place_on_pair", "place_direct", "pure_clearance", "swing_stop", "unit_parts"]
+
 DIRECT_FREE = math.radians(10.0)   # each junction of a direct connection swings freely this far from built
 LEVER_TILT = math.radians(15.0)    # ... plus this at the driver's lever: its line tilts with the lever (12.4 deg
                                    # between the states of a NAND's output, which the stop must not resist)
@@ -135,9 +137,8 @@ def pure_clearance(drv_type: str, drv_state: str, snk_type: str, snk_state: str,
     db, dbond = _gate_bodies("g1", sc, pos, quat, np.zeros(3))
     out = _pair({b.name: b for b in db}, "g1_out_lo.out", "g1_out_hi.out")
     sc2, pos2, quat2 = _posed_gate(snk_type, signal, snk_state)
-    by2 = {f"g2_{b.name}": b for b in sc2.bodies}
-    for b, p, q in zip(sc2.bodies, pos2, quat2):
-        by2[f"g2_{b.name}"] = Body(b.name, np.asarray(p, float), np.asarray(q, float), b.boxes, dict(b.sites))
+    by2 = {f"g2_{b.name}": Body(b.name, np.asarray(p, float), np.asarray(q, float), b.boxes, dict(b.sites))
+           for b, p, q in zip(sc2.bodies, pos2, quat2)}
     inp = _pair(by2, f"g2_{pin}_lo.in", f"g2_{pin}_hi.in")
     z = np.array([0.0, 0.0, 1.0])
     res = []
@@ -154,8 +155,6 @@ def pure_clearance(drv_type: str, drv_state: str, snk_type: str, snk_state: str,
             res.append((sign, int(round(phi)), float(clearance(s).min_clearance)))
     return res
 
-
-__all__ = ["DIRECT_FREE", "direct_nets", "moved_bodies", "place_on_pair", "place_direct", "pure_clearance", "swing_stop", "unit_parts"]
 
 
 def place_direct(sid: str, drv: str, pin: str, sc, pos, quat, by_name: dict, state: int, geo: ConnectorGeometry,

@@ -13,8 +13,6 @@ from __future__ import annotations
 
 import json
 import sys
-import time
-from pathlib import Path
 
 from mlc.errors import MlcError
 
@@ -138,7 +136,6 @@ def format_summary(d: dict) -> str:
 
 
 def run(args) -> int:
-    from mlc.errors import MlcError
     from mlc.front.load import load
     from mlc.io.outputs import Outputs
     from mlc.io.progress import Progress
@@ -181,8 +178,8 @@ def run(args) -> int:
         from mlc.circuit.build import CircuitOptions
         from mlc.pipeline import build
         from mlc.scene.io import dump_scene
-        opts = CircuitOptions() if joint_k is None else CircuitOptions(joint_k=joint_k)
-        opts.direct = bool(getattr(args, "direct", False))
+        extra = {} if joint_k is None else {"joint_k": joint_k}
+        opts = CircuitOptions(direct=bool(getattr(args, "direct", False)), **extra)
         with Progress("placing and routing", total=1) as bar:
             build(c, progress=lambda done, total: (setattr(bar, "total", total), bar.update(done)), options=opts)
         scene = c.circuit.scene

@@ -33,7 +33,7 @@ from numba import njit, prange
 # Parallel kernels (threads > 1) prefer OpenMP over TBB unless the user chose a layer: with
 # TBB, one advance() of many tiny parallel steps slows down as it runs (8 bodies, 2 threads,
 # idle machine: 0.025 ms/step over 200 steps, 0.24 over 2000, 6.7 over 20000), while OpenMP
-# stays at 0.0054 ms/step (docs/simulation.md, "Threads").
+# stays at 0.0054 ms/step (docs/simulation.md, "Benchmarks", throughput).
 if "NUMBA_THREADING_LAYER" not in os.environ and "NUMBA_THREADING_LAYER_PRIORITY" not in os.environ:
     numba.config.THREADING_LAYER_PRIORITY = ["omp", "tbb", "workqueue"]
 
