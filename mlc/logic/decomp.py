@@ -21,6 +21,21 @@ from mlc.logic.aig import AIG
 from mlc.logic.lower import factor_sop
 
 
+# Caches of the pure steps (their results depend only on the arguments and the
+# number of variables), shared by all decompositions: refactoring meets the same cone
+# functions again in every round.  Cleared when they grow past _CACHE_MAX entries.
+_CACHE_MAX = 200_000
+_support_cache: dict = {}
+_sop_cache: dict = {}
+_exact_cache: dict = {}
+
+
+def _cache_put(cache: dict, key, value) -> None:
+    if len(cache) >= _CACHE_MAX:
+        cache.clear()
+    cache[key] = value
+
+
 class _Dec:
     def __init__(self, n: int, effort: int, rng=None):
         self.rng = rng
@@ -38,20 +53,37 @@ class _Dec:
     # -------------------------------------------------------------- analysis
     def reduce_support(self, f: int, care: int) -> tuple[int, int, list[int]]:
         n = self.n
+        key = (n, f, care)
+        r = _support_cache.get(key)
+        if r is not None:
+            return r[0], r[1], list(r[2])
         sup = []
+        pos, neg = T.var_tables(n)
         for i in range(n):
-            if not T.depends(f, n, i) and not T.depends(care, n, i):
-                continue
+            s = 1 << i
+            vi, ni = pos[i], neg[i]
+            if ((f & vi) >> s) == (f & ni) and ((care & vi) >> s) == (care & ni):
+                continue                      # depends on neither
             off = care & ~f
-            on0, on1 = T.cof0(f, n, i), T.cof1(f, n, i)
-            of0, of1 = T.cof0(off, n, i), T.cof1(off, n, i)
+            lo = f & ni
+            on0 = lo | (lo << s)
+            hi = f & vi
+            on1 = hi | (hi >> s)
+            lo = off & ni
+            of0 = lo | (lo << s)
+            hi = off & vi
+            of1 = hi | (hi >> s)
             if on0 & of1 == 0 and on1 & of0 == 0:
                 # need not depend on i: merge the cofactors
                 f = on0 | on1
-                care = T.cof0(care, n, i) | T.cof1(care, n, i)
+                lo = care & ni
+                hi = care & vi
+                care = lo | (lo << s) | hi | (hi >> s)
             else:
                 sup.append(i)
-        return f & care, care, sup
+        r = (f & care, care, tuple(sup))
+        _cache_put(_support_cache, key, r)
+        return r[0], r[1], sup
 
     # -------------------------------------------------------------- main recursion
     def rec(self, f: int, care: int) -> tuple[int, object]:
@@ -128,11 +160,22 @@ class _Dec:
         if sh is not None:
             return sh
         off = care & ~f
+        pos, neg = T.var_tables(n)
         # disjoint-support steps
         for i in sup:
-            on0, on1 = T.cof0(f, n, i), T.cof1(f, n, i)
-            of0, of1 = T.cof0(off, n, i), T.cof1(off, n, i)
-            c0, c1 = T.cof0(care, n, i), T.cof1(care, n, i)
+            sh_, vi, ni = 1 << i, pos[i], neg[i]
+            t = f & ni
+            on0 = t | (t << sh_)
+            t = f & vi
+            on1 = t | (t >> sh_)
+            t = off & ni
+            of0 = t | (t << sh_)
+            t = off & vi
+            of1 = t | (t >> sh_)
+            t = care & ni
+            c0 = t | (t << sh_)
+            t = care & vi
+            c1 = t | (t >> sh_)
             x = 2 * (i + 1)
             if on0 == 0:                 # f = x & f1
                 c, p = self.rec(on1, c1)
@@ -157,8 +200,15 @@ class _Dec:
             # Shannon on the variables whose cofactors are simplest
             scored = []
             for i in sup:
-                on0, on1 = T.cof0(f, n, i), T.cof1(f, n, i)
-                c0, c1 = T.cof0(care, n, i), T.cof1(care, n, i)
+                sh_, vi, ni = 1 << i, pos[i], neg[i]
+                t = f & ni
+                on0 = t | (t << sh_)
+                t = f & vi
+                on1 = t | (t >> sh_)
+                t = care & ni
+                c0 = t | (t << sh_)
+                t = care & vi
+                c1 = t | (t >> sh_)
                 s0 = len(self.reduce_support(on0, c0)[2])
                 s1 = len(self.reduce_support(on1, c1)[2])
                 noise = self.rng.random() * 3 if self.rng is not None else 0.0
@@ -174,6 +224,14 @@ class _Dec:
         return best
 
     def sop_plan(self, f: int, care: int):
+        key = (self.n, f, care)
+        r = _sop_cache.get(key)
+        if r is None:
+            r = self._sop_plan(f, care)
+            _cache_put(_sop_cache, key, r)
+        return r[0], (r[1][0], r[1][1], r[1][2])      # a fresh plan object (see build)
+
+    def _sop_plan(self, f: int, care: int):
         n, full = self.n, self.full
         cubes, _ = T.isop(f, f | (full & ~care), n)
         off = care & ~f
@@ -188,6 +246,14 @@ class _Dec:
         return best
 
     def exact(self, f: int, care: int, sup: list[int]):
+        key = (self.n, f, care, tuple(sup))
+        r = _exact_cache.get(key)
+        if r is None:
+            r = self._exact(f, care, sup)
+            _cache_put(_exact_cache, key, r)
+        return r[0], (r[1][0], r[1][1], r[1][2])      # a fresh plan object (see build)
+
+    def _exact(self, f: int, care: int, sup: list[int]):
         n = self.n
         k = len(sup)
         lf = T.shrink(f, n, sup)

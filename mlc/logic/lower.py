@@ -44,14 +44,22 @@ def factor_sop(g: AIG, cubes: Sequence[tuple[int, int]], var_lits: Sequence[int]
             return g.and_(cube_lit(cp, cq), rec(rest))
         # the literal in most cubes
         best, bestc = None, 1
+        cnt_p = [0] * nv
+        cnt_q = [0] * nv
+        for p, q in cs:
+            while p:
+                low = p & -p
+                cnt_p[low.bit_length() - 1] += 1
+                p ^= low
+            while q:
+                low = q & -q
+                cnt_q[low.bit_length() - 1] += 1
+                q ^= low
         for i in range(nv):
-            bit = 1 << i
-            cnt_p = sum(1 for p, _ in cs if p & bit)
-            cnt_q = sum(1 for _, q in cs if q & bit)
-            if cnt_p > bestc:
-                best, bestc = (i, 0), cnt_p
-            if cnt_q > bestc:
-                best, bestc = (i, 1), cnt_q
+            if cnt_p[i] > bestc:
+                best, bestc = (i, 0), cnt_p[i]
+            if cnt_q[i] > bestc:
+                best, bestc = (i, 1), cnt_q[i]
         if best is None:
             return g.or_many([cube_lit(p, q) for p, q in cs])
         i, neg = best

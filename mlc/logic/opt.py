@@ -17,6 +17,7 @@ Passes
 from __future__ import annotations
 
 import random
+from heapq import heappop, heappush
 
 from mlc.spec import NetworkSpec, TableSpec
 from mlc.logic import tt as T
@@ -392,26 +393,27 @@ def resub_window(g: AIG, max_leaves: int | None = None, max_new: int = 2, max_wi
         full = T.mask(k)
         vals: dict[int, int] = {leaf: T.var(k, i) for i, leaf in enumerate(leaves)}
         # window: grow from the leaves through fanouts whose fanins are all inside
+        # (candidates are taken smallest first: a heap)
         cand = sorted({y for leaf in leaves for y in fanouts[leaf]})
         seen = set(cand)
-        i = 0
-        while i < len(cand) and len(vals) < max_window:
-            y = cand[i]
-            i += 1
-            if y in vals or y > x + max_window:
+        ands = g.ands
+        top = x + max_window
+        while cand and len(vals) < max_window:
+            y = heappop(cand)
+            if y in vals or y > top:
                 continue
-            a, b = g.ands[y - n - 1]
-            if (a >> 1) in vals and (b >> 1) in vals:
-                va = vals[a >> 1] ^ (full if a & 1 else 0)
-                vb = vals[b >> 1] ^ (full if b & 1 else 0)
-                vals[y] = va & vb
-                for z in fanouts[y]:
-                    if z not in seen:
-                        seen.add(z)
-                        cand.append(z)
-                cand_tail = cand[i:]
-                cand_tail.sort()
-                cand[i:] = cand_tail
+            a, b = ands[y - n - 1]
+            va = vals.get(a >> 1)
+            if va is None:
+                continue
+            vb = vals.get(b >> 1)
+            if vb is None:
+                continue
+            vals[y] = (va ^ full if a & 1 else va) & (vb ^ full if b & 1 else vb)
+            for z in fanouts[y]:
+                if z not in seen:
+                    seen.add(z)
+                    heappush(cand, z)
         if x not in vals:
             continue
         # exclude the node's fanout cone and its MFFC from the divisors
@@ -544,9 +546,33 @@ def enumerate_cuts(g: AIG, k: int = 4, limit: int = 10) -> list[list[tuple[int, 
     return cuts
 
 
+_VAR4 = (0xAAAA, 0xCCCC, 0xF0F0, 0xFF00)
+
+
 def cut_table(g: AIG, node: int, leaves: tuple[int, ...]) -> int:
     """16-bit table of ``node`` over ``leaves`` (padded to 4 variables)."""
-    return cone_table(g, node, list(leaves), 4)
+    val = dict(zip(leaves, _VAR4))
+    ands = g.ands
+    off = g.num_inputs + 1
+    stack = [node]
+    while stack:
+        x = stack[-1]
+        if x in val:
+            stack.pop()
+            continue
+        a, b = ands[x - off]
+        ya, yb = a >> 1, b >> 1
+        va = val.get(ya)
+        vb = val.get(yb)
+        if va is None or vb is None:
+            if va is None:
+                stack.append(ya)
+            if vb is None:
+                stack.append(yb)
+            continue
+        stack.pop()
+        val[x] = (va ^ 0xFFFF if a & 1 else va) & (vb ^ 0xFFFF if b & 1 else vb)
+    return val[node]
 
 
 def _place_class_circuit(g: AIG, ent: dict, lits: list, out: int, incone: set[int],
@@ -641,6 +667,8 @@ def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> A
                 gain = len(cone) - new
                 if gain < 0 or (gain == 0 and not zero_gain):
                     continue
+                if best is not None and gain < best[0][0]:
+                    continue                   # the key below cannot win
                 key = (gain, -_expr_depth(e, lev))      # depth estimate as a tie-breaker
                 if best is None or key > best[0]:
                     best = (key, e, cone)

@@ -38,6 +38,12 @@ def nvar(n: int, i: int) -> int:
     return mask(n) & ~var(n, i)
 
 
+@lru_cache(maxsize=None)
+def var_tables(n: int) -> tuple[tuple[int, ...], tuple[int, ...]]:
+    """``(var(n, i) for all i, nvar(n, i) for all i)``: for inner loops."""
+    return tuple(var(n, i) for i in range(n)), tuple(nvar(n, i) for i in range(n))
+
+
 def cof0(t: int, n: int, i: int) -> int:
     """Negative cofactor w.r.t. variable ``i``, as a full-width table independent of ``i``."""
     lo = t & nvar(n, i)
@@ -79,6 +85,7 @@ def isop(lower: int, upper: int, n: int) -> tuple[list[Cube], int]:
     if lower & ~upper & full:
         raise ValueError("isop: lower bound not contained in upper bound")
     memo: dict[tuple[int, int, int], tuple[list[Cube], int]] = {}
+    pos, neg = var_tables(n)
 
     def rec(L: int, U: int, top: int) -> tuple[list[Cube], int]:
         if L == 0:
@@ -90,19 +97,27 @@ def isop(lower: int, upper: int, n: int) -> tuple[list[Cube], int]:
         if r is not None:
             return r
         v = top - 1
-        while v >= 0 and not depends(L, n, v) and not depends(U, n, v):
+        while v >= 0:
+            s, x, nx = 1 << v, pos[v], neg[v]
+            if ((L & x) >> s) != (L & nx) or ((U & x) >> s) != (U & nx):
+                break
             v -= 1
         assert v >= 0
-        x = var(n, v)
-        L0, L1 = cof0(L, n, v), cof1(L, n, v)
-        U0, U1 = cof0(U, n, v), cof1(U, n, v)
+        t = L & nx
+        L0 = t | (t << s)
+        t = L & x
+        L1 = t | (t >> s)
+        t = U & nx
+        U0 = t | (t << s)
+        t = U & x
+        U1 = t | (t >> s)
         c0, f0 = rec(L0 & ~U1 & full, U0, v)
         c1, f1 = rec(L1 & ~U0 & full, U1, v)
         Ln = (L0 & ~f0 | L1 & ~f1) & full
         c2, f2 = rec(Ln, U0 & U1, v)
         bit = 1 << v
         cubes = [(p, q | bit) for p, q in c0] + [(p | bit, q) for p, q in c1] + c2
-        f = f2 | (f0 & ~x & full) | (f1 & x)
+        f = f2 | (f0 & nx) | (f1 & x)
         memo[key] = (cubes, f)
         return cubes, f
 
