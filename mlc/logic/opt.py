@@ -603,6 +603,39 @@ def _place_class_circuit(g: AIG, ent: dict, lits: list, out: int, incone: set[in
     return _neg(exprs[node], c_out ^ out), new
 
 
+def _place_cost(g: AIG, ent: dict, lits: list, incone: set[int], touched, refs, lev,
+                threshold: int) -> tuple[int, int]:
+    """``(new nodes, depth)`` of what :func:`_place_class_circuit` would build (the
+    depth as :func:`_expr_depth` of its expression), without building it; the depth
+    is only computed (else -1) when ``new <= threshold``."""
+    lits = list(lits)
+    new = 0
+    lookup = g.lookup
+    for j, l, fj, fl, fo in ent["gates"]:
+        a, b = lits[j], lits[l]
+        r = None
+        if a is not None and b is not None:
+            r = lookup(a ^ fj, b ^ fl)
+            if r is not None and ((r >> 1) in incone or touched[r >> 1] or refs[r >> 1] == 0):
+                r = None
+        if r is None:
+            new += 1
+            lits.append(None)
+        else:
+            lits.append(r ^ fo)
+    if new > threshold:
+        return new, -1
+    node, _c = ent["out"]
+    if node < 0:
+        return new, lev[0]
+    # depth: a placed literal has its level, a new gate one more than its fanins'
+    dep = [lev[x >> 1] for x in lits[:4]]
+    for k, (j, l, _fj, _fl, _fo) in enumerate(ent["gates"]):
+        x = lits[4 + k]
+        dep.append(lev[x >> 1] if x is not None else 1 + max(dep[j], dep[l]))
+    return new, dep[node]
+
+
 CUT_LIMIT = 10
 STRUCT_VARIANTS = True
 ROUNDS_BIG = 30
@@ -663,14 +696,17 @@ def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> A
                 if (tuple(lits), out) in seen_lits:
                     continue
                 seen_lits.add((tuple(lits), out))
-                e, new = _place_class_circuit(g, ent, lits, out, incone, touched, refs)
-                gain = len(cone) - new
-                if gain < 0 or (gain == 0 and not zero_gain):
+                # a move must not lose nodes, nor tie without zero_gain, nor lose to best
+                limit = len(cone) - (0 if zero_gain else 1)
+                if best is not None:
+                    limit = min(limit, len(cone) - best[0][0])
+                new, dep = _place_cost(g, ent, lits, incone, touched, refs, lev, limit)
+                if new > limit:
                     continue
-                if best is not None and gain < best[0][0]:
-                    continue                   # the key below cannot win
-                key = (gain, -_expr_depth(e, lev))      # depth estimate as a tie-breaker
+                gain = len(cone) - new
+                key = (gain, -dep)      # depth estimate as a tie-breaker
                 if best is None or key > best[0]:
+                    e, _new = _place_class_circuit(g, ent, lits, out, incone, touched, refs)
                     best = (key, e, cone)
         if best is None:
             continue
@@ -734,14 +770,28 @@ def reconv_cut(g: AIG, x: int, max_leaves: int) -> list[int]:
 def cone_table(g: AIG, node: int, leaves: list[int], k: int | None = None) -> int:
     """Truth table of ``node`` over ``leaves`` as ``k`` variables (default: one per leaf)."""
     k = len(leaves) if k is None else k
-    n = g.num_inputs
     full = T.mask(k)
-    val = {leaf: T.var(k, i) for i, leaf in enumerate(leaves)}
-    for x in _postorder([node], lambda x: _fanin_nodes(g, x), val):
-        a, b = g.ands[x - n - 1]
-        va = val[a >> 1] ^ (full if a & 1 else 0)
-        vb = val[b >> 1] ^ (full if b & 1 else 0)
-        val[x] = va & vb
+    val = dict(zip(leaves, T.var_tables(k)[0]))
+    ands = g.ands
+    off = g.num_inputs + 1
+    stack = [node]
+    while stack:
+        x = stack[-1]
+        if x in val:
+            stack.pop()
+            continue
+        a, b = ands[x - off]
+        ya, yb = a >> 1, b >> 1
+        va = val.get(ya)
+        vb = val.get(yb)
+        if va is None or vb is None:
+            if va is None:
+                stack.append(ya)
+            if vb is None:
+                stack.append(yb)
+            continue
+        stack.pop()
+        val[x] = (va ^ full if a & 1 else va) & (vb ^ full if b & 1 else vb)
     return val[node]
 
 
@@ -800,6 +850,7 @@ def refactor(g: AIG, max_leaves: int = 8, zero_gain: bool = False,
     repl: dict[int, tuple] = {}
     virt = _Virtual(g)
     decs: dict[int, _Dec] = {}
+    lev = None
     for x in range(g.num_nodes - 1, n, -1):          # outputs first: large cones
         if deadline is not None and work.now(g.num_nodes) > deadline:
             break
@@ -824,7 +875,8 @@ def refactor(g: AIG, max_leaves: int = 8, zero_gain: bool = False,
         if new > len(cone) or (new == len(cone) and not zero_gain):
             continue
         if new == len(cone):
-            lev = g.levels()
+            if lev is None:
+                lev = g.levels()
             if _expr_depth(e, lev) >= lev[x]:
                 continue
         if not virt.accept(x, e):
