@@ -437,6 +437,198 @@ def resub_window(g: AIG, max_leaves: int | None = None, max_new: int = 2, max_wi
     return rebuild(g, repl)
 
 
+def _in_tfo(g: AIG, x: int, v: int, memo: dict[int, bool], budget: list[int]) -> bool:
+    """Whether ``v`` is in the transitive fanout of ``x`` (a search down from ``v``
+    through nodes above ``x``); True (the safe answer) once ``budget[0]`` visits ran out."""
+    if v <= x:
+        return v == x
+    r = memo.get(v)
+    if r is not None:
+        return r
+    budget[0] -= 1
+    if budget[0] < 0:
+        return True
+    a, b = g.ands[v - g.num_inputs - 1]
+    r = _in_tfo(g, x, a >> 1, memo, budget) or _in_tfo(g, x, b >> 1, memo, budget)
+    memo[v] = r
+    return r
+
+
+def resub_dc(g: AIG, max_leaves: int | None = None, levels: int | None = None,
+             max_fanout: int | None = None, max_window: int = 300, max_new: int = 2,
+             deadline: float | None = None) -> AIG:
+    """Windowed resubstitution with observability don't cares, for networks of any
+    width (the windowed counterpart of :func:`resub_odc`, in the spirit of ABC's
+    ``mfs``): node ``x`` gets a window of its fanout up to ``levels`` levels and a
+    reconvergence-driven cut (up to ``max_leaves`` leaves) below the whole window;
+    truth tables over the leaves give ``x``'s care set -- the leaf values under which
+    complementing ``x`` changes some window node seen from outside the window (a
+    primary output or a node with a fanout outside) -- and ``x`` may be replaced by an
+    expression over divisors that equals it on the care set.
+
+    Moves are sound together: a move changes the functions of ``x`` and of the window
+    nodes not seen from outside (only outside their care sets), so a later window that
+    contains such a changed node is skipped, and changed nodes are no divisors."""
+    n = g.num_inputs
+    if not g.ands:
+        return g
+    if max_leaves is None:
+        max_leaves = DC_LEAVES
+    if levels is None:
+        levels = DC_LEVELS
+    if max_fanout is None:
+        max_fanout = DC_FANOUT
+    tick = WIDE_TICK if n > TT_LIMIT else 1.0
+    N = g.num_nodes
+    ands = g.ands
+    refs = refcounts(g)
+    fanouts: list[list[int]] = [[] for _ in range(N)]
+    for k, (a, b) in enumerate(ands):
+        y = n + 1 + k
+        fanouts[a >> 1].append(y)
+        if (b >> 1) != (a >> 1):
+            fanouts[b >> 1].append(y)
+    is_po = bytearray(N)
+    for lit in g.output_lits:
+        is_po[lit >> 1] = 1
+    touched = bytearray(N)       # the freed cones of accepted moves
+    changed = bytearray(N)       # nodes whose function an accepted move changed
+    repl: dict[int, tuple] = {}
+    virt = _Virtual(g)
+    for x in range(n + 1, N):
+        if deadline is not None and work.now(N, tick) > deadline:
+            break
+        if touched[x] or changed[x] or refs[x] == 0:
+            continue
+        # the fanout window: nodes up to `levels` levels above x whose fanins in
+        # the fanout of x are all in the window (then every leaf below is outside it)
+        win = {x}
+        memo: dict[int, bool] = {x: True}
+        budget = [200]
+        frontier = [x]
+        for _lev in range(levels):
+            nxt = []
+            for y in frontier:
+                if len(fanouts[y]) > max_fanout:
+                    continue
+                for z in fanouts[y]:
+                    if z in win:
+                        continue
+                    a, b = ands[z - n - 1]
+                    if any(v not in win and _in_tfo(g, x, v, memo, budget)
+                           for v in (a >> 1, b >> 1)):
+                        continue
+                    win.add(z)
+                    nxt.append(z)
+            frontier = nxt
+        if len(win) == 1:
+            continue
+        if any(changed[y] for y in win):
+            continue
+        # the leaves: a reconvergence-driven cut below x and the window
+        inside = set(win)
+        leaves: set[int] = set()
+        for y in win:
+            a, b = ands[y - n - 1]
+            for v in (a >> 1, b >> 1):
+                if v not in win:
+                    leaves.add(v)
+        leaves.discard(0)
+        if len(leaves) > max_leaves:
+            continue
+        while True:
+            best, bcost = None, None
+            for y in leaves:
+                if y <= n:
+                    continue
+                fa, fb = ands[y - n - 1]
+                za, zb = fa >> 1, fb >> 1
+                c = ((za != 0 and za not in leaves and za not in inside)
+                     + (zb != 0 and zb not in leaves and zb not in inside) - 1)
+                if bcost is None or c < bcost or (c == bcost and y > best):
+                    best, bcost = y, c
+            if best is None or len(leaves) + bcost > max_leaves:
+                break
+            leaves.discard(best)
+            inside.add(best)
+            fa, fb = ands[best - n - 1]
+            for z in (fa >> 1, fb >> 1):
+                if z and z not in inside:
+                    leaves.add(z)
+        if any(changed[y] or touched[y] for y in leaves) or any(changed[y] for y in inside):
+            continue
+        lv = sorted(leaves)
+        cone = mffc(g, x, refs, leaves)
+        if any(touched[y] for y in cone):
+            continue
+        k = len(lv)
+        full = T.mask(k)
+        vals: dict[int, int] = dict(zip(lv, T.var_tables(k)[0]))
+        ok = True
+        for y in sorted(inside):
+            a, b = ands[y - n - 1]
+            va = vals.get(a >> 1)
+            vb = vals.get(b >> 1)
+            if va is None or vb is None:
+                ok = False                # (not a cut: cannot happen; be safe)
+                break
+            vals[y] = (va ^ full if a & 1 else va) & (vb ^ full if b & 1 else vb)
+        if not ok:
+            continue
+        # care set of x: complement it and re-simulate the window
+        flip = {x: vals[x] ^ full}
+        for y in sorted(win):
+            if y == x:
+                continue
+            a, b = ands[y - n - 1]
+            va = flip.get(a >> 1, vals[a >> 1])
+            vb = flip.get(b >> 1, vals[b >> 1])
+            flip[y] = (va ^ full if a & 1 else va) & (vb ^ full if b & 1 else vb)
+        roots = [y for y in win if is_po[y] or any(z not in win for z in fanouts[y])]
+        care = 0
+        for y in roots:
+            care |= flip[y] ^ vals[y]
+        # more divisors: nodes computable from the leaves, outside x's fanout
+        cand = sorted({z for leaf in lv for z in fanouts[leaf]})
+        seen = set(cand)
+        top = x + max_window
+        while cand and len(vals) < max_window:
+            y = heappop(cand)
+            if y in vals or y > top:
+                continue
+            a, b = ands[y - n - 1]
+            if (a >> 1) in win or (b >> 1) in win:
+                continue
+            va = vals.get(a >> 1)
+            if va is None:
+                continue
+            vb = vals.get(b >> 1)
+            if vb is None:
+                continue
+            vals[y] = (va ^ full if a & 1 else va) & (vb ^ full if b & 1 else vb)
+            for z in fanouts[y]:
+                if z not in seen:
+                    seen.add(z)
+                    heappush(cand, z)
+        incone = set(cone)
+        divs = [d for d in sorted(vals) if d not in win and d not in incone and not touched[d]
+                and not changed[d] and refs[d] > 0]
+        e = _find_resub(vals[x] & care, care, full, divs, vals, min(max_new, len(cone) - 1), 8)
+        if e is None or not virt.accept(x, e):
+            continue
+        repl[x] = e
+        for y in cone:
+            touched[y] = 1
+        rootset = set(roots)
+        for y in win:
+            if y not in rootset:
+                changed[y] = 1
+        changed[x] = 1
+    if not repl:
+        return g
+    return rebuild(g, repl)
+
+
 def _find_resub(f: int, care: int, full: int, divs: list[int], vals: list[int], max_new: int,
                 or_width: int = 16):
     """An expression over divisors for ``f`` (on ``care``) with at most ``max_new`` ANDs."""
@@ -645,6 +837,14 @@ ROUNDS_BIG = 30
 # time, 16 leaves 1050 and 384 in twice the time); the zero-gain rounds keep 10 and 150
 WINDOW_LEAVES = 14
 WINDOW_SIZE = 300
+# resub_dc (windowed resubstitution with observability don't cares)
+DC_BIG = True
+DC_LEAVES = 14
+DC_LEVELS = 3
+DC_FANOUT = 12
+DC_ROUND_MAX = 2000
+DC_FIRST = False
+DC_POLISH = 4
 WINDOW_LEAVES_Z = 10
 WINDOW_SIZE_Z = 150
 # work-clock tick of resub_window and rewrite on wide networks (> TT_LIMIT inputs):
@@ -1199,7 +1399,11 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
             cur = extract_and(cur)
         cur = sweep(cur)
         if cur.num_inputs > TT_LIMIT:
+            if DC_FIRST and effort >= 2 and DC_BIG and cur.num_ands() <= DC_ROUND_MAX:
+                cur = resub_dc(cur, deadline=deadline)
             cur = resub_window(cur, max_new=1 if effort == 1 else 2, deadline=deadline)
+            if not DC_FIRST and effort >= 2 and DC_BIG and cur.num_ands() <= DC_ROUND_MAX:
+                cur = resub_dc(cur, deadline=deadline)
         cur = resub(cur, care, max_new=1 if effort == 1 else 2, deadline=deadline)
         if effort >= 2:
             cur = rewrite(cur, deadline=deadline)
@@ -1248,6 +1452,15 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
                     best = cur2
                     continue
             break
+    if big and DC_BIG:
+        # don't-care polish (any size; the only use on networks above DC_ROUND_MAX):
+        # resub_dc while it gains (at most DC_POLISH times)
+        for _ in range(DC_POLISH):
+            d = resub_dc(best)
+            if cost(d) < cost(best):
+                best = d
+            else:
+                break
     if effort >= 2:
         # depth polish: zero-gain rewrites that shorten paths, then balancing
         for _ in range(3):
