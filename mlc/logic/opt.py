@@ -231,6 +231,79 @@ def sweep(g: AIG) -> AIG:
     return rebuild(g, repl)
 
 
+def fraig(g: AIG, seed: int = 1, width: int = 2048, conflicts: int = 1000,
+          rounds: int = 3, deadline: float | None = None) -> AIG:
+    """SAT sweeping for networks too wide for :func:`sweep`'s global tables (ABC's
+    ``fraig``): nodes with equal signatures (up to complement) under seeded random
+    patterns are candidates; each is proven equal to its class's first node by
+    incremental SAT (:class:`mlc.logic.cec._Sat`, ``conflicts`` per query, a pair over
+    budget is left alone) and merged; counterexamples refine the patterns for the next
+    of ``rounds`` rounds."""
+    n = g.num_inputs
+    if n <= TT_LIMIT:
+        return sweep(g)
+    if not g.ands:
+        return g
+    from mlc.logic.cec import SWEEP_SOLVER, _Sat
+    rng = random.Random(seed)
+    words = [rng.getrandbits(width) for _ in range(n)]
+    N = g.num_nodes
+    repl: dict[int, int] = {}
+    sat = None
+    done: set[int] = set()          # merged, disproved for good or over budget
+    try:
+        for _ in range(rounds):
+            full = (1 << width) - 1
+            sig = g.simulate_nodes(words, width)
+            reps: dict[int, int] = {0: 0}
+            for i in range(1, n + 1):
+                reps.setdefault(sig[i] ^ full if sig[i] & 1 else sig[i], i)
+            cexs: list[int] = []
+            for v in range(n + 1, N):
+                if deadline is not None and work.now(N, FRAIG_TICK) > deadline:
+                    break
+                s = sig[v]
+                key = s ^ full if s & 1 else s
+                r = reps.get(key)
+                if r is None or v in done:
+                    reps.setdefault(key, v)
+                    continue
+                y = 2 * r ^ ((s ^ sig[r]) & 1)          # the literal v would equal
+                if r == 0:
+                    y = s & 1
+                if sat is None:
+                    sat = _Sat(g, SWEEP_SOLVER)
+                x = 2 * v
+                verdict = True
+                for q in ([x, y ^ 1], [x ^ 1, y]):
+                    ok = sat.satisfiable(q, conflicts)
+                    if ok is None:
+                        verdict = None
+                        break
+                    if ok:
+                        cexs.append(sat.model_minterm())
+                        verdict = False
+                        break
+                if verdict is True:
+                    sat.add_equal(x, y)
+                    repl[v] = y
+                    done.add(v)
+                elif verdict is None:
+                    done.add(v)
+            if not cexs or (deadline is not None and work.now(N, FRAIG_TICK) > deadline):
+                break
+            for i in range(n):
+                bits = sum(((c >> i) & 1) << j for j, c in enumerate(cexs))
+                words[i] |= bits << width
+            width += len(cexs)
+    finally:
+        if sat is not None:
+            sat.close()
+    if not repl:
+        return g
+    return rebuild(g, repl)
+
+
 # ----------------------------------------------------------------------------- resub
 def resub(g: AIG, care_out: list[int] | None = None, max_new: int = 2, max_div: int = 150,
           deadline: float | None = None) -> AIG:
@@ -467,8 +540,10 @@ def resub_dc(g: AIG, max_leaves: int | None = None, levels: int | None = None,
     expression over divisors that equals it on the care set.
 
     Moves are sound together: a move changes the functions of ``x`` and of the window
-    nodes not seen from outside (only outside their care sets), so a later window that
-    contains such a changed node is skipped, and changed nodes are no divisors."""
+    nodes not seen from outside (only outside their care sets) and relies on the
+    functions of its window (leaves, the nodes between, the divisors it uses); a later
+    move is skipped when its window contains a changed node or when it would change a
+    node an earlier move relies on, and changed nodes are no divisors."""
     n = g.num_inputs
     if not g.ands:
         return g
@@ -493,6 +568,7 @@ def resub_dc(g: AIG, max_leaves: int | None = None, levels: int | None = None,
         is_po[lit >> 1] = 1
     touched = bytearray(N)       # the freed cones of accepted moves
     changed = bytearray(N)       # nodes whose function an accepted move changed
+    read = bytearray(N)          # nodes whose function an accepted move relies on
     repl: dict[int, tuple] = {}
     virt = _Virtual(g)
     for x in range(n + 1, N):
@@ -585,6 +661,9 @@ def resub_dc(g: AIG, max_leaves: int | None = None, levels: int | None = None,
             vb = flip.get(b >> 1, vals[b >> 1])
             flip[y] = (va ^ full if a & 1 else va) & (vb ^ full if b & 1 else vb)
         roots = [y for y in win if is_po[y] or any(z not in win for z in fanouts[y])]
+        rootset = set(roots)
+        if any(read[y] for y in win if y not in rootset):
+            continue                  # would change what an accepted move relies on
         care = 0
         for y in roots:
             care |= flip[y] ^ vals[y]
@@ -619,11 +698,16 @@ def resub_dc(g: AIG, max_leaves: int | None = None, levels: int | None = None,
         repl[x] = e
         for y in cone:
             touched[y] = 1
-        rootset = set(roots)
         for y in win:
             if y not in rootset:
                 changed[y] = 1
         changed[x] = 1
+        for y in leaves:
+            read[y] = 1
+        for y in inside:
+            read[y] = 1
+        for y in _expr_nodes(e, []):
+            read[y] = 1
     if not repl:
         return g
     return rebuild(g, repl)
@@ -838,6 +922,8 @@ ROUNDS_BIG = 30
 WINDOW_LEAVES = 14
 WINDOW_SIZE = 300
 # resub_dc (windowed resubstitution with observability don't cares)
+# fraig: work-clock tick per node visited (its SAT queries are few and cheap)
+FRAIG_TICK = 0.25
 DC_BIG = True
 DC_LEAVES = 14
 DC_LEVELS = 3
