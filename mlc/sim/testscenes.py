@@ -9,7 +9,8 @@
 * :func:`lever_scene` -- two slabs joined by a hinge and opened by a muscle to a
   given angle; ``angle`` near pi gives a nearly flat lever.
 * :func:`bonded_pairs` -- n independent pairs of bodies, each joined by one bond between
-  their centres (no torques): the bond-length statistics workload.
+  their centres (no torques): the bond-length statistics workload; its exact length
+  variance: :func:`bond_length_var` (quadrature) and :func:`bond_length_var_closed`.
 """
 from __future__ import annotations
 
@@ -107,6 +108,19 @@ def bonded_pairs(n: int, rest: float = 1.0, tol: float = 0.0, k: float = 1.0, sp
                                [Box(np.array([0.3, 0.3, 0.01]))], {"c": np.zeros(3)}))
         bonds.append(Bond(f"u{i}", f"a{i}.c", f"b{i}.c", k, rest, tol, "universal", f"u{i}"))
     return Scene("pairs", bodies, bonds).check()
+
+
+def bond_length_var_closed(kT: float, L: float = 1.0, k: float = 1.0) -> float:
+    """The same variance in closed form: with s^2 = kT/k and x = r - L, the weight
+    (L + x)^2 exp(-x^2/2s^2) (extended to r < 0, which changes nothing above double
+    precision while s < L/8) has Z = L^2 + s^2, Z <x> = 2 L s^2, Z <x^2> = L^2 s^2 + 3 s^4, so
+
+        Var r = s^2 (L^4 + 3 s^4) / (L^2 + s^2)^2 = s^2 (1 - 2 s^2/L^2 + O(s^4/L^4)),
+
+    below kT/k by 2 kT/(k L^2): 0.98059 kT/k at kT = 1e-2 k0 sigma^2, L = 1 sigma, k = 1 k0.
+    (The mean length is L + 2 L s^2/(L^2 + s^2): the r^2 of the 3-D shell pushes it out.)"""
+    s2 = kT / k
+    return s2 * (L ** 4 + 3.0 * s2 * s2) / (L * L + s2) ** 2
 
 
 def bond_length_var(kT: float, L: float = 1.0, k: float = 1.0) -> float:
