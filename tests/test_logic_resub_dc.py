@@ -70,3 +70,19 @@ def test_resub_dc_moves_that_rely_on_each_other():
     h = opt.resub_dc(g, max_leaves=14, levels=3)
     assert h.num_ands() < g.num_ands()
     assert check_equivalent(h, spec)["equivalent"]
+
+
+def test_fraig_merges_equal_nodes_of_a_wide_network():
+    # (a & b) & c and a & (b & c) are one function in two structures; 20 inputs are
+    # too many for global tables, so SAT sweeping has to prove it
+    g = AIG([f"x{i}" for i in range(20)])
+    x = [2 * (i + 1) for i in range(20)]
+    g.add_output("p", g.and_(g.and_(x[0], x[1]), x[2]))
+    g.add_output("q", g.and_(x[0], g.and_(x[1], x[2])) ^ 1)
+    g.add_output("r", g.or_(g.and_(x[3], x[4]), x[19]))
+    assert g.num_ands() == 5
+    h = opt.fraig(g)
+    assert h.num_ands() == 3
+    assert h.output_lits[0] == h.output_lits[1] ^ 1
+    words = [random.Random(i).getrandbits(256) for i in range(20)]
+    assert h.simulate(words, 256) == g.simulate(words, 256)

@@ -673,7 +673,7 @@ def resub_dc(g: AIG, max_leaves: int | None = None, levels: int | None = None,
         top = x + max_window
         while cand and len(vals) < max_window:
             y = heappop(cand)
-            if y in vals or y > top:
+            if y in vals or y > top or changed[y]:
                 continue
             a, b = ands[y - n - 1]
             if (a >> 1) in win or (b >> 1) in win:
@@ -706,8 +706,16 @@ def resub_dc(g: AIG, max_leaves: int | None = None, levels: int | None = None,
             read[y] = 1
         for y in inside:
             read[y] = 1
-        for y in _expr_nodes(e, []):
+        # the divisors and their cones down to the window's nodes and leaves
+        stack = _expr_nodes(e, [])
+        while stack:
+            y = stack.pop()
+            if read[y]:
+                continue
             read[y] = 1
+            if y > n:
+                a, b = ands[y - n - 1]
+                stack += [a >> 1, b >> 1]
     if not repl:
         return g
     return rebuild(g, repl)
@@ -924,6 +932,8 @@ WINDOW_SIZE = 300
 # resub_dc (windowed resubstitution with observability don't cares)
 # fraig: work-clock tick per node visited (its SAT queries are few and cheap)
 FRAIG_TICK = 0.25
+FRAIG_BIG = True
+FRAIG_EVERY = False
 DC_BIG = True
 DC_LEAVES = 14
 DC_LEVELS = 3
@@ -1483,7 +1493,10 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
             # regroup AND trees for sharing before the round's passes (router 189 -> 179
             # in three rounds of sweep/resub/rewrite/refactor after it)
             cur = extract_and(cur)
-        cur = sweep(cur)
+        if cur.num_inputs > TT_LIMIT and effort >= 2 and FRAIG_BIG and (r == 0 or FRAIG_EVERY):
+            cur = fraig(cur, deadline=deadline)
+        else:
+            cur = sweep(cur)
         if cur.num_inputs > TT_LIMIT:
             if DC_FIRST and effort >= 2 and DC_BIG and cur.num_ands() <= DC_ROUND_MAX:
                 cur = resub_dc(cur, deadline=deadline)
@@ -1540,9 +1553,9 @@ def improve(g: AIG, effort: int, care, deadline: float) -> AIG:
             break
     if big and DC_BIG:
         # don't-care polish (any size; the only use on networks above DC_ROUND_MAX):
-        # resub_dc while it gains (at most DC_POLISH times)
+        # SAT sweeping and resub_dc while they gain (at most DC_POLISH times)
         for _ in range(DC_POLISH):
-            d = resub_dc(best)
+            d = resub_dc(fraig(best) if FRAIG_BIG else best)
             if cost(d) < cost(best):
                 best = d
             else:
