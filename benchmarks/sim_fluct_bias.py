@@ -1,35 +1,27 @@
-"""Bias of the fluctuation mode (``--fluct``) at large dt: bond-length variance over exact.
+"""Bias of the fluctuation mode (``--fluct``) against dt: bond-length variance over exact.
 
 The fluctuation mode (post-processed SK-ROCK, eta = 0) gives every *linear* mode its exact
-stationary variance at any dt.  The nonlinearity it does not cover is geometric: a
-bonded pair whose axis turns within one step (noise per step comparable with the bond
-length) mixes its stiff radial mode with its free tangential ones.  Measured here on
-200 independent bonded pairs (one bond, k = 1 k0, rest 1 sigma, between the bodies'
-centres: no torques), bond-length variance over its exact Boltzmann value (quadrature
-of r^2 exp(-k (r - 1)^2 / 2kT)), against dt from 0.01 t0 to 100 t0 (the largest dt a
-sweep spec accepts; ``mlc simulate`` takes any dt without rotational noise) at
-kT = 1e-5 ... 1e-2 k0 sigma^2.  The natural variable is the pair's noise turn per step,
-phi^2 = 4 kT h / (gamma L^2) (h = dt in gamma/k0, L = 1 sigma): the relative position of the two
-bodies gets 2 kT h/gamma of noise variance per axis from each.  If the bias is geometric
-the points of all kT fall on one curve of phi^2.  They do not (measured: the bias grows
-with kT at equal phi^2), so ``mlc simulate --json`` reports the measured ratio at the
-nearest measured kT and the run's dt (``variance_bias.pair_ratio_measured``, from
-``mlc.sim.integrator.FLUCT_PAIR_RATIO``, a copy of this benchmark's rows).  kT = 1e-2 at
-dt = 100 t0 is not measured (about 1e5 force evaluations per step).
+stationary variance at any dt.  Measured here on 200 independent bonded pairs (one bond,
+k = 1 k0, rest 1 sigma, between the bodies' centres: no torques), bond-length variance over
+its exact Boltzmann value (quadrature of r^2 exp(-k (r - 1)^2 / 2kT); closed form and an
+Euler check in sim_pair_exact.py), against dt from 0.01 t0 to 100 t0 (the largest dt a sweep
+spec accepts; ``mlc simulate`` takes any dt without rotational noise) at kT = 1e-5 ... 1e-2
+k0 sigma^2.  ``phi2`` = 4 kT h/(gamma L^2) (h = dt in gamma/k0, L = 1 sigma) is the pair's
+noise turn per step.  ``mlc simulate --json`` reports the measured ratio at the nearest
+measured kT and the run's dt (``variance_bias.pair_ratio_measured``, from
+``mlc.sim.integrator.FLUCT_PAIR_RATIO``, a copy of this benchmark's rows).
 
-Each point: 5 steps of burn-in (the post-processed records are exact from the first
-step in linear theory; the burn-in removes the start at rest length), then 100 steps,
-one record per step, variance per pair over time, averaged over pairs (independent, so
-the standard error is over pairs).  Five steps of burn-in are short for a mode whose rate
-sits near an interior Chebyshev extremum (undamped SK-ROCK relaxes it slowly): at
-kT = 1e-5, dt = 0.2 t0 the ratio is 0.910 after 5 steps, 0.982 after 100 and 1.007
-after 400 (a one-off check); single points scatter by up to ~10 % for that reason.  Runs longer than ``--cap`` seconds are cut short and
-marked.
+Each point: ``--burn`` steps of burn-in (default 50: modes near an interior Chebyshev
+extremum relax slowly without damping; 5 steps left 0.910 at kT = 1e-5, dt = 0.2 t0), then
+``--steps`` measured (default 200), one record per step, variance per pair over time,
+averaged over pairs (independent, so the standard error is over pairs).  Runs longer than
+``--cap`` seconds are cut short (steps_measured says how many were kept).  Rows with
+fluct False: the plain stiff scheme for comparison.
 
-    python benchmarks/sim_fluct_bias.py [--quick]
+    python benchmarks/sim_fluct_bias.py [--quick] [--burn N] [--steps N] [--out STEM]
 
-Writes benchmarks/results/sim_fluct_bias.json and .png.  Units: sigma, k0, gamma,
-t0 = gamma/(1e-3 k0).
+Writes benchmarks/results/sim_fluct_bias.json and .png (~6 min on the shared 2-core machine).
+Units: sigma, k0, gamma, t0 = gamma/(1e-3 k0).
 """
 from __future__ import annotations
 
@@ -54,12 +46,12 @@ T_UNIT = 1000.0
 exact_var = bond_length_var              # mlc.sim.testscenes: the exact theory
 
 
-def point(sc, kT, dt, fluct, seed, cap):
+def point(sc, kT, dt, fluct, seed, cap, burn=5, nmeas=100):
     sim = Simulation(sc, None, SimOptions(kT=kT, dt=dt, seed=seed, fluct=fluct, wca_eps=0.0))
     t = time.perf_counter()
-    sim.run(5 * dt, quiet=True)
+    sim.run(burn * dt, quiet=True)
     lengths, steps, evals = [], 0, 0
-    for _ in range(20):
+    for _ in range(nmeas // 5):
         res = sim.run(5 * dt, frames=6, quiet=True)
         # frames[:-1]: the (post-processed) records at each step's start; frames[-1]: the raw final state
         d = res.frame_pos[:-1, 1::2] - res.frame_pos[:-1, 0::2]
@@ -78,6 +70,9 @@ def main():
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--pairs", type=int, default=200)
     ap.add_argument("--cap", type=float, default=60.0, help="seconds per point before it is cut short")
+    ap.add_argument("--burn", type=int, default=50, help="steps of burn-in")
+    ap.add_argument("--steps", type=int, default=200, help="measured steps (one record each)")
+    ap.add_argument("--out", default="sim_fluct_bias", help="file stem in benchmarks/results")
     args = ap.parse_args()
     sc = bonded_pairs(args.pairs)          # mlc.sim.testscenes: rest 1, tol 0, k 1
     kTs = [1e-5, 1e-4, 1e-3, 1e-2]
@@ -89,33 +84,33 @@ def main():
     for kT in kTs:
         ex = exact_var(kT)
         for dt in dts:
-            if kT >= 1e-2 and dt > 20:
-                continue        # ~1e5 force evaluations per step: minutes per point (not measured)
             for fluct in (True, False):
                 if not fluct and dt not in (0.05, 5.0):
                     continue
-                L, steps, wall, evals = point(sc, kT, dt, fluct, 11, args.cap)
+                L, steps, wall, evals = point(sc, kT, dt, fluct, 11, args.cap, args.burn, args.steps)
                 v = L.var(axis=0, ddof=1) / ex
                 m, e = float(np.mean(v)), float(np.std(v, ddof=1) / math.sqrt(len(v)))
                 h = dt * T_UNIT
                 row = {"kT": kT, "dt_t0": dt, "fluct": fluct, "phi2": 4 * kT * h, "noise_step_sigma": math.sqrt(2 * kT * h),
                        "ratio": m, "ratio_se": e, "steps_measured": steps, "force_evals": evals, "wall_s": wall,
-                       "exact_var_over_kT": ex / kT}
+                       "exact_var_over_kT": ex / kT,
+                       "stage_factor": Simulation(sc, None, SimOptions(kT=kT, dt=dt, fluct=fluct)).fluct_stage_factor()}
                 rows.append(row)
                 print(json.dumps(row), flush=True)
     out = {"benchmark": "fluctuation-mode bond-length variance / exact against dt (bonded pairs, rest 1 sigma, k = 1)",
            "machine": {"platform": platform.platform(), "cpus": os.cpu_count(), "python": platform.python_version(),
                        "loadavg": [load0, os.getloadavg()]},
-           "pairs": args.pairs, "rows": rows,
+           "pairs": args.pairs, "burn_in_steps": args.burn, "measured_steps": args.steps, "rows": rows,
            "notes": "phi2 = 4 kT h/gamma (h = dt in gamma/k0): the pair's noise turn per step squared (rad^2) for a "
-                    "1 sigma bond; ratio = mean over pairs of the per-pair variance over 100 steps / exact; fluct "
-                    "False rows: the plain stiff scheme for comparison"}
+                    "1 sigma bond; ratio = mean over pairs of the per-pair variance over the measured steps / exact; fluct "
+                    "False rows: the plain stiff scheme for comparison; fluctuation mode with its default stage factor "
+                    "(stage_factor: 2 where 2 kT h/gamma > 1 sigma^2, else 1)"}
     RESULTS.mkdir(exist_ok=True)
-    (RESULTS / "sim_fluct_bias.json").write_text(json.dumps(out, indent=1) + "\n")
-    plot(out)
+    (RESULTS / f"{args.out}.json").write_text(json.dumps(out, indent=1) + "\n")
+    plot(out, args.out)
 
 
-def plot(out):
+def plot(out, stem="sim_fluct_bias"):
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -139,7 +134,7 @@ def plot(out):
     axes[0].set_title("fluctuation mode, bonded pairs (rest 1 sigma, k = 1)", fontsize=9)
     axes[1].set_title("the same against the noise turn per step", fontsize=9)
     fig.tight_layout()
-    fig.savefig(RESULTS / "sim_fluct_bias.png", dpi=120)
+    fig.savefig(RESULTS / f"{stem}.png", dpi=120)
 
 
 if __name__ == "__main__":

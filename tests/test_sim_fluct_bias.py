@@ -1,7 +1,9 @@
 """The fluctuation mode's bias beyond linear theory, as `mlc simulate --json` reports it
 (``variance_bias.pair_ratio_measured``): the table in the package is the benchmark's
-(benchmarks/results/sim_fluct_bias.json), and an independent run (another seed) at a point
-with a real bias agrees with it.  Units: sigma, k0, t0."""
+(benchmarks/results/sim_fluct_bias.json), and the goal of issue 12 (bond-length variance
+within 5 % of exact in the fluctuation mode) holds, with another seed, at points where the
+benchmark meets it, including the two where it failed before the session-10 fixes (kT = 1e-3,
+dt = 5 t0: +21 %; kT = 1e-2, dt = 0.2 t0: +23 %).  Units: sigma, k0, t0."""
 import json
 import math
 from pathlib import Path
@@ -10,6 +12,7 @@ import numpy as np
 import pytest
 
 from mlc.sim.integrator import FLUCT_PAIR_RATIO, SimOptions, Simulation, fluct_pair_bias
+from mlc.sim.testscenes import bond_length_var_closed, bonded_pairs
 
 RESULTS = Path(__file__).resolve().parent.parent / "benchmarks" / "results" / "sim_fluct_bias.json"
 
@@ -26,33 +29,43 @@ def test_reported_in_variance_bias():
     from mlc.gates.library import gate_scene
     sim = Simulation(gate_scene("NAND"), {"a": 1, "b": 1}, SimOptions(kT=1e-3, dt=5.0, fluct=True))
     vb = sim.variance_bias()
-    assert vb["scheme"] == "stiff-fluct" and vb["pair_ratio_measured"] == pytest.approx(1.209)
+    ref = dict(FLUCT_PAIR_RATIO[1e-3])
+    assert vb["scheme"] == "stiff-fluct" and vb["pair_ratio_measured"] == pytest.approx(ref[5.0], abs=6e-4)
     assert vb["pair_ratio_kT"] == 1e-3 and vb["noise_turn_rad2"] == pytest.approx(20.0)
+    assert vb["stage_factor"] == 2.0            # 2 kT h/gamma = 10 sigma^2 > 1
+    assert Simulation(gate_scene("NAND"), {"a": 1, "b": 1},
+                      SimOptions(kT=1e-3, dt=0.05, fluct=True)).variance_bias()["stage_factor"] == 1.0
     # interpolation in log dt between measured points, nearest measured kT, clamped dt
+    a, b = ref[2.0], ref[5.0]
     mid = fluct_pair_bias(2e-3, math.sqrt(2.0 * 5.0))["pair_ratio_measured"]
-    assert min(1.038, 1.209) < mid < max(1.038, 1.209)
-    assert fluct_pair_bias(1e-3, 1e4)["pair_ratio_measured"] == pytest.approx(0.994)
+    assert min(a, b) - 1e-3 <= mid <= max(a, b) + 1e-3
+    assert fluct_pair_bias(1e-3, 1e4)["pair_ratio_measured"] == pytest.approx(ref[100.0], abs=6e-4)
     assert "extrapolation" in fluct_pair_bias(1e-3, 1e4)["pair_note"]
     assert fluct_pair_bias(0.0, 1.0) == {}
     plain = Simulation(gate_scene("NAND"), {"a": 1, "b": 1}, SimOptions(kT=1e-3, dt=5.0)).variance_bias()
     assert "pair_ratio_measured" not in plain
 
 
-def test_bias_at_large_dt_reproduced_with_another_seed():
-    # kT = 1e-3, dt = 5 t0: the pair turns ~4.5 rad per step; the benchmark measured 1.209 +- 0.012
-    # (seed 11, 5 steps of burn-in, 100 measured); an independent seed must agree within the two
-    # sampling errors, and both must be far from the exact 1 (the bias is real, not noise)
-    from test_sim_stats import _bond_length_var, bonded_pairs
-    kT, dt = 1e-3, 5.0
-    exact = _bond_length_var(kT, 1.0)
+def test_stage_factor_option_checked():
+    from mlc.errors import MlcError
+    with pytest.raises(MlcError, match="stage factor"):
+        Simulation(bonded_pairs(2), None, SimOptions(kT=1e-3, fluct=True, fluct_stages=0.5))
+
+
+@pytest.mark.parametrize("kT, dt", [(1e-3, 5.0), (1e-2, 0.2), (1e-2, 0.01), (1e-2, 20.0)])
+def test_goal_within_5_percent_another_seed(kT, dt):
+    # 200 independent pairs, 50 steps of burn-in, 200 measured: standard error ~0.01, so the goal
+    # (|ratio - 1| < 0.05) is resolved at 3 standard errors
+    exact = bond_length_var_closed(kT, 1.0)
     sim = Simulation(bonded_pairs(200, 1.0, 0.0), None, SimOptions(kT=kT, dt=dt, seed=12, fluct=True, wca_eps=0.0))
-    sim.run(5 * dt)
-    res = sim.run(100 * dt, frames=101)
+    sim.run(50 * dt)
+    res = sim.run(200 * dt, frames=201)
     d = res.frame_pos[:-1, 1::2] - res.frame_pos[:-1, 0::2]
     v = np.linalg.norm(d, axis=2).var(axis=0, ddof=1) / exact
     m, e = float(v.mean()), float(v.std(ddof=1) / math.sqrt(len(v)))
     ref = dict(FLUCT_PAIR_RATIO[kT])[dt]
-    print(f"\n--fluct kT={kT:g} dt={dt:g} t0, seed 12: bond variance / exact = {m:.4f} +- {e:.4f}; "
-          f"reported (seed 11) {ref}")
-    assert abs(m - ref) < 4 * math.hypot(e, 0.012)
-    assert m - 1.0 > 6 * e
+    print(f"\n--fluct kT={kT:g} dt={dt:g} t0 (stage factor {sim.fluct_stage_factor():g}), seed 12: bond variance "
+          f"/ exact = {m:.4f} +- {e:.4f}; benchmark (seed 11) {ref}; goal |x - 1| < 0.05")
+    assert 3 * e <= 0.05, "too few samples to resolve the goal"
+    assert abs(m - 1.0) < 0.05
+    assert abs(m - ref) < 4 * math.hypot(e, 0.012)      # agrees with the benchmark's table

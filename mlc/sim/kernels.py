@@ -785,6 +785,11 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
     amp_dt = math.sqrt(2.0 * kT * dt / gamma)
     amp_dt_r = math.sqrt(2.0 * kT * dt / gamma_r) if rot_noise else 0.0
     noisy = amp_dt > 0.0 or amp_dt_r > 0.0
+    # fluctuation mode with noise: the accuracy test never rejects the substep it measured (its
+    # end state depends on the substep's noise, so keeping or refining it would select on the
+    # noise); it refines the next substep instead.  Safety tests (bond bounds, WCA cores, drift
+    # beyond max_disp/max_rot) still reject.
+    predict = post and noisy
     h_last = stages_out[4]
     lev = lev_min
     if h_last > 0.0:
@@ -814,8 +819,13 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
         lev = max(lev - 1, lev_min)
         if _due(n, rec_every, rec_phase) or _due(n, frame_every, frame_phase):
             if post and noisy:
-                h0 = dt / (1 << lev)
-                s0 = fixed_s if fixed_s > 0 else stages_for(h0, rho, eta)
+                # the stiff modes' variance deficit is that of the last substep taken (h, s)
+                if stages_out[6] > 0.0:
+                    h0 = stages_out[6]
+                    s0 = int(stages_out[7])
+                else:
+                    h0 = dt / (1 << lev)
+                    s0 = fixed_s if fixed_s > 0 else stages_for(h0, rho, eta)
                 c = math.sqrt(h0 / dt) / (2.0 * s0)
                 pkey = np.uint64(step) * np.uint64(2147483648) + np.uint64(2147483647)
                 for b in prange(N):
@@ -881,6 +891,13 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
             amax = 0.0
             worst = 0.0
             wb = -1
+            md = max_disp
+            mr = max_rot
+            if predict:
+                # a body held by a stiff bond absorbs its noise, so its drift is of the noise's
+                # size: the displacement alarm gets the same allowance as the accuracy test
+                md += 3.0 * math.sqrt(3.0) * amp_dt * math.sqrt(1.0 / (1 << lev))
+                mr += 3.0 * math.sqrt(3.0) * amp_dt_r * math.sqrt(1.0 / (1 << lev))
             for b in range(N):
                 ex = pos[b, 0] - xs[b, 0] - Qn[b, 0]
                 ey = pos[b, 1] - xs[b, 1] - Qn[b, 1]
@@ -894,7 +911,7 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
                 a2 = rx * rx + ry * ry + rz * rz
                 if not (a2 <= amax):
                     amax = a2
-                w = max(v / (max_disp * max_disp), a2 / (max_rot * max_rot))
+                w = max(v / (md * md), a2 / (mr * mr))
                 if not (w <= worst):
                     worst = w
                     wb = b
@@ -908,12 +925,16 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
             alim = min(rot_acc, dlim / arm_max) if arm_max > 0.0 else rot_acc
             ok = (mon[0] <= accept) and (mon[2] >= wca_min) and (worst <= 1.0)
             accurate = (dmax <= dlim) and (amax <= alim)
-            if ok and (accurate or lev >= LMAX):
+            if ok and (accurate or lev >= LMAX or predict):
                 u += full >> lev
+                stages_out[6] = h
+                stages_out[7] = s
                 for b in range(N):
                     for c in range(6):
                         Bc[b, c] = Bn[b, c]
-                if dmax < 0.5 * dlim and amax < 0.5 * alim and lev > lev_min and ((u >> (LMAX - lev)) & 1) == 0:
+                if not accurate and lev < LMAX:
+                    lev += 1                    # predictive control: the next substep is refined
+                elif dmax < 0.5 * dlim and amax < 0.5 * alim and lev > lev_min and ((u >> (LMAX - lev)) & 1) == 0:
                     lev -= 1
                 stages_out[4] = dt / (1 << lev)         # the level to go on with (kept between calls)
                 continue
