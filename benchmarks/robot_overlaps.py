@@ -107,16 +107,20 @@ def main(argv=None) -> int:
     out = {"what": "slab overlaps of a robot's static poses, by class (benchmarks/robot_overlaps.py)",
            "scene": a.scene, "bodies": len(sc.bodies),
            "joint_k": float((sc.meta.get("circuit", {}).get("connector", {}) or {}).get("joint_k", 1.0)),
-           "units": "sigma (depth), seconds wall", "as_built": analyse(sc, None, None), "rows": {}}
+           "build_overrides": sc.meta.get("robot", {}).get("build_overrides", {}),
+           "units": "sigma (depth), degrees, seconds wall", "as_built": analyse(sc, None, None), "rows": {}}
     for row in rows:
         t = time.perf_counter()
         rep = verify_robot_static(sc, rows=[row], keep_poses=True, clearance=False)
         pos, quat = rep.poses[row]
         r = analyse(sc, pos, quat)
         r.update({"shape_read": rep.rows[0]["shape_read"], "shape_ok": rep.rows[0]["shape_ok"],
-                  "joint_stretch": rep.rows[0]["joint_stretch"], "wall_s": round(time.perf_counter() - t, 1)})
+                  "joint_stretch": rep.rows[0]["joint_stretch"], "row_ok": rep.rows[0]["ok"],
+                  "max_dof_error_deg": round(rep.rows[0]["max_dof_error_deg"], 3),
+                  "turns_read": rep.rows[0]["turns_read"], "wall_s": round(time.perf_counter() - t, 1)})
         out["rows"][row] = r
-        print(f"row {row}: {r['shape_read']}, clearance {r['min_clearance']} {r['pair']}, {r['n_overlaps']} pairs: "
+        print(f"row {row}: {r['shape_read']} (verdict {'ok' if r['row_ok'] else 'WRONG'}, DOF error "
+              f"{r['max_dof_error_deg']:.1f} deg, stretch {r['joint_stretch']:.1e}), clearance {r['min_clearance']} {r['pair']}, {r['n_overlaps']} pairs: "
               + ", ".join(f"{k} {v['n']} (deepest {v['deepest']:.3f})" for k, v in r["by_class"].items()), flush=True)
         with open(a.out + ".tmp", "w") as f:
             json.dump(out, f, indent=1)
