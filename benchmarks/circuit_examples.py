@@ -7,10 +7,12 @@ the router flagged tight, the build and verification wall times, the rows read r
 the largest joint stretch and the smallest slab clearance per row (exact oriented-box
 test) with the pair of bodies that sets it.
 
-    python benchmarks/circuit_examples.py [--only tetris.tt ...] [--joint-k K]
+    python benchmarks/circuit_examples.py [--only tetris.tt ...] [--joint-k K] [--direct]
 
 With ``--only`` the other examples' last entries are kept (each entry names its commit).
-``--joint-k K`` builds with connector joints K times k0 (``mlc compile --joint-k``).
+``--joint-k K`` builds with connector joints K times k0 (``mlc compile --joint-k``);
+``--direct`` with direct gate-to-gate connections (``mlc compile --direct``; the nets made
+direct and those dropped as crossed are recorded), into ``circuit_examples_direct.json``.
 
 Writes benchmarks/results/circuit_examples.json (``circuit_examples_jointk{K}.json`` with ``--joint-k``).  Wall seconds on this machine in one
 run (shared, noisy): compare ratios, not absolute numbers across machines.
@@ -34,11 +36,12 @@ OUT = ROOT / "benchmarks" / "results"
 SUFFIXES = (".tt", ".pla", ".expr", ".blif", ".aag")
 
 
-def example_point(path: Path, joint_k: float | None = None) -> dict:
+def example_point(path: Path, joint_k: float | None = None, direct: bool = False) -> dict:
     t0 = time.perf_counter()
     compiled = compile_spec(load(str(path)))
     t1 = time.perf_counter()
-    compiled = build(compiled, options=None if joint_k is None else CircuitOptions(joint_k=joint_k))
+    kw = {} if joint_k is None else {"joint_k": joint_k}
+    compiled = build(compiled, options=CircuitOptions(direct=direct, **kw) if (kw or direct) else None)
     t2 = time.perf_counter()
     circ = compiled.circuit
     sc = circ.scene
@@ -53,6 +56,7 @@ def example_point(path: Path, joint_k: float | None = None) -> dict:
             "rows": len(rows), "rows_ok": sum(r["ok"] for r in rows), "ok": rep.ok,
             "max_joint_stretch": max(r["joint_stretch"] for r in rows),
             "min_clearance": min(r["clearance"] for r in rows), "rows_clear": sum(r["clearance"] > 0 for r in rows),
+            "direct": sc.meta["connector"].get("direct"), "direct_dropped": sc.meta["connector"].get("direct_dropped"),
             "per_row": rows}
 
 
@@ -60,8 +64,10 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--only", nargs="*", help="example file names (default: all)")
     ap.add_argument("--joint-k", type=float, default=None, help="connector joint stiffness, in k0 (default: mlc's)")
+    ap.add_argument("--direct", action="store_true", help="direct gate-to-gate connections (mlc compile --direct)")
     args = ap.parse_args()
-    res_path = OUT / ("circuit_examples.json" if args.joint_k is None else f"circuit_examples_jointk{args.joint_k:g}.json")
+    res_path = OUT / ("circuit_examples_direct.json" if args.direct else "circuit_examples.json" if args.joint_k is None
+                      else f"circuit_examples_jointk{args.joint_k:g}.json")
     paths = sorted(p for p in (ROOT / "examples").iterdir() if p.suffix in SUFFIXES)
     if args.only:
         paths = [p for p in paths if p.name in args.only]
@@ -77,7 +83,7 @@ def main():
         prev = json.loads(res_path.read_text())
         old = {e["example"]: e for e in prev.get("examples", []) if e["example"] not in args.only}
     for p in paths:
-        pt = example_point(p, args.joint_k)
+        pt = example_point(p, args.joint_k, args.direct)
         pt["commit"] = commit
         points.append(pt)
         print(f"{pt['example']:>18}: {pt['gates']} gates, {pt['bodies']} bodies, build {pt['build_s']:.1f} s, "

@@ -158,3 +158,28 @@ def test_joint_k_stiffens_connector_bonds_and_narrows_the_thermal_spread():
     assert suggest_joint_k(0.139, 0.25, {}) == 10.0           # Tetris's g1 output: 2 x 2.8 -> 10
     assert suggest_joint_k(0.05, 0.25, {"joint_k": 100.0}) == 100.0
     assert suggest_joint_k(0.3, 0.25, {"joint_k": 100.0}) == 1e4
+
+
+def test_slab_points_run_along_every_slab_of_the_gates(tetris):
+    """What the router keeps chains from (build._slab_points): points along the middle of
+    each slab, no farther apart than GATE_POINT_STEP, each inside its slab."""
+    from mlc.circuit.build import GATE_POINT_STEP, _slab_points
+    from mlc.geometry.rotation import quat_to_matrix
+    scene = tetris[2].scene
+    gid = next(iter(scene.meta["gates"]))
+    bodies = [b for b in scene.bodies if b.name.startswith(f"{gid}_")]
+    pts = _slab_points(bodies)
+    n = 0
+    for b in bodies:
+        R = b.rotation()
+        for box in b.boxes:
+            A = R @ quat_to_matrix(np.asarray(box.orientation, float))
+            c = b.position + R @ np.asarray(box.center, float)
+            local = (pts - c) @ A                       # box frame
+            inside = np.all(np.abs(local) <= 0.5 * np.asarray(box.size) + 1e-9, axis=1)
+            k = int(np.argmax(box.size))
+            along = np.sort(local[inside, k])
+            assert along[0] <= -0.5 * box.size[k] + 1e-9 and along[-1] >= 0.5 * box.size[k] - 1e-9
+            assert np.diff(along).max() <= GATE_POINT_STEP + 1e-9
+            n += 1
+    assert n > 5 and len(pts) >= n * 2

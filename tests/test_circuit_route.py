@@ -57,3 +57,31 @@ def test_blas_single_thread_sets_one_thread_and_restores():
     with R.blas_single_thread():
         assert all(g() == 1 for _, g in ctl)
     assert [g() for _, g in ctl] == before
+
+
+def _layer_dist(route, geo, pts):
+    cs, _, _ = R._fk(route.centre, route.axis, route.tangent, route.bends, geo.pitch)
+    m = 0.5 * (cs[1:] + cs[:-1])
+    return np.sqrt(((m[:, None, :] - np.asarray(pts)[None]) ** 2).sum(-1)).min(axis=1)
+
+
+def test_avoid_pushes_the_layers_from_the_points_and_still_closes():
+    """``avoid``: a chain whose plain route passes through a set of points keeps its
+    layers' centres about ``distance`` from them, still closing exactly on its target."""
+    args, kw = _args()
+    geo = args[4]
+    plain = R.solve_route(*args, **kw)
+    cs, _, _ = R._fk(plain.centre, plain.axis, plain.tangent, plain.bends, geo.pitch)
+    mid = 0.5 * (cs[len(cs) // 2] + cs[len(cs) // 2 + 1])
+    pts = mid + np.array([[0.0, 0.3, 0.0], [0.0, -0.3, 0.0], [0.3, 0.0, 0.0]])   # on the plain route
+    D = 1.8
+    assert _layer_dist(plain, geo, pts).min() < 0.5
+    pushed = R.solve_route(*args, avoid=((pts, D),), **kw)
+    assert pushed is not None and pushed.error < R.EXACT
+    d = _layer_dist(pushed, geo, pts)
+    print("nearest layer to the points: plain", _layer_dist(plain, geo, pts).min(), "avoid", d.min())
+    assert d.min() > 0.8 * D
+    # from avoid_from on only: the layers before it are not pushed
+    n = len(pushed.bends)
+    late = R.solve_route(*args, avoid=((pts, D),), avoid_from=n, **kw)
+    assert late.bends == plain.bends

@@ -59,6 +59,8 @@ END_JUNCTIONS, END_BEND = 4, 0.2   # the 4 junctions at either end bend at most 
 LANE_EXTRAS = (0, 4, 8)     # chain lengths (half units beyond the steered guess) tried in a plane before the next
 BRANCH_LAYERS = 3           # layers of a chain next to its branch page, left out of the keep-apart test
 LAYER_RADIUS = 0.9          # sigma: bounds a half unit's layer with its posts (reach 0.75, half pitch 0.5)
+GATE_POINT_STEP = 0.25      # sigma between the points that stand for a gate's slab (along its length)
+GATE_CLEAR = LAYER_RADIUS + 0.3   # sigma: a layer's centre stays this far from them (slab half width 0.25)
 PIN_SPREAD = 2.5            # sigma: a gate's two input chains arrive this far apart in x
 PIN_STAGGER = 2.5           # sigma: the far input's chain crosses under the gate this much lower than the near one's
 PIN_END = 1.5               # sigma: and rises to its lever this far to its side of the gate (x)
@@ -84,6 +86,7 @@ class CircuitOptions:
                                      # the paper's; muscles and gates keep the design k (docs/circuits.md,
                                      # "Thermal spread": 100 k0 joints give 12 spreads of margin, not 1.8)
     direct: bool = False             # join a gate's single-sink net by one full unit (mlc.circuit.direct)
+    direct_skip: tuple = ()          # ... except into these sinks (build_circuit fills it: see there)
 
 
 @dataclass
@@ -192,11 +195,34 @@ def _pair(bodies_by_name, lo: str, hi: str) -> Pair:
 def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, progress=None) -> Circuit:
     """One scene of the whole circuit, posed in the all-zero input row (see module doc).
 
-    When the router leaves chains it could not keep apart (``tight_chains``), the wires
-    they belong to are routed again first, in a second build (once); the build whose
-    tight chains come closest to another chain by the larger distance is kept (the
-    first on a tie): one chain pressed into another is worse than several just inside
-    the keep-apart distance."""
+    With ``options.direct``, a direct net whose unit, sink or driver another element's
+    slab passes through in the built scene (``direct.crossed_direct``: a chain rising
+    to a pin through the column a direct sink stands in) is routed as a chain instead,
+    and the circuit built again, until no direct net is crossed (the dropped sinks are
+    in ``meta.connector.direct_dropped``)."""
+    opt = options or CircuitOptions()
+    circ = _build_routed(netlist, spec, opt, progress)
+    dropped: list = []
+    while opt.direct and circ.scene.meta["connector"]["direct"]:
+        from mlc.circuit.direct import crossed_direct
+        direct = {s: (d, p) for d, s, p in circ.scene.meta["connector"]["direct"]}
+        hit = sorted(crossed_direct(circ.scene, direct))
+        if not hit:
+            break
+        dropped += hit
+        opt = replace(opt, direct_skip=tuple(opt.direct_skip) + tuple(hit))
+        circ = _build_routed(netlist, spec, opt, progress)
+    if opt.direct:
+        circ.scene.meta["connector"]["direct_dropped"] = dropped
+    return circ
+
+
+def _build_routed(netlist, spec, options: CircuitOptions, progress) -> Circuit:
+    """One build, or two: when the router leaves chains it could not keep apart
+    (``tight_chains``), the wires they belong to are routed again first, in a second
+    build (once); the build whose tight chains come closest to another chain by the
+    larger distance is kept (the first on a tie): one chain pressed into another is
+    worse than several just inside the keep-apart distance."""
     first = _build_circuit(netlist, spec, options, progress)
     tight = first.scene.meta["connector"]["tight_chains"]
     if not tight:
@@ -216,6 +242,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     import time
 
     from mlc.circuit.lanes import Lane, Lanes, Space, layer_centres, plane_y, rounded
+    from scipy.spatial import cKDTree
+
     from mlc.circuit.route import _fk, solve_route
 
     opt = options or CircuitOptions()
@@ -244,7 +272,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     consumers_all = consumers
 
     from mlc.circuit.direct import direct_nets
-    direct = direct_nets(netlist, consumers) if opt.direct else {}   # sink id -> (driver id, pin)
+    direct = direct_nets(netlist, consumers, opt.direct_skip) if opt.direct else {}   # sink -> (driver, pin)
 
     # ---- placement -----------------------------------------------------------------
     levels: dict[int, list] = {}
@@ -303,6 +331,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         if len(cons) == 1 and cons[0][0] == "pin":
             direct_input[(cons[0][1], cons[0][2])] = w.name
     n_direct_half = 0
+    gate_owned: list[tuple[list[Body], frozenset]] = []   # bodies of each gate (and direct unit), their owners
     for g in [g for g in netlist.gates if g.id not in direct] + sorted(
             (g for g in netlist.gates if g.id in direct), key=lambda g: g.depth):
         state = f"{zero[g.a.src]}{zero[g.b.src]}"
@@ -312,12 +341,14 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             parts, R, t = place_direct(g.id, *direct[g.id], sc, pos, quat, by_name, zero[("gate", direct[g.id][0])],
                                        geo, LEVER_STOP, TERMINAL_POST)
             add(parts)
+            gate_owned.append((parts.bodies, frozenset((g.id, direct[g.id][0]))))
             n_direct_half += 2
             origin[g.id] = t
             xpos[("gate", g.id)] = float(t[0])
         else:
             bs, bd = _gate_bodies(g.id, sc, pos, quat, origin[g.id])
             add(Parts(bs, bd, []))
+            gate_owned.append((bs, frozenset((g.id,))))
         for m in sc.muscles:                     # muscle_a / muscle_b: kept where an input drives the lever
             key = (g.id, m.input)
             if key in direct_input:
@@ -347,6 +378,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     lanes = Lanes()
     space = Space(LAYER_RADIUS)
     space_clear = 2.0 * LAYER_RADIUS
+    gate_pts = [(_slab_points(bs), owners) for bs, owners in gate_owned]
     tight: list = []                        # chains that could not be kept apart by the lanes
     depth_of = {g.id: g.depth for g in netlist.gates}
     if direct:                                  # the direct nets need no chain
@@ -443,27 +475,52 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                    else SOURCE_TURN * max_bend(geo))
             plane = lanes.assign(lane)
             route = None
-            best = (-math.inf, None, plane)
+            best = (-math.inf, None, plane, ())
+            # a branch's chains leave their pages side by side: their first layers are the branch's
+            skip = BRANCH_LAYERS if start is not tap else 0
+            # the gates this chain may touch: its driver's and its sink's (with their direct units)
+            others = [p for p, owners in gate_pts
+                      if gid not in owners and not (wire[0] == "gate" and wname in owners)]
+            others = np.concatenate(others) if others else np.zeros((0, 3))
+            others_tree = cKDTree(others) if len(others) else None
+            route_kw = dict(tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
+                            start_bend_max=sbm, extras=LANE_EXTRAS, bend_max=LANE_BEND * max_bend(geo),
+                            end_bends=(END_JUNCTIONS, END_BEND * max_bend(geo)), wp_weight=WAYPOINT_WEIGHT)
+
+            def gap_of(r):
+                """Distance of the route's layers to other chains' layers; a gate's points
+                count as a layer nearer by the difference of the two clearances."""
+                cs, _, _ = _fk(r.centre, r.axis, r.tangent, r.bends,
+                               [geo.pitch] * (len(r.bends) - 1) + [geo.pitch + ext])
+                m = layer_centres(cs)[skip:]
+                g = space.nearest(m, tag)
+                if others_tree is not None and len(m):
+                    g = min(g, float(others_tree.query(m)[0].min()) + space_clear - GATE_CLEAR)
+                return g
+
             for attempt in range(PLANE_TRIES):
                 y_k = plane_y(plane)
                 corners = [(x_rise, y_k, lane.z_a), (x_rise, y_k, z_run), (x_in, y_k, z_run),
                            (x_in, y_k, lane.z_in), (x_end, yp - 1.0, zp - 6.0)]
                 wps = [tuple(p) for p in rounded(corners, TURN_RADIUS, WAYPOINT_STEP)]
                 r = solve_route(start.centre, start.axis, target.centre, target.axis, geo, spol, waypoints=wps,
-                                tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
-                                start_bend_max=sbm, extras=LANE_EXTRAS, bend_max=LANE_BEND * max_bend(geo),
-                                end_bends=(END_JUNCTIONS, END_BEND * max_bend(geo)), wp_weight=WAYPOINT_WEIGHT)
+                                **route_kw)
                 if r is not None:
-                    cs, _, _ = _fk(r.centre, r.axis, r.tangent, r.bends,
-                                   [geo.pitch] * (len(r.bends) - 1) + [geo.pitch + ext])
-                    # a branch's chains leave their pages side by side: their first layers are the branch's
-                    gap_ = space.nearest(layer_centres(cs)[BRANCH_LAYERS if start is not tap else 0:], tag)
+                    gap_ = gap_of(r)
                     if gap_ > best[0]:
-                        best = (gap_, r, plane)
+                        best = (gap_, r, plane, wps)
                     if gap_ >= space_clear:
                         break
                 plane = lanes.assign(lane, plane + 1)
-            gap_, route, plane = best
+            gap_, route, plane, wps = best
+            if route is not None and gap_ < space_clear:
+                # no plane keeps it apart: the best plane's route again, pushed away from the
+                # layers of the chains placed so far and from the other gates' slabs
+                avoid = ((space.points(tag), space_clear), (others, GATE_CLEAR))
+                r = solve_route(start.centre, start.axis, target.centre, target.axis, geo, spol, waypoints=wps,
+                                avoid=avoid, avoid_from=skip, **route_kw)
+                if r is not None and gap_of(r) > gap_:
+                    gap_, route = gap_of(r), r
             if route is None:        # the lanes are a preference: route straight if they cannot be kept
                 route = solve_route(start.centre, start.axis, target.centre, target.axis, geo, spol,
                                     tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
@@ -538,6 +595,23 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     return Circuit(scene, origin, n_chains, n_half,
                    {"place": t_route - t_start, "route": t_done - t_route, "assemble": t_end - t_done},
                    min((g for _, g in tight), default=float("inf")))
+
+
+def _slab_points(bodies: list[Body]) -> np.ndarray:
+    """Points along the middle of every slab of ``bodies`` (world frame, sigma), at most
+    ``GATE_POINT_STEP`` apart along each slab's longest edge: what the router keeps chains from."""
+    from mlc.geometry.rotation import quat_to_matrix
+    pts = []
+    for b in bodies:
+        R = b.rotation()
+        for box in b.boxes:
+            A = R @ quat_to_matrix(np.asarray(box.orientation, float))
+            c = b.position + R @ np.asarray(box.center, float)
+            k = int(np.argmax(box.size))
+            L = float(box.size[k])
+            m = max(1, int(math.ceil(L / GATE_POINT_STEP)))
+            pts += [c + A[:, k] * (L * (j / m - 0.5)) for j in range(m + 1)]
+    return np.array(pts).reshape(-1, 3)
 
 
 def _stem(source: str) -> str:

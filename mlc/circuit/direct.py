@@ -38,19 +38,34 @@ LEVER_TILT = math.radians(15.0)    # ... plus this at the driver's lever: its li
                                    # between the states of a NAND's output, which the stop must not resist)
 
 
-def direct_nets(netlist, consumers: dict) -> dict:
+def direct_nets(netlist, consumers: dict, skip=()) -> dict:
     """{sink gate id: (driver gate id, pin)} of the nets made direct: driver a gate, exactly
     one consumer, a gate pin; each sink takes at most one (the first pin, a then b, whose
-    driver qualifies).  ``consumers``: wire -> [("pin", gid, pin) | ("out", ...)]."""
+    driver qualifies); sinks in ``skip`` take none.  ``consumers``: wire -> [("pin", gid,
+    pin) | ("out", ...)]."""
     out: dict = {}
     for g in netlist.gates:
         for pin, p in (("a", g.a), ("b", g.b)):
-            if g.id in out or p.src[0] != "gate":
+            if g.id in out or g.id in skip or p.src[0] != "gate":
                 continue
             cons = consumers.get(p.src, [])
             if len(cons) == 1 and cons[0] == ("pin", g.id, pin):
                 out[g.id] = (p.src[1], pin)
     return out
+
+
+def crossed_direct(scene, direct: dict) -> set:
+    """Sinks of the direct nets (``direct``: sink -> (driver, pin)) whose unit, sink or
+    driver a slab of another element passes through in the built pose: the exact
+    oriented-box test (:func:`mlc.verify.overlap.clearance`, joined hinge contact left out)."""
+    from mlc.verify.overlap import clearance
+    hit = set()
+    for a, b, _ in clearance(scene).overlaps:
+        for sid, (drv, _pin) in direct.items():
+            mine = (f"d_{drv}_", f"{sid}_", f"{drv}_")
+            if a.startswith(mine) != b.startswith(mine):
+                hit.add(sid)
+    return hit
 
 
 def _frame(a, n) -> np.ndarray:
@@ -154,7 +169,6 @@ def pure_clearance(drv_type: str, drv_state: str, snk_type: str, snk_state: str,
             s = Scene(name="pure", bodies=db + sb, bonds=bonds, muscles=[], probes=[], inputs=[], outputs=[])
             res.append((sign, int(round(phi)), float(clearance(s).min_clearance)))
     return res
-
 
 
 def place_direct(sid: str, drv: str, pin: str, sc, pos, quat, by_name: dict, state: int, geo: ConnectorGeometry,

@@ -152,6 +152,11 @@ class Space:
                                     best = d
         return best
 
+    def points(self, owner) -> np.ndarray:
+        """Every layer centre of the other owners, (m, 3)."""
+        pts = [q for cell in self.grid.values() for q, o in cell if o != owner]
+        return np.array(pts).reshape(-1, 3)
+
     def add(self, pts: np.ndarray, owner) -> None:
         for p in pts:
             self.grid.setdefault(self._keys(p), []).append((np.asarray(p, float), owner))

@@ -26,8 +26,9 @@ from dataclasses import dataclass
 import numpy as np
 from numba import njit
 from scipy.optimize import least_squares
+from scipy.spatial import cKDTree
 
-from mlc.gates.connector import ConnectorGeometry, chain_frames, max_bend, rotate
+from mlc.gates.connector import ConnectorGeometry, max_bend
 
 BEND_FRACTION = 0.75         # routing bends at most this fraction of the geometric largest bend
 EXACT = 1e-7                 # sigma: the last pair must land this close
@@ -35,6 +36,7 @@ PASSES = (1.0, 1e-5)         # weights of the soft terms: shape the chain, then 
 DEBUG = False
 SHAPE_TOL = 1e-5           # relative cost change that ends the shaping pass
 STATS = None               # a list to collect (n, pass, evaluations, status, closure) per solve
+AVOID_WEIGHT = 30.0        # weight of the keep-away terms (``avoid``) against the waypoints' 1
 EARLY_CLOSE = True         # the closing passes stop at the first evaluation that closes to CLOSE_MARGIN * EXACT
 CLOSE_MARGIN = 0.1
 
@@ -227,7 +229,7 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
                 min_half: int = 2, max_half: int = 400, bend_max: float | None = None,
                 last_pitch: float | None = None, start_bend_max: float = math.radians(50.0),
                 extras=(0, 2, 4, 8, 12, 16, 24), end_bends: tuple[int, float] | None = None,
-                 wp_weight: float = 0.3) -> Route | None:
+                 wp_weight: float = 0.3, avoid=(), avoid_from: int = 0) -> Route | None:
     """A chain from pair (c0, u0) to pair (target_c, +-target_a) with ``n % 2 == parity``
     half units; None when no chain closes.
 
@@ -241,7 +243,11 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
     ``wp_weight``: weight of the waypoints against the exact equations (10).
     ``end_bends = (m, b)``: the ``m`` junctions after the first and the last ``m`` bend at
     most ``b`` (rad), leaving room for the levers at both ends to move the chain between
-    rows."""
+    rows.
+    ``avoid``: ``(points, distance)`` sets (sigma): the soft passes push every layer
+    centre from the ``avoid_from``-th on (see ``lanes.layer_centres``) towards at least
+    ``distance`` from each set's points (a one-sided term of weight ``AVOID_WEIGHT``,
+    scaled like the waypoints: the closing passes keep the shape but do not enforce it)."""
     c0, u0 = np.asarray(c0, float), np.asarray(u0, float) / np.linalg.norm(u0)
     P, a = np.asarray(target_c, float), np.asarray(target_a, float) / np.linalg.norm(target_a)
     e1, e2 = _perp_basis(a)
@@ -268,7 +274,7 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
                 np.asarray(w, float)) for w in waypoints]
         try:
             r = _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start and start_bend_max, wps,
-                         end_bends, wp_weight)
+                         end_bends, wp_weight, avoid, avoid_from)
         except ValueError:          # a degenerate start (non-finite residuals): try the next length
             continue
         if DEBUG:
@@ -346,7 +352,7 @@ def _fk(c0, u0, t0, b, pitch):
 
 
 def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=(), end_bends=None,
-             wp_weight=0.3) -> Route:
+             wp_weight=0.3, avoid=(), avoid_from=0) -> Route:
     lo = np.full(n, -bmax)
     hi = np.full(n, bmax)
     if end_bends is not None:                  # (count, bound): the first and last junctions bend less
@@ -362,6 +368,22 @@ def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=(
     app_v = np.zeros(3) if app is None else np.asarray(app, float)
     n_rows = 5 + (3 if has_app else 0) + 3 * len(wp_k) + (n - 1)
     cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
+    avoid = [(cKDTree(np.asarray(p, float).reshape(-1, 3)), float(d)) for p, d in avoid if len(p)]
+    n_avoid = n - min(max(int(avoid_from), 0), n)
+    near_q = np.zeros((len(avoid) * n_avoid, 3))     # per avoid row: its nearest point ...
+    near_d = np.full(len(avoid) * n_avoid, np.inf)   # ... its distance (inf: none within the set's distance)
+    near_D = np.zeros(len(avoid) * n_avoid)          # ... and the set's distance
+
+    def nearest():
+        m = 0.5 * (cs[1:] + cs[:-1])[n - n_avoid:]
+        for k_, (tree, d) in enumerate(avoid):
+            dist, idx = tree.query(m, distance_upper_bound=d)
+            sl = slice(k_ * n_avoid, (k_ + 1) * n_avoid)
+            ok = np.isfinite(dist)
+            near_d[sl] = dist
+            q = near_q[sl]
+            q[ok] = tree.data[idx[ok]]
+            near_D[sl] = d
 
     def frames(b):
         _fk_kernel(c0, u0, t0, np.ascontiguousarray(b, dtype=np.float64), pitches, cs, us, ts)
@@ -374,8 +396,11 @@ def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=(
 
     def resid(b, w_soft, stop=False):
         frames(b)
-        out = np.empty(n_rows)
+        out = np.empty(n_rows + near_d.size)
         _resid_kernel(cs, us, ts, b, P, e1, e2, has_app, app_v, wp_k, wp_p, w_soft, wp_weight, out)
+        if near_d.size:
+            nearest()
+            out[n_rows:] = w_soft * AVOID_WEIGHT * np.where(np.isfinite(near_d), near_D - near_d, 0.0)
         if stop and max(abs(out[0]), abs(out[1]), abs(out[2]), abs(out[3]), abs(out[4])) < 10.0 * EXACT * CLOSE_MARGIN:
             if np.all(b >= lo) and np.all(b <= hi):
                 raise _Closed(b)
@@ -384,8 +409,11 @@ def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=(
     def jac(b, w_soft, stop=False):
         # bend i turns everything downstream of junction i rigidly about (c_i, u_i)
         frames(b)
-        J = np.empty((n_rows, n))
+        J = np.empty((n_rows + near_d.size, n))
         _jac_kernel(cs, us, ts, e1, e2, has_app, wp_k, w_soft, wp_weight, J)
+        if near_d.size:
+            nearest()
+            _avoid_jac_kernel(cs, us, n - n_avoid, near_q, near_d, w_soft * AVOID_WEIGHT, J[n_rows:])
         return J
 
     x = np.clip(np.asarray(x0, float), lo + 1e-12, hi - 1e-12)
@@ -439,6 +467,34 @@ def _resid_kernel(cs, us, ts, b, P, e1, e2, has_app, app, wp_k, wp_p, w_soft, wp
     for i in range(1, n):
         out[r] = w_soft * 0.05 * b[i]
         r += 1
+
+
+@njit(cache=True)
+def _avoid_jac_kernel(cs, us, j0, near_q, near_d, w, J):
+    """Jacobian of the avoid rows, w (D - d) for the layer centres m_j, j = j0 ..., with a
+    point q within D (set after set; rows without one are 0): with n = (m_j - q) / d,
+    d d / d b_i = n . (u_i x (m_j - c_i)) for i < j and n . (u_j x (c_{j+1} - c_j)) / 2 for i = j."""
+    n_av = cs.shape[0] - 1 - j0
+    J[:, :] = 0.0
+    for r in range(near_d.shape[0]):
+        if not math.isfinite(near_d[r]) or near_d[r] <= 0.0:
+            continue
+        j = j0 + r % n_av
+        mx = 0.5 * (cs[j, 0] + cs[j + 1, 0])
+        my = 0.5 * (cs[j, 1] + cs[j + 1, 1])
+        mz = 0.5 * (cs[j, 2] + cs[j + 1, 2])
+        nx = (mx - near_q[r, 0]) / near_d[r]
+        ny = (my - near_q[r, 1]) / near_d[r]
+        nz = (mz - near_q[r, 2]) / near_d[r]
+        for i in range(j + 1):
+            ux, uy, uz = us[i, 0], us[i, 1], us[i, 2]
+            if i < j:
+                dx, dy, dz = mx - cs[i, 0], my - cs[i, 1], mz - cs[i, 2]
+            else:
+                dx = 0.5 * (cs[j + 1, 0] - cs[j, 0])
+                dy = 0.5 * (cs[j + 1, 1] - cs[j, 1])
+                dz = 0.5 * (cs[j + 1, 2] - cs[j, 2])
+            J[r, i] = -w * (nx * (uy * dz - uz * dy) + ny * (uz * dx - ux * dz) + nz * (ux * dy - uy * dx))
 
 
 @njit(cache=True)

@@ -102,7 +102,9 @@ def summary(c, written: list[str], level: int) -> dict:
         "seconds": round(c.seconds, 3),
         "circuit": None if c.circuit is None else {
             "bodies": len(c.circuit.scene.bodies), "chains": c.circuit.chains, "half_units": c.circuit.half_units,
-            "seconds": {k: round(v, 3) for k, v in c.circuit.seconds.items()}},
+            "seconds": {k: round(v, 3) for k, v in c.circuit.seconds.items()},
+            **{k: c.circuit.scene.meta["connector"][k] for k in ("direct", "direct_dropped")
+               if k in c.circuit.scene.meta["connector"]}},
     }
 
 
@@ -123,6 +125,11 @@ def format_summary(d: dict) -> str:
         ci = d["circuit"]
         lines.append(f"circuit: {ci['bodies']} bodies, {ci['chains']} connector chains, {ci['half_units']} half units "
                      f"(placed and routed in {sum(ci['seconds'].values()):.1f} s)")
+        if "direct" in ci:
+            lines.append(f"direct connections: {len(ci['direct'])}"
+                         + "".join(f", {d} -> {s}.{p}" for d, s, p in ci["direct"])
+                         + (f"; chained instead, as a chain crossed their column: {', '.join(ci['direct_dropped'])}"
+                            if ci.get("direct_dropped") else ""))
     if d.get("verification"):
         v = d["verification"]
         lines.append(f"verification ({v['mode']}): {'all ' + str(v['rows']) + ' rows correct' if v['ok'] else 'FAILED'}"
