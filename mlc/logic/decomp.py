@@ -106,10 +106,21 @@ class _Dec:
         n = self.n
         off = care & ~f
         best = None
+        pos, neg = T.var_tables(n)
         for i in sup:
-            on0, on1 = T.cof0(f, n, i), T.cof1(f, n, i)
-            of0, of1 = T.cof0(off, n, i), T.cof1(off, n, i)
-            c0, c1 = T.cof0(care, n, i), T.cof1(care, n, i)
+            sh_, vi, ni = 1 << i, pos[i], neg[i]
+            t = f & ni
+            on0 = t | (t << sh_)
+            t = f & vi
+            on1 = t | (t >> sh_)
+            t = off & ni
+            of0 = t | (t << sh_)
+            t = off & vi
+            of1 = t | (t >> sh_)
+            t = care & ni
+            c0 = t | (t << sh_)
+            t = care & vi
+            c1 = t | (t >> sh_)
             x = 2 * (i + 1)
             steps = []
             if on0 == 0:

@@ -181,15 +181,23 @@ def stretch(t: int, k: int, n: int, vars_: list[int]) -> int:
     return res
 
 
-def shrink(t: int, n: int, vars_: list[int]) -> int:
-    """Restrict a table over ``n`` variables that only depends on ``vars_`` to those variables."""
-    k = len(vars_)
-    res = 0
-    for lm in range(1 << k):
+@lru_cache(maxsize=4096)
+def _shrink_minterms(vars_: tuple[int, ...]) -> tuple[int, ...]:
+    """The global minterm of every local minterm of :func:`shrink`."""
+    out = []
+    for lm in range(1 << len(vars_)):
         m = 0
         for i, g in enumerate(vars_):
             if (lm >> i) & 1:
                 m |= 1 << g
+        out.append(m)
+    return tuple(out)
+
+
+def shrink(t: int, n: int, vars_: list[int]) -> int:
+    """Restrict a table over ``n`` variables that only depends on ``vars_`` to those variables."""
+    res = 0
+    for lm, m in enumerate(_shrink_minterms(tuple(vars_))):
         if (t >> m) & 1:
             res |= 1 << lm
     return res
