@@ -83,7 +83,12 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true")
     ap.add_argument("--budget", type=float, default=1.5, help="seconds per point")
+    ap.add_argument("--crossover", action="store_true",
+                    help="only the serial/parallel crossover: 64..4096 bodies, Euler and stiff on 1 and 2 threads "
+                         "(parallel kernels forced), -> sim_throughput_crossover.json")
     args = ap.parse_args()
+    if args.crossover:
+        return crossover(args.budget)
     sizes = [8, 32, 128, 512, 2048, 8192, 32768, 100000]
     if args.quick:
         sizes = [8, 128, 2048]
@@ -129,6 +134,36 @@ def main():
     RESULTS.mkdir(exist_ok=True)
     (RESULTS / "sim_throughput.json").write_text(json.dumps(out, indent=1) + "\n")
     plot(out)
+
+
+def crossover(budget):
+    """Where the parallel kernels on 2 threads start to beat the serial ones (the default of
+    ``SimOptions.parallel_min_bodies``): hinged slab chains of 64..4096 bodies, Euler and the
+    stiff scheme, serial kernels on one thread against parallel kernels on two, interleaved
+    per size so that a change of machine load hits both."""
+    load0 = os.getloadavg()
+    rows = []
+    for N in (64, 128, 256, 512, 1024, 2048, 4096):
+        sc = chain_scene(N, check=False)
+        row = {"bodies": N}
+        for label, opt in (("euler_1thread", SimOptions(scheme="euler", dt=1e-4, kT=1e-5, threads=1)),
+                           ("euler_2threads", SimOptions(scheme="euler", dt=1e-4, kT=1e-5, threads=2,
+                                                        parallel_min_bodies=0)),
+                           ("stiff_1thread_per_eval", SimOptions(scheme="stiff", dt=0.01, kT=1e-5, threads=1)),
+                           ("stiff_2threads_per_eval", SimOptions(scheme="stiff", dt=0.01, kT=1e-5, threads=2,
+                                                                 parallel_min_bodies=0))):
+            row[label] = measure(Simulation(sc, None, opt), budget)
+        row["euler_speedup_2threads"] = row["euler_2threads"] / row["euler_1thread"]
+        row["stiff_speedup_2threads"] = row["stiff_2threads_per_eval"] / row["stiff_1thread_per_eval"]
+        rows.append(row)
+        print(json.dumps(row), flush=True)
+    out = {"benchmark": "serial (1 thread) against parallel kernels (2 threads), body-steps per second, hinged slab "
+                        "chains, kT = 1e-5",
+           "machine": {"platform": platform.platform(), "cpus": os.cpu_count(), "python": platform.python_version(),
+                       "loadavg": [load0, os.getloadavg()]},
+           "rows": rows}
+    RESULTS.mkdir(exist_ok=True)
+    (RESULTS / "sim_throughput_crossover.json").write_text(json.dumps(out, indent=1) + "\n")
 
 
 def plot(out):
