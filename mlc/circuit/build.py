@@ -423,10 +423,16 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             angs = branch_angles(len(cons))
             spread = abs(angs[1] - angs[0])
             post = max(geo.branch_post, geo.reach / math.tan(0.5 * spread) + 0.25) + PAGE_CLEAR
+            # the pages' input posts meet at the tap's joint: their ends, d from it, are
+            # 2 d sin(s/2) apart, a post's width w at d = w for 4 pages (s = 60 deg; measured
+            # clear, +0.0107 sigma); 5 pages at d = w overlapped by 0.0117 sigma, so from 5
+            # pages on d = w / (2 sin(s/2)) + 0.03 sigma
+            page_stop = stop_at_tap if len(cons) <= 4 else max(
+                stop_at_tap, 0.5 * POST_WIDTH / math.sin(0.5 * spread) + 0.03)
             for k, (c, ang) in enumerate(zip(cons, angs)):
                 t = rotate(t_up, tap.axis, sgn * ang)
                 parts, pin, pout = half_unit_parts(f"w_{wname}_p{k}", tap.centre, tap.axis, t, state_at_tap, geo,
-                                                   in_post=post, in_stop=stop_at_tap)
+                                                   in_post=post, in_stop=page_stop)
                 parts.bonds += join(f"w_{wname}_p{k}_j", tap, pin, geo.k)
                 add(parts)
                 n_half += 1
