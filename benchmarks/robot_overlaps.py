@@ -34,14 +34,15 @@ import re
 import sys
 import time
 
-_RC = re.compile(r"^rc_(u\d+_(?:up|dn))_(pg|\d+)_([A-D]{2})$")
+_RC = re.compile(r"^rc_(u\d+_(?:up|dn))_(pg|w\d+|\d+)_([A-D]{2})$")
 
 
 def part(name: str) -> tuple[str, str | None, int | None]:
     """(kind, chain, half-unit index) of a body name: kind 'chain', 'skeleton' or 'circuit'."""
     m = _RC.match(name)
     if m:
-        return "chain", m.group(1), (-1 if m.group(2) == "pg" else int(m.group(2)))
+        g = m.group(2)       # page: -1; wrist half units (mlc.robot.build.WRIST): 1000 + i, after the chain
+        return "chain", m.group(1), (-1 if g == "pg" else 1000 + int(g[1:]) if g[0] == "w" else int(g))
     if name.startswith("skel_"):
         return "skeleton", None, None
     return "circuit", None, None
@@ -81,7 +82,8 @@ def analyse(scene, pos, quat) -> dict:
         for nm in (a, b):
             k, ch, i = part(nm)
             if k == "chain":
-                where.append(f"{ch} half unit {'page' if i < 0 else i} of {n_half[ch]}")
+                where.append(f"{ch} page" if i < 0 else f"{ch} wrist half unit {i - 1000}" if i >= 1000
+                             else f"{ch} half unit {i} of {n_half[ch]}")
             else:
                 where.append(nm)
         pairs.append({"a": a, "b": b, "depth": round(d, 4), "class": cls, "where": where})

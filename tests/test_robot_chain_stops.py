@@ -1,8 +1,8 @@
 """Junction stops in a robot's coupling chains (docs/robot.md section 2.2, ``CHAIN_STOPS``):
 with the option on, every junction of every chain, the first included, has one flat-bottom
 stop bond; none is engaged as built (the routes bend at most 0.75 of the largest bend);
-each stop reads a junction's bend as 2 m cos(beta/2) between its sites; the default build
-has none.  Also the reach bookkeeping of section 2.4."""
+each stop reads a junction's bend as 2 m cos(beta/2) between its sites; the wrist's junctions
+(``WRIST``) have none.  Also the reach bookkeeping of section 2.4."""
 import math
 
 import numpy as np
@@ -43,7 +43,8 @@ def test_chain_stops_one_per_junction_free_as_built(circuit, monkeypatch, stops)
             continue
         pre, n = d["chain"]["prefix"], d["chain"]["half_units"]
         st = [bd for bd in sc.bonds if bd.name.startswith(f"{pre}_s")]
-        assert len(st) == (n if stops else 0)           # n - 1 inner junctions + the first one
+        nw = d["chain"]["wrist_units"]                  # the wrist's long-post junctions have no stop
+        assert len(st) == (n - nw if stops else 0)      # the chain's inner junctions + the first one
         for bd in st:
             dd = float(np.linalg.norm(_site(sc, by, bd.a) - _site(sc, by, bd.b)))
             assert abs(dd - bd.rest) <= bd.tolerance + 1e-9          # free as built
@@ -51,5 +52,8 @@ def test_chain_stops_one_per_junction_free_as_built(circuit, monkeypatch, stops)
                 beta = 2 * math.degrees(math.acos(min(1.0, dd / (2 * STOP_ARM))))
                 assert beta < STOP_FRACTION * math.degrees(max_bend(geo))
         # reach bookkeeping (section 2.4): the largest distance over the rows over the contour
-        assert d["chain"]["reach_fraction"] == pytest.approx(d["chain"]["reach_max"] / (n * geo.pitch), abs=2e-3)
+        wp = rb.WRIST_POST + geo.width + 0.5 * geo.gap                # a wrist half unit's pitch
+        contour = (n - nw) * geo.pitch + nw * wp
+        assert d["chain"]["contour"] == pytest.approx(contour, abs=2e-3)
+        assert d["chain"]["reach_fraction"] == pytest.approx(d["chain"]["reach_max"] / contour, abs=2e-3)
         assert 0 < d["chain"]["reach_fraction"] < 1.0

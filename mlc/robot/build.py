@@ -32,8 +32,17 @@ rigid slab) holds its DOF with a plain bond between the tips at its constant len
 bonds (:func:`dof_stops`) that leave it free over [-15, 105] degrees of turn and close
 the lever triangle's mirror equilibria at 180 and -90 degrees.
 
-**Chain stops** (docs/robot.md section 2.2; ``CHAIN_STOPS``, off by default: with them the
-Tetris couplings cannot reach the O pose).  Every junction of a coupling chain has the
+**Wrist** (docs/robot.md section 2.2; ``WRIST``, on since session 10).  A chain does not end
+on the lever sites itself: it ends on ``WRIST_UNITS`` = 3 straight half units going up (+z)
+whose input posts are ``WRIST_POST`` = 1.5 sigma long, so each of their junctions bends up to
+2 atan((WRIST_POST + gap/2) / 2 reach) = 99 degrees before its layers touch (a chain
+junction: 37).  Three such junctions about alternating axes (x, y, x) make any rotation,
+so the wrist takes the lever's turn about z as the skeleton folds (up to 106 degrees in
+the Tetris O pose), which a chain of 37-degree junctions could take only by bending
+past its largest bend.
+
+**Chain stops** (docs/robot.md section 2.2; ``CHAIN_STOPS``, on since session 10: without the
+wrist the Tetris couplings cannot reach the O pose with them).  Every junction of a coupling chain has the
 circuit's junction stop (:func:`mlc.gates.connector.junction_stops`); a chain's first
 junction gets one too when it hangs on a half unit, or a tap stop (:func:`_lever_stop`)
 when it hangs on a gate's output lever.  ``SLACK_FRACTION`` > 0 lengthens the chains so
@@ -83,8 +92,11 @@ STOP_UNDER_LOW = math.radians(52.5)  # rad: the under-turn stop's arms this far 
 STOP_K = 4.0                       # k0: the stops' stiffness once engaged (a wire joint's is 1)
 LEVER_STOP = 0.35                  # sigma: a chain's first posts stop this short of a gate lever's joints (as in circuits)
 SLACK_FRACTION = 0.0               # >0: a chain spans at most this fraction of its length in any row (2.4; 0.6 tried: no faster)
-CHAIN_STOPS = False                # junction stops in the coupling chains: off, with them static row 11 of
-                                   # the Tetris robot folds wrong and dynamics 8/12 (docs/robot.md 2.2, 2.4, 3.1)
+WRIST = True                       # each chain ends on a wrist of WRIST_UNITS long-post half units (docs/robot.md 2.2)
+WRIST_UNITS = 3
+WRIST_POST = 1.5                   # sigma: the wrist half units' input posts (the junction gap grows to WRIST_POST + gap/2)
+CHAIN_STOPS = True                 # junction stops in the coupling chains (session 10, with the wrist; without
+                                   # the wrist static row 11 of the Tetris robot folds wrong: docs/robot.md 2.2, 2.4, 6)
 
 
 @dataclass
@@ -242,6 +254,38 @@ def _end_bonds(tag: str, lout: Pair, target: Pair, tax, k: float) -> list[Bond]:
     ends = (lout.lo, lout.hi) if same else (lout.hi, lout.lo)
     return [Bond(f"{tag}_end_lo", ends[0], target.lo, k, 0.0, 0.0, "universal", f"{tag}_end_lo"),
             Bond(f"{tag}_end_hi", ends[1], target.hi, k, 0.0, 0.0, "universal", f"{tag}_end_hi")]
+
+
+def _join_aligned(name: str, a: Pair, b: Pair, k: float) -> list[Bond]:
+    """Two universal joints from pair ``a`` to pair ``b``, lo to the nearer end."""
+    if float(a.axis @ b.axis) > 0:
+        return join(name, a, b, k)
+    return [Bond(f"{name}_lo", a.lo, b.hi, k, 0.0, 0.0, "universal", f"{name}_lo"),
+            Bond(f"{name}_hi", a.hi, b.lo, k, 0.0, 0.0, "universal", f"{name}_hi")]
+
+
+def _wrist(tag: str, tc, tax, state: int, geo):
+    """WRIST_UNITS straight half units with long input posts, going up (+z) and ending on the
+    lever pair (centre ``tc``, axis ``tax``): each of their junctions can bend far further than
+    a chain's (gap WRIST_POST + gap/2 instead of gap), so together they can take the lever's
+    turn about z.  ``state``: the signal state at the wrist's input.  Returns (parts, pin, pout)."""
+    from mlc.gates.connector import Parts
+    ez = np.array([0.0, 0.0, 1.0])
+    pitch = WRIST_POST + geo.width + 0.5 * geo.gap
+    u = np.asarray(tax, float) / np.linalg.norm(tax)
+    for _ in range(WRIST_UNITS):                       # back down: u_out = ez x u_in, so u_in = -ez x u_out
+        u = -np.cross(ez, u)
+    c = np.asarray(tc, float) - WRIST_UNITS * pitch * ez
+    parts, pin, prev = Parts(), None, None
+    for i in range(WRIST_UNITS):
+        p, pi_, po = half_unit_parts(f"{tag}_w{i}", c, u, ez, (state + i) % 2, geo, in_post=WRIST_POST)
+        parts.add(p)
+        if prev is None:
+            pin = pi_
+        else:
+            parts.bonds += join(f"{tag}_wj{i}", prev, pi_, geo.k)
+        prev, c, u = po, po.centre, po.axis
+    return parts, pin, prev
 
 
 def _chain_overlap(placed: list[Body], placed_bonds: list[Bond], parts, new_bonds: list[Bond],
@@ -498,8 +542,12 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
                 c_start, parity, cstate, free, sb = pout, 1, 1 - sstate, True, BEND_FRACTION * max_bend(geo)
             else:
                 c_start, parity, cstate, free, sb = start, 0, sstate, fan == 0, sbm
+            rc, rax = tc, tax
+            if WRIST:                                 # the chain ends on a wrist under the lever sites
+                wparts0, wpin0, _ = _wrist(f"{tag}", tc, tax, 0, geo)
+                rc, rax, parity = wpin0.centre, wpin0.axis, (parity + WRIST_UNITS) % 2
             for wp in (wps, []):
-                route = solve_route(c_start.centre, c_start.axis, tc, tax, geo, parity, waypoints=wp, tangent=tv,
+                route = solve_route(c_start.centre, c_start.axis, rc, rax, geo, parity, waypoints=wp, tangent=tv,
                                     free_start=free, approach=ez, min_half=min_half + parity, start_bend_max=sb)
                 if route is not None:
                     break
@@ -511,6 +559,11 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
             if pg is not None:
                 parts.bodies = pg.bodies + parts.bodies
                 parts.bonds = pg.bonds + parts.bonds
+            if WRIST:
+                wparts, wpin, wout = _wrist(tag, tc, tax, (cstate + len(route.bends)) % 2, geo)
+                parts.bodies += wparts.bodies
+                parts.bonds += wparts.bonds + _join_aligned(f"{tag}_wj0", pairs[-1], wpin, geo.k)
+                pairs = pairs + [wout]
             new_c = np.array([b.position for b in parts.bodies])
             d2 = ((new_c[:, None, :] - placed[None, :, :]) ** 2).sum(-1)
             if float(d2.min()) < CLEAR ** 2:
@@ -550,11 +603,14 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
         parts_bodies += parts.bodies
         parts_bonds += parts.bonds
         n_chains += 1
-        nh = len(route.bends) + (1 if paged else 0)
+        nh = len(route.bends) + (1 if paged else 0) + (WRIST_UNITS if WRIST else 0)
+        contour = (len(route.bends) + (1 if paged else 0)) * geo.pitch + (
+            WRIST_UNITS * (WRIST_POST + geo.width + 0.5 * geo.gap) if WRIST else 0.0)   # sigma
         n_half += nh
         next(d for d in dofs_meta if d["name"] == name)["chain"] = {
             "half_units": nh, "prefix": tag, "page": paged, "fan_deg": fan, "route_seconds": round(time.perf_counter() - tr, 2),
-            "reach_max": round(max(d_rows), 3), "reach_fraction": round(max(d_rows) / (nh * geo.pitch), 3)}
+            "reach_max": round(max(d_rows), 3), "wrist_units": WRIST_UNITS if WRIST else 0,
+            "contour": round(contour, 3), "reach_fraction": round(max(d_rows) / contour, 3)}
     rmeta = spec.as_dict()
     rmeta.update({"origin": [float(v) for v in origin], "plane_normal": [0.0, 0.0, 1.0], "x_axis": [1.0, 0, 0],
                   "joint_length": s, "links": [f"skel_u{i}" for i in range(spec.units + 1)],
