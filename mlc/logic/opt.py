@@ -830,33 +830,9 @@ def enumerate_cuts(g: AIG, k: int = 4, limit: int = 10) -> list[list[tuple[int, 
     return cuts
 
 
-_VAR4 = (0xAAAA, 0xCCCC, 0xF0F0, 0xFF00)
-
-
 def cut_table(g: AIG, node: int, leaves: tuple[int, ...]) -> int:
     """16-bit table of ``node`` over ``leaves`` (padded to 4 variables)."""
-    val = dict(zip(leaves, _VAR4))
-    ands = g.ands
-    off = g.num_inputs + 1
-    stack = [node]
-    while stack:
-        x = stack[-1]
-        if x in val:
-            stack.pop()
-            continue
-        a, b = ands[x - off]
-        ya, yb = a >> 1, b >> 1
-        va = val.get(ya)
-        vb = val.get(yb)
-        if va is None or vb is None:
-            if va is None:
-                stack.append(ya)
-            if vb is None:
-                stack.append(yb)
-            continue
-        stack.pop()
-        val[x] = (va ^ 0xFFFF if a & 1 else va) & (vb ^ 0xFFFF if b & 1 else vb)
-    return val[node]
+    return cone_table(g, node, leaves, 4)
 
 
 def _place_class_circuit(g: AIG, ent: dict, lits: list, out: int, incone: set[int],
