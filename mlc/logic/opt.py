@@ -612,25 +612,7 @@ def resub_dc(g: AIG, max_leaves: int | None = None, levels: int | None = None,
         leaves.discard(0)
         if len(leaves) > max_leaves:
             continue
-        while True:
-            best, bcost = None, None
-            for y in leaves:
-                if y <= n:
-                    continue
-                fa, fb = ands[y - n - 1]
-                za, zb = fa >> 1, fb >> 1
-                c = ((za != 0 and za not in leaves and za not in inside)
-                     + (zb != 0 and zb not in leaves and zb not in inside) - 1)
-                if bcost is None or c < bcost or (c == bcost and y > best):
-                    best, bcost = y, c
-            if best is None or len(leaves) + bcost > max_leaves:
-                break
-            leaves.discard(best)
-            inside.add(best)
-            fa, fb = ands[best - n - 1]
-            for z in (fa >> 1, fb >> 1):
-                if z and z not in inside:
-                    leaves.add(z)
+        _expand_cut(ands, n, leaves, inside, max_leaves)
         if any(changed[y] or touched[y] for y in leaves) or any(changed[y] for y in inside):
             continue
         lv = sorted(leaves)
@@ -1016,7 +998,13 @@ def reconv_cut(g: AIG, x: int, max_leaves: int) -> list[int]:
     leaves = {a >> 1, b >> 1}
     leaves.discard(0)
     inside = {x}
-    ands = g.ands
+    _expand_cut(g.ands, n, leaves, inside, max_leaves)
+    return sorted(leaves)
+
+
+def _expand_cut(ands, n: int, leaves: set[int], inside: set[int], max_leaves: int) -> None:
+    """Grow a cut in place: move into ``inside`` the leaf whose fanins add fewest new
+    leaves (the larger node on a tie) while the cut stays within ``max_leaves``."""
     while True:
         best, bcost = None, None
         for y in leaves:
@@ -1032,11 +1020,10 @@ def reconv_cut(g: AIG, x: int, max_leaves: int) -> list[int]:
             break
         leaves.discard(best)
         inside.add(best)
-        fa, fb = g.ands[best - n - 1]
+        fa, fb = ands[best - n - 1]
         for z in (fa >> 1, fb >> 1):
             if z and z not in inside:
                 leaves.add(z)
-    return sorted(leaves)
 
 
 def cone_table(g: AIG, node: int, leaves: list[int], k: int | None = None) -> int:
