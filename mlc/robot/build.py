@@ -544,7 +544,7 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
                 c_start, parity, cstate, free, sb = start, 0, sstate, fan == 0, sbm
             rc, rax = tc, tax
             if WRIST:                                 # the chain ends on a wrist under the lever sites
-                wparts0, wpin0, _ = _wrist(f"{tag}", tc, tax, 0, geo)
+                _, wpin0, _ = _wrist(tag, tc, tax, 0, geo)
                 rc, rax, parity = wpin0.centre, wpin0.axis, (parity + WRIST_UNITS) % 2
             for wp in (wps, []):
                 route = solve_route(c_start.centre, c_start.axis, rc, rax, geo, parity, waypoints=wp, tangent=tv,
