@@ -95,6 +95,7 @@ SLACK_FRACTION = 0.0               # >0: a chain spans at most this fraction of 
 WRIST = True                       # each chain ends on a wrist of WRIST_UNITS long-post half units (docs/robot.md 2.2)
 WRIST_UNITS = 3
 WRIST_POST = 1.5                   # sigma: the wrist half units' input posts (the junction gap grows to WRIST_POST + gap/2)
+AVOID_CHAINS = 1.5                 # sigma: routes pushed this far from the chains placed before (docs/robot.md 2.6)
 CHAIN_STOPS = True                 # junction stops in the coupling chains (session 10, with the wrist; without
                                    # the wrist static row 11 of the Tetris robot folds wrong: docs/robot.md 2.2, 2.4, 6)
 
@@ -546,9 +547,12 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
             if WRIST:                                 # the chain ends on a wrist under the lever sites
                 _, wpin0, _ = _wrist(tag, tc, tax, 0, geo)
                 rc, rax, parity = wpin0.centre, wpin0.axis, (parity + WRIST_UNITS) % 2
+            avoid_kw = ({"avoid": (([b.position for b in parts_bodies], AVOID_CHAINS),), "avoid_from": 2}
+                        if AVOID_CHAINS > 0 and parts_bodies else {})
             for wp in (wps, []):
                 route = solve_route(c_start.centre, c_start.axis, rc, rax, geo, parity, waypoints=wp, tangent=tv,
-                                    free_start=free, approach=ez, min_half=min_half + parity, start_bend_max=sb)
+                                    free_start=free, approach=ez, min_half=min_half + parity, start_bend_max=sb,
+                                    **avoid_kw)
                 if route is not None:
                     break
             if route is None:
