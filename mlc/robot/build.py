@@ -95,7 +95,7 @@ SLACK_FRACTION = 0.0               # >0: a chain spans at most this fraction of 
 WRIST = True                       # each chain ends on a wrist of WRIST_UNITS long-post half units (docs/robot.md 2.2)
 WRIST_UNITS = 3
 WRIST_POST = 1.5                   # sigma: the wrist half units' input posts (the junction gap grows to WRIST_POST + gap/2)
-AVOID_CHAINS = 1.5                 # sigma: routes pushed this far from the chains placed before (docs/robot.md 2.6)
+AVOID_CHAINS = 0.0                 # sigma, >0: routes pushed this far from the chains placed before (probe, off: docs/robot.md 2.6)
 CHAIN_STOPS = True                 # junction stops in the coupling chains (session 10, with the wrist; without
                                    # the wrist static row 11 of the Tetris robot folds wrong: docs/robot.md 2.2, 2.4, 6)
 
