@@ -36,6 +36,25 @@ def _cache_put(cache: dict, key, value) -> None:
     cache[key] = value
 
 
+def _cofactors(f: int, off: int, care: int, s: int, vi: int, ni: int):
+    """The cofactors of the interval (on-set ``f``, off-set ``off``, care set ``care``)
+    with respect to variable ``i`` (``s = 1 << i``, ``vi``/``ni`` its positive and
+    negative tables), each spread over both halves: (on0, on1, of0, of1, c0, c1)."""
+    t = f & ni
+    on0 = t | (t << s)
+    t = f & vi
+    on1 = t | (t >> s)
+    t = off & ni
+    of0 = t | (t << s)
+    t = off & vi
+    of1 = t | (t >> s)
+    t = care & ni
+    c0 = t | (t << s)
+    t = care & vi
+    c1 = t | (t >> s)
+    return on0, on1, of0, of1, c0, c1
+
+
 class _Dec:
     def __init__(self, n: int, effort: int, rng=None):
         self.rng = rng
@@ -108,19 +127,7 @@ class _Dec:
         best = None
         pos, neg = T.var_tables(n)
         for i in sup:
-            sh_, vi, ni = 1 << i, pos[i], neg[i]
-            t = f & ni
-            on0 = t | (t << sh_)
-            t = f & vi
-            on1 = t | (t >> sh_)
-            t = off & ni
-            of0 = t | (t << sh_)
-            t = off & vi
-            of1 = t | (t >> sh_)
-            t = care & ni
-            c0 = t | (t << sh_)
-            t = care & vi
-            c1 = t | (t >> sh_)
+            on0, on1, of0, of1, c0, c1 = _cofactors(f, off, care, 1 << i, pos[i], neg[i])
             x = 2 * (i + 1)
             steps = []
             if on0 == 0:
@@ -174,19 +181,7 @@ class _Dec:
         pos, neg = T.var_tables(n)
         # disjoint-support steps
         for i in sup:
-            sh_, vi, ni = 1 << i, pos[i], neg[i]
-            t = f & ni
-            on0 = t | (t << sh_)
-            t = f & vi
-            on1 = t | (t >> sh_)
-            t = off & ni
-            of0 = t | (t << sh_)
-            t = off & vi
-            of1 = t | (t >> sh_)
-            t = care & ni
-            c0 = t | (t << sh_)
-            t = care & vi
-            c1 = t | (t >> sh_)
+            on0, on1, of0, of1, c0, c1 = _cofactors(f, off, care, 1 << i, pos[i], neg[i])
             x = 2 * (i + 1)
             if on0 == 0:                 # f = x & f1
                 c, p = self.rec(on1, c1)

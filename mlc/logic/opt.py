@@ -428,6 +428,36 @@ def resub_odc(g: AIG, care_out: list[int] | None = None, max_new: int = 2,
     return g
 
 
+def _grow_window(ands, n: int, fanouts, vals: dict[int, int], leaves, full: int, top: int,
+                 max_window: int, changed=None, win=None) -> None:
+    """Grow a window from ``leaves`` up through fanouts: a node joins (its table over
+    the leaves into ``vals``) once both its fanins have tables, smallest node first
+    (a heap), up to node ``top`` and ``max_window`` tables in all.  Nodes marked in
+    ``changed`` and nodes with a fanin in ``win`` are left out (for resub_dc)."""
+    cand = sorted({y for leaf in leaves for y in fanouts[leaf]})
+    seen = set(cand)
+    while cand and len(vals) < max_window:
+        y = heappop(cand)
+        if y in vals or y > top:
+            continue
+        if changed is not None and changed[y]:
+            continue
+        a, b = ands[y - n - 1]
+        if win is not None and ((a >> 1) in win or (b >> 1) in win):
+            continue
+        va = vals.get(a >> 1)
+        if va is None:
+            continue
+        vb = vals.get(b >> 1)
+        if vb is None:
+            continue
+        vals[y] = (va ^ full if a & 1 else va) & (vb ^ full if b & 1 else vb)
+        for z in fanouts[y]:
+            if z not in seen:
+                seen.add(z)
+                heappush(cand, z)
+
+
 def resub_window(g: AIG, max_leaves: int | None = None, max_new: int = 2, max_window: int | None = None,
                  deadline: float | None = None) -> AIG:
     """Resubstitution for networks too wide for global tables: each node gets a
@@ -467,26 +497,7 @@ def resub_window(g: AIG, max_leaves: int | None = None, max_new: int = 2, max_wi
         vals: dict[int, int] = {leaf: T.var(k, i) for i, leaf in enumerate(leaves)}
         # window: grow from the leaves through fanouts whose fanins are all inside
         # (candidates are taken smallest first: a heap)
-        cand = sorted({y for leaf in leaves for y in fanouts[leaf]})
-        seen = set(cand)
-        ands = g.ands
-        top = x + max_window
-        while cand and len(vals) < max_window:
-            y = heappop(cand)
-            if y in vals or y > top:
-                continue
-            a, b = ands[y - n - 1]
-            va = vals.get(a >> 1)
-            if va is None:
-                continue
-            vb = vals.get(b >> 1)
-            if vb is None:
-                continue
-            vals[y] = (va ^ full if a & 1 else va) & (vb ^ full if b & 1 else vb)
-            for z in fanouts[y]:
-                if z not in seen:
-                    seen.add(z)
-                    heappush(cand, z)
+        _grow_window(g.ands, n, fanouts, vals, leaves, full, x + max_window, max_window)
         if x not in vals:
             continue
         # exclude the node's fanout cone and its MFFC from the divisors
@@ -650,27 +661,7 @@ def resub_dc(g: AIG, max_leaves: int | None = None, levels: int | None = None,
         for y in roots:
             care |= flip[y] ^ vals[y]
         # more divisors: nodes computable from the leaves, outside x's fanout
-        cand = sorted({z for leaf in lv for z in fanouts[leaf]})
-        seen = set(cand)
-        top = x + max_window
-        while cand and len(vals) < max_window:
-            y = heappop(cand)
-            if y in vals or y > top or changed[y]:
-                continue
-            a, b = ands[y - n - 1]
-            if (a >> 1) in win or (b >> 1) in win:
-                continue
-            va = vals.get(a >> 1)
-            if va is None:
-                continue
-            vb = vals.get(b >> 1)
-            if vb is None:
-                continue
-            vals[y] = (va ^ full if a & 1 else va) & (vb ^ full if b & 1 else vb)
-            for z in fanouts[y]:
-                if z not in seen:
-                    seen.add(z)
-                    heappush(cand, z)
+        _grow_window(ands, n, fanouts, vals, lv, full, x + max_window, max_window, changed, win)
         incone = set(cone)
         divs = [d for d in sorted(vals) if d not in win and d not in incone and not touched[d]
                 and not changed[d] and refs[d] > 0]
