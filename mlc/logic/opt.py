@@ -705,24 +705,36 @@ def _find_resub(f: int, care: int, full: int, divs: list[int], vals: list[int], 
         return 0
     if nf == 0:
         return 1
+    # one pass over the divisors, on the divisor's tables as they are (f and !f lie in
+    # the care set, so f & x == f & (x & care)): a 0-resub answer (the first divisor
+    # that matches), and the divisor literals that contain f (pos, for f = AND) or !f
+    # (neg, for f = OR = !AND(!,!)) with their tables on the care set
+    pos, neg = [], []
+    info = []
     for d in divs:
-        v = vals[d] & care
-        if v == f:
-            return 2 * d
-        if v == nf:
-            return 2 * d + 1
+        x = vals[d]
+        fv = f & x
+        nfv = nf & x
+        if fv == f:
+            if nfv == 0:
+                return 2 * d                   # x == f on the care set
+        elif fv == 0 and nfv == nf:
+            return 2 * d + 1                   # x == !f on the care set
+        info.append((d, x, fv, nfv))
     if max_new < 1:
         return None
-    # divisor literals that contain f (for f = AND) or contain !f (for f = OR = !AND(!,!))
-    pos, neg = [], []
-    for d in divs:
-        v = vals[d]
-        for c in (0, 1):
-            w = (v ^ (full if c else 0)) & care
-            if f & ~w == 0:
-                pos.append((2 * d + c, w))
-            if nf & ~w == 0:
-                neg.append((2 * d + c, w))
+    for d, x, fv, nfv in info:
+        if fv == f or fv == 0 or nfv == nf or nfv == 0:
+            v = x & care
+            nv = v ^ care
+            if fv == f:
+                pos.append((2 * d, v))
+            if nfv == nf:
+                neg.append((2 * d, v))
+            if fv == 0:
+                pos.append((2 * d + 1, nv))
+            if nfv == 0:
+                neg.append((2 * d + 1, nv))
     # 1-resub
     for target, cands, oc in ((f, pos, 0), (nf, neg, 1)):
         L = len(cands)
@@ -735,11 +747,6 @@ def _find_resub(f: int, care: int, full: int, divs: list[int], vals: list[int], 
     if max_new < 2:
         return None
     # 2-resub: f = d1 & (d2 & d3)  (all three in pos), or f = d1 & (d2 | d3)
-    allv = []
-    for d in divs:
-        v = vals[d] & care
-        allv.append((2 * d, v))
-        allv.append((2 * d + 1, (~vals[d]) & care))
     for target, cands, oc in ((f, pos, 0), (nf, neg, 1)):
         L = len(cands)
         if L <= 30:
@@ -749,16 +756,31 @@ def _find_resub(f: int, care: int, full: int, divs: list[int], vals: list[int], 
                 for j in range(i + 1, L):
                     lj, wj = cands[j]
                     e2 = extra & wj
+                    if e2 == 0 and j + 1 < L:     # any third literal will do: the first
+                        return ("and", li, ("and", lj, cands[j + 1][0], 0), oc)
                     for k in range(j + 1, L):
                         lk, wk = cands[k]
                         if e2 & wk == 0:
                             return ("and", li, ("and", lj, lk, 0), oc)
         # d1 & (d2 | d3): d2, d3 avoid what d1 lets through, together cover the target
+        hits = []
+        if L:
+            # the divisor literals that meet the target: a divisor's table meets it
+            # where it has some of the target, its complement where not all of it
+            full_t = f if oc == 0 else nf
+            for d, x, fv, nfv in info:
+                m = fv if oc == 0 else nfv
+                if m or m != full_t:
+                    v = x & care
+                    if m:
+                        hits.append((2 * d, v))
+                    if m != full_t:
+                        hits.append((2 * d + 1, v ^ care))
         for i in range(min(L, or_width)):
             li, wi = cands[-1 - i]
             extra = wi & ~target
-            avoid = [(l, w) for l, w in allv if w & extra == 0 and w & target
-                     and (l >> 1) != (li >> 1)]
+            di = li >> 1
+            avoid = [(l, w) for l, w in hits if w & extra == 0 and (l >> 1) != di]
             if len(avoid) > 60:
                 avoid = avoid[-60:]
             A = len(avoid)
