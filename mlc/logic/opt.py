@@ -434,26 +434,32 @@ def _grow_window(ands, n: int, fanouts, vals: dict[int, int], leaves, full: int,
     the leaves into ``vals``) once both its fanins have tables, smallest node first
     (a heap), up to node ``top`` and ``max_window`` tables in all.  Nodes marked in
     ``changed`` and nodes with a fanin in ``win`` are left out (for resub_dc)."""
-    cand = sorted({y for leaf in leaves for y in fanouts[leaf]})
+    # (nodes come off the heap in increasing order and every push is above the node
+    # being processed, so once a node above ``top`` comes off, none below it remains:
+    # nodes above ``top`` are never pushed)
+    cand = sorted({y for leaf in leaves for y in fanouts[leaf] if y <= top})
     seen = set(cand)
-    while cand and len(vals) < max_window:
+    size = len(vals)
+    get = vals.get
+    while cand and size < max_window:
         y = heappop(cand)
-        if y in vals or y > top:
+        if y in vals:
             continue
         if changed is not None and changed[y]:
             continue
         a, b = ands[y - n - 1]
         if win is not None and ((a >> 1) in win or (b >> 1) in win):
             continue
-        va = vals.get(a >> 1)
+        va = get(a >> 1)
         if va is None:
             continue
-        vb = vals.get(b >> 1)
+        vb = get(b >> 1)
         if vb is None:
             continue
         vals[y] = (va ^ full if a & 1 else va) & (vb ^ full if b & 1 else vb)
+        size += 1
         for z in fanouts[y]:
-            if z not in seen:
+            if z <= top and z not in seen:
                 seen.add(z)
                 heappush(cand, z)
 
@@ -762,33 +768,54 @@ def _find_resub(f: int, care: int, full: int, divs: list[int], vals: list[int], 
                         lk, wk = cands[k]
                         if e2 & wk == 0:
                             return ("and", li, ("and", lj, lk, 0), oc)
-        # d1 & (d2 | d3): d2, d3 avoid what d1 lets through, together cover the target
-        hits = []
-        if L:
-            # the divisor literals that meet the target: a divisor's table meets it
-            # where it has some of the target, its complement where not all of it
-            full_t = f if oc == 0 else nf
-            for d, x, fv, nfv in info:
-                m = fv if oc == 0 else nfv
-                if m or m != full_t:
-                    v = x & care
-                    if m:
-                        hits.append((2 * d, v))
-                    if m != full_t:
-                        hits.append((2 * d + 1, v ^ care))
+        # d1 & (d2 | d3): d2, d3 avoid what d1 lets through, together cover the target.
+        # Candidates d2, d3: the divisor literals that meet the target (a divisor's
+        # table where it has some of the target, its complement where not all of it),
+        # in divisor order, each with how much of the target it covers (two whose
+        # counts add up to less than the target's cannot cover it); a divisor avoids
+        # ``extra`` where x & extra == 0, its complement where x & extra == extra.
+        if not L:
+            continue
+        full_t = f if oc == 0 else nf
+        ct = full_t.bit_count()
+        meet = []
+        for d, x, fv, nfv in info:
+            m = fv if oc == 0 else nfv
+            cm = m.bit_count()
+            meet.append((d, x, m != 0, m != full_t, cm, ct - cm))
+        vcache: dict[int, int] = {}
         for i in range(min(L, or_width)):
             li, wi = cands[-1 - i]
             extra = wi & ~target
             di = li >> 1
-            avoid = [(l, w) for l, w in hits if w & extra == 0 and (l >> 1) != di]
+            avoid = []
+            for d, x, p_ok, n_ok, cp, cn in meet:
+                if d == di:
+                    continue
+                xe = x & extra
+                if p_ok and xe == 0:
+                    v = vcache.get(d)
+                    if v is None:
+                        v = vcache[d] = x & care
+                    avoid.append((2 * d, v, cp))
+                if n_ok and xe == extra:
+                    v = vcache.get(d)
+                    if v is None:
+                        v = vcache[d] = x & care
+                    avoid.append((2 * d + 1, v ^ care, cn))
             if len(avoid) > 60:
                 avoid = avoid[-60:]
             A = len(avoid)
             for j in range(A):
-                lj, wj = avoid[j]
-                rest = target & ~wj
+                lj, wj, cj = avoid[j]
+                need = ct - cj
+                rest = None
                 for k in range(j + 1, A):
-                    lk, wk = avoid[k]
+                    lk, wk, ck = avoid[k]
+                    if ck < need:
+                        continue
+                    if rest is None:
+                        rest = target & ~wj
                     if rest & ~wk == 0 and (lk >> 1) != (lj >> 1):
                         return ("and", li, ("and", lj ^ 1, lk ^ 1, 1), oc)
     return None
@@ -1018,18 +1045,18 @@ def reconv_cut(g: AIG, x: int, max_leaves: int) -> list[int]:
 def _expand_cut(ands, n: int, leaves: set[int], inside: set[int], max_leaves: int) -> None:
     """Grow a cut in place: move into ``inside`` the leaf whose fanins add fewest new
     leaves (the larger node on a tie) while the cut stays within ``max_leaves``."""
+    both = leaves | inside           # = leaves | inside | {0} throughout
+    both.add(0)
     while True:
-        best, bcost = None, None
+        best, bcost = -1, 3
         for y in leaves:
             if y <= n:
                 continue
             fa, fb = ands[y - n - 1]
-            za, zb = fa >> 1, fb >> 1
-            c = ((za != 0 and za not in leaves and za not in inside)
-                 + (zb != 0 and zb not in leaves and zb not in inside) - 1)
-            if bcost is None or c < bcost or (c == bcost and y > best):
+            c = ((fa >> 1) not in both) + ((fb >> 1) not in both)
+            if c < bcost or (c == bcost and y > best):
                 best, bcost = y, c
-        if best is None or len(leaves) + bcost > max_leaves:
+        if best < 0 or len(leaves) + bcost - 1 > max_leaves:
             break
         leaves.discard(best)
         inside.add(best)
@@ -1037,6 +1064,7 @@ def _expand_cut(ands, n: int, leaves: set[int], inside: set[int], max_leaves: in
         for z in (fa >> 1, fb >> 1):
             if z and z not in inside:
                 leaves.add(z)
+                both.add(z)
 
 
 def cone_table(g: AIG, node: int, leaves: list[int], k: int | None = None) -> int:
