@@ -778,31 +778,27 @@ def _find_resub(f: int, care: int, full: int, divs: list[int], vals: list[int], 
             continue
         full_t = f if oc == 0 else nf
         ct = full_t.bit_count()
-        meet = []
-        for d, x, fv, nfv in info:
-            m = fv if oc == 0 else nfv
-            cm = m.bit_count()
-            meet.append((d, x, m != 0, m != full_t, cm, ct - cm))
-        vcache: dict[int, int] = {}
+        meet = [(d, x, fv if oc == 0 else nfv) for d, x, fv, nfv in info]
+        vcache: dict[int, tuple[int, int]] = {}     # d -> (x & care, |m|)
         for i in range(min(L, or_width)):
             li, wi = cands[-1 - i]
             extra = wi & ~target
             di = li >> 1
             avoid = []
-            for d, x, p_ok, n_ok, cp, cn in meet:
+            for d, x, m in meet:
                 if d == di:
                     continue
                 xe = x & extra
-                if p_ok and xe == 0:
-                    v = vcache.get(d)
-                    if v is None:
-                        v = vcache[d] = x & care
-                    avoid.append((2 * d, v, cp))
-                if n_ok and xe == extra:
-                    v = vcache.get(d)
-                    if v is None:
-                        v = vcache[d] = x & care
-                    avoid.append((2 * d + 1, v ^ care, cn))
+                if m and xe == 0:
+                    vc = vcache.get(d)
+                    if vc is None:
+                        vc = vcache[d] = (x & care, m.bit_count())
+                    avoid.append((2 * d, vc[0], vc[1]))
+                if m != full_t and xe == extra:
+                    vc = vcache.get(d)
+                    if vc is None:
+                        vc = vcache[d] = (x & care, m.bit_count())
+                    avoid.append((2 * d + 1, vc[0] ^ care, ct - vc[1]))
             if len(avoid) > 60:
                 avoid = avoid[-60:]
             A = len(avoid)
