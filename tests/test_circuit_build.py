@@ -196,3 +196,26 @@ def test_five_way_branch_pages_clear_each_other():
     rep = clearance(sc)
     print("smallest clearance", rep.min_clearance, rep.pair)
     assert rep.min_clearance > 0.0, rep.pair
+
+
+def test_rip_up_reroutes_a_chain_and_the_one_it_presses_into(monkeypatch):
+    """Routed with wires g1 and g2 first, the full adder's chain w_g3_1 comes 0.99 sigma
+    from w_g3_0, routed before it, which could not make room (layer centres; 1.8 keeps
+    them apart by the sphere bound).  The rip-up routes w_g3_0 again around it, then
+    w_g3_1, and keeps the two new routes only if they are farther apart."""
+    from mlc.circuit import build as B
+    spec = load("examples/full_adder.tt", None)
+    c = compile_spec(spec)
+    opt = B.CircuitOptions()
+    monkeypatch.setattr(B, "RIP_GAP", 0.0)              # no rip-up
+    plain = B._build_circuit(c.netlist, spec, opt, first_wires=("g1", "g2"))
+    monkeypatch.undo()
+    ripped = B._build_circuit(c.netlist, spec, opt, first_wires=("g1", "g2"))
+    assert plain.closest < B.RIP_GAP and "rerouted" not in plain.scene.meta["connector"]
+    assert ripped.scene.meta["connector"]["rerouted"], "no chain was routed again"
+    assert ripped.closest > plain.closest, (plain.closest, ripped.closest)
+    ripped.scene.check()
+    # the untouched chains are the same, body for body
+    moved = {t for pair in ripped.scene.meta["connector"]["rerouted"] for t in pair}
+    keep = lambda sc: {b.name: tuple(b.position) for b in sc.bodies if not any(b.name.startswith(t + "_") for t in moved)}
+    assert keep(plain.scene) == keep(ripped.scene)

@@ -59,4 +59,11 @@ def test_space_nearest_matches_brute_force():
     # the grid looks one cell (1.8) around: it is exact whenever the answer is below that
     assert brute < 1.8 and abs(got - brute) < 1e-12
     assert sp.nearest(np.array([[100.0, 100, 100]]), 0) == np.inf
+    # the owner of that nearest layer, and forgetting an owner
+    d, who = sp.nearest_owner(q, 2)
+    brute_who = min(((np.linalg.norm(p - x), o) for x in q for p, o in placed if o != 2), key=lambda t: t[0])[1]
+    assert d == got and who == brute_who
+    sp.remove(who)
+    assert all(o != who for cell in sp.grid.values() for _, o in cell)
+    assert sp.nearest(q, 2) > got and len(sp.points(2)) == 30 * 3
     assert np.allclose(layer_centres([[0, 0, 0], [0, 0, 1], [0, 0, 3]]), [[0, 0, 0.5], [0, 0, 2]])

@@ -57,6 +57,9 @@ WAYPOINT_STEP = 2.0         # sigma between the lane points a chain is pulled to
 WAYPOINT_WEIGHT = 1.0       # their weight in the inverse kinematics
 END_JUNCTIONS, END_BEND = 4, 0.2   # the 4 junctions at either end bend at most 0.2 of the largest (lever travel)
 LANE_EXTRAS = (0, 4, 8)     # chain lengths (half units beyond the steered guess) tried in a plane before the next
+RIP_GAP = 1.2               # sigma: a chain this much closer to another is routed again with it (_rip_up);
+                            # measured: chains 1.29 sigma apart and more were clear in every row of every
+                            # example, one 0.93 apart (3-bit adder) overlapped by 0.23 sigma
 BRANCH_LAYERS = 3           # layers of a chain next to its branch page, left out of the keep-apart test
 LAYER_RADIUS = 0.9          # sigma: bounds a half unit's layer with its posts (reach 0.75, half pitch 0.5)
 GATE_POINT_STEP = 0.25      # sigma between the points that stand for a gate's slab (along its length)
@@ -241,10 +244,9 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     """One build; ``first_wires`` (wire names: a gate id or a circuit input) are routed first."""
     import time
 
-    from mlc.circuit.lanes import Lane, Lanes, Space, layer_centres, plane_y, rounded
     from scipy.spatial import cKDTree
 
-    from mlc.circuit.route import _fk, solve_route
+    from mlc.circuit.lanes import Lane, Lanes, Space
 
     opt = options or CircuitOptions()
     t_start = time.perf_counter()
@@ -380,6 +382,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     space_clear = 2.0 * LAYER_RADIUS
     gate_pts = [(_slab_points(bs), owners) for bs, owners in gate_owned]
     tight: list = []                        # chains that could not be kept apart by the lanes
+    routed: dict[str, _Chain] = {}         # chain tag -> its route and what assembling it needs
+    deferred: list = []                     # pages and stubs (Parts) and chain tags, in routing order
     depth_of = {g.id: g.depth for g in netlist.gates}
     if direct:                                  # the direct nets need no chain
         consumers = {w: c for w, c in consumers_all.items()
@@ -434,7 +438,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                 parts, pin, pout = half_unit_parts(f"w_{wname}_p{k}", tap.centre, tap.axis, t, state_at_tap, geo,
                                                    in_post=post, in_stop=page_stop)
                 parts.bonds += join(f"w_{wname}_p{k}_j", tap, pin, geo.k)
-                add(parts)
+                deferred.append(parts)
                 n_half += 1
                 starts.append((pout, pol ^ 1, True, t, None))
         for k, (c, (start, spol, free, t0, _)) in enumerate(zip(cons, starts)):
@@ -453,7 +457,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                     elif start is tap and wire[0] == "gate":       # on a lever: the tap stop
                         parts.bonds += _tap_stop(f"{tag}_stub_s", by_name[tap.lo.split(".")[0]], tap.lo.split(".")[1],
                                                  t_up, t0, f"{tag}_stub", geo.k)
-                    add(parts)
+                    deferred.append(parts)
                     n_half += 1
                     end = pout
                 probes.append(Probe(c[1], c[1], end.lo, end.hi, geo.L0, geo.L1))
@@ -479,9 +483,6 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             lane = Lane(x_rise, start.centre[2] + 3.0, z_run, x_in, z_in, x_end, zp - 6.0)
             sbm = (END_BEND * max_bend(geo) if len(starts) > 1 else TAP_TURN if wire[0] == "gate"
                    else SOURCE_TURN * max_bend(geo))
-            plane = lanes.assign(lane)
-            route = None
-            best = (-math.inf, None, plane, ())
             # a branch's chains leave their pages side by side: their first layers are the branch's
             skip = BRANCH_LAYERS if start is not tap else 0
             # the gates this chain may touch: its driver's and its sink's (with their direct units)
@@ -492,84 +493,59 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             route_kw = dict(tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
                             start_bend_max=sbm, extras=LANE_EXTRAS, bend_max=LANE_BEND * max_bend(geo),
                             end_bends=(END_JUNCTIONS, END_BEND * max_bend(geo)), wp_weight=WAYPOINT_WEIGHT)
-
-            def gap_of(r):
-                """Distance of the route's layers to other chains' layers; a gate's points
-                count as a layer nearer by the difference of the two clearances."""
-                cs, _, _ = _fk(r.centre, r.axis, r.tangent, r.bends,
-                               [geo.pitch] * (len(r.bends) - 1) + [geo.pitch + ext])
-                m = layer_centres(cs)[skip:]
-                g = space.nearest(m, tag)
-                if others_tree is not None and len(m):
-                    g = min(g, float(others_tree.query(m)[0].min()) + space_clear - GATE_CLEAR)
-                return g
-
-            for attempt in range(PLANE_TRIES):
-                y_k = plane_y(plane)
-                corners = [(x_rise, y_k, lane.z_a), (x_rise, y_k, z_run), (x_in, y_k, z_run),
-                           (x_in, y_k, lane.z_in), (x_end, yp - 1.0, zp - 6.0)]
-                wps = [tuple(p) for p in rounded(corners, TURN_RADIUS, WAYPOINT_STEP)]
-                r = solve_route(start.centre, start.axis, target.centre, target.axis, geo, spol, waypoints=wps,
-                                **route_kw)
-                if r is not None:
-                    gap_ = gap_of(r)
-                    if gap_ > best[0]:
-                        best = (gap_, r, plane, wps)
-                    if gap_ >= space_clear:
-                        break
-                plane = lanes.assign(lane, plane + 1)
-            gap_, route, plane, wps = best
-            if route is not None and gap_ < space_clear:
-                # no plane keeps it apart: the best plane's route again, pushed away from the
-                # layers of the chains placed so far and from the other gates' slabs
-                avoid = ((space.points(tag), space_clear), (others, GATE_CLEAR))
-                r = solve_route(start.centre, start.axis, target.centre, target.axis, geo, spol, waypoints=wps,
-                                avoid=avoid, avoid_from=skip, **route_kw)
-                if r is not None and gap_of(r) > gap_:
-                    gap_, route = gap_of(r), r
-            if route is None:        # the lanes are a preference: route straight if they cannot be kept
-                route = solve_route(start.centre, start.axis, target.centre, target.axis, geo, spol,
-                                    tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
-                                    start_bend_max=sbm)
-            if route is None:
+            ch = _Chain(tag, lane, yp, (start.centre, start.axis, target.centre, target.axis, geo, spol), route_kw,
+                        dict(tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
+                             start_bend_max=sbm),
+                        skip, others, _gap_fn(space, tag, skip, others_tree, geo, ext, space_clear), (geo, ext),
+                        (wire, start, tap, spol, sstate, stop_at_tap, t_up, target, ext))
+            _route_chain(ch, lanes, space, space_clear)
+            if ch.route is None:
                 raise MlcError(f"cannot route wire {wname} to {gid}.{pin_name}: no connector chain reaches it",
                                netlist.source, "this is a placement limit of mlc; please report the netlist")
-            lanes.take(lane, plane)
-            cs, _, _ = _fk(route.centre, route.axis, route.tangent, route.bends,
-                           [geo.pitch] * (len(route.bends) - 1) + [geo.pitch + ext])
-            space.add(layer_centres(cs), tag)
-            if gap_ < space_clear:
-                tight.append((tag, round(float(gap_), 3)))
-            parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, sstate, geo,
-                                       in_stop=stop_at_tap if start is tap else POST_WIDTH, stops=True)
-            # the last half unit's output post is longer so its layer clears the lever plane:
-            last = len(route.bends) - 1
-            for b in list(parts.bodies):
-                if b.name.startswith(f"{tag}_{last}_"):
-                    parts.bodies.remove(b)
-            parts.bonds = [bd for bd in parts.bonds if not bd.name.startswith(f"{tag}_{last}_")]
-            cs_in = pairs[-2]
-            t_last = (pairs[-1].centre - cs_in.centre) / np.linalg.norm(pairs[-1].centre - cs_in.centre)
-            lp, lin, lout = half_unit_parts(f"{tag}_{last}", cs_in.centre, cs_in.axis, t_last,
-                                            sstate ^ (last % 2), geo, out_post=0.5 * geo.gap + ext,
-                                            out_stop=LEVER_STOP)
-            parts.add(lp)
-            parts.bonds += join(f"{tag}_j0", start, pairs[0], geo.k)
-            if start is not tap and half_unit_prefix(start):     # the junction after a branch page
-                parts.bonds += junction_stops(f"{tag}_s0", half_unit_prefix(start), f"{tag}_0", geo, geo.k)
-            if start is tap and wire[0] != "gate" and half_unit_prefix(start):   # on a source half unit
-                parts.bonds += junction_stops(f"{tag}_s0", half_unit_prefix(start), f"{tag}_0", geo, geo.k)
-            if start is tap and wire[0] == "gate":            # the chain hangs on the lever: its stop
-                parts.bonds += _tap_stop(f"{tag}_s0", by_name[tap.lo.split(".")[0]], tap.lo.split(".")[1],
-                                         t_up, pairs[1].centre - pairs[0].centre, f"{tag}_0", geo.k)
-            add(parts)
-            n_chains += 1
-            n_half += len(route.bends)
-            same = float(lout.axis @ target.axis) > 0
-            ends = (lout.lo, lout.hi) if same else (lout.hi, lout.lo)
-            bonds.append(Bond(f"{tag}_end_lo", ends[0], target.lo, geo.k, 0.0, 0.0, "universal", f"{tag}_end_lo"))
-            bonds.append(Bond(f"{tag}_end_hi", ends[1], target.hi, geo.k, 0.0, 0.0, "universal", f"{tag}_end_hi"))
+            routed[tag] = ch
+            deferred.append(tag)
+    t_rip = time.perf_counter()
+    rip_ups = _rip_up(routed, lanes, space, space_clear)
     t_done = time.perf_counter()
+    # ---- assembly, in routing order (pages and stubs where they were made) --------------
+    for item in deferred:
+        if isinstance(item, Parts):
+            add(item)
+            continue
+        tag, ch = item, routed[item]
+        if ch.gap < space_clear:
+            tight.append((tag, round(float(ch.gap), 3)))
+        wire, start, tap, spol, sstate, stop_at_tap, t_up, target, ext = ch.ctx
+        route = ch.route
+        parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, sstate, geo,
+                                   in_stop=stop_at_tap if start is tap else POST_WIDTH, stops=True)
+        # the last half unit's output post is longer so its layer clears the lever plane:
+        last = len(route.bends) - 1
+        for b in list(parts.bodies):
+            if b.name.startswith(f"{tag}_{last}_"):
+                parts.bodies.remove(b)
+        parts.bonds = [bd for bd in parts.bonds if not bd.name.startswith(f"{tag}_{last}_")]
+        cs_in = pairs[-2]
+        t_last = (pairs[-1].centre - cs_in.centre) / np.linalg.norm(pairs[-1].centre - cs_in.centre)
+        lp, lin, lout = half_unit_parts(f"{tag}_{last}", cs_in.centre, cs_in.axis, t_last,
+                                        sstate ^ (last % 2), geo, out_post=0.5 * geo.gap + ext,
+                                        out_stop=LEVER_STOP)
+        parts.add(lp)
+        parts.bonds += join(f"{tag}_j0", start, pairs[0], geo.k)
+        if start is not tap and half_unit_prefix(start):     # the junction after a branch page
+            parts.bonds += junction_stops(f"{tag}_s0", half_unit_prefix(start), f"{tag}_0", geo, geo.k)
+        if start is tap and wire[0] != "gate" and half_unit_prefix(start):   # on a source half unit
+            parts.bonds += junction_stops(f"{tag}_s0", half_unit_prefix(start), f"{tag}_0", geo, geo.k)
+        if start is tap and wire[0] == "gate":            # the chain hangs on the lever: its stop
+            parts.bonds += _tap_stop(f"{tag}_s0", by_name[tap.lo.split(".")[0]], tap.lo.split(".")[1],
+                                     t_up, pairs[1].centre - pairs[0].centre, f"{tag}_0", geo.k)
+        add(parts)
+        n_chains += 1
+        n_half += len(route.bends)
+        same = float(lout.axis @ target.axis) > 0
+        ends = (lout.lo, lout.hi) if same else (lout.hi, lout.lo)
+        bonds.append(Bond(f"{tag}_end_lo", ends[0], target.lo, geo.k, 0.0, 0.0, "universal", f"{tag}_end_lo"))
+        bonds.append(Bond(f"{tag}_end_hi", ends[1], target.hi, geo.k, 0.0, 0.0, "universal", f"{tag}_end_hi"))
 
     # ---- constant outputs ------------------------------------------------------------
     for i, o in enumerate(netlist.outputs):
@@ -594,13 +570,148 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                         "connector": {"gap": geo.gap, "side": round(geo.side, 6), "joint_k": geo.k, "chains": n_chains,
                                       "half_units": n_half, "planes": 1 + max((k for k, _ in lanes.placed), default=-1),
                                       "tight_chains": [t for t, _ in tight]}})
+    if rip_ups:
+        scene.meta["connector"]["rerouted"] = [list(p) for p in rip_ups]
     if opt.direct:
         scene.meta["connector"]["direct"] = [[d, s, p] for s, (d, p) in direct.items()]
     scene.check()
     t_end = time.perf_counter()
     return Circuit(scene, origin, n_chains, n_half,
-                   {"place": t_route - t_start, "route": t_done - t_route, "assemble": t_end - t_done},
+                   {"place": t_route - t_start, "route": t_rip - t_route, "rip_up": t_done - t_rip,
+                    "assemble": t_end - t_done},
                    min((g for _, g in tight), default=float("inf")))
+
+
+@dataclass
+class _Chain:
+    """One chain to route (sigma): its lane, the y of its sink's pin (``yp``), the
+    positional arguments of ``solve_route`` (``solve``) and its keywords in a lane
+    (``kw``) and straight (``straight_kw``: when no lane closes), the layers left out of
+    the keep-apart test at its start (``skip``), the other gates' points it keeps from,
+    its keep-apart distance function (``_gap_fn``), ``(geo, ext)`` for its layers, what
+    assembling it needs (``ctx``); then its route, distance and plane."""
+
+    tag: str
+    lane: object
+    yp: float
+    solve: tuple
+    kw: dict
+    straight_kw: dict
+    skip: int
+    others: np.ndarray
+    gap_of: object
+    geo_ext: tuple
+    ctx: tuple
+    route: object = None
+    gap: float = -math.inf
+    plane: int = 0
+
+
+def _layers(route, geo, ext: float) -> np.ndarray:
+    """Layer centres of a routed chain whose last half unit's post is ``ext`` longer (sigma)."""
+    from mlc.circuit.lanes import layer_centres
+    from mlc.circuit.route import _fk
+    cs, _, _ = _fk(route.centre, route.axis, route.tangent, route.bends,
+                   [geo.pitch] * (len(route.bends) - 1) + [geo.pitch + ext])
+    return layer_centres(cs)
+
+
+def _gap_fn(space, tag: str, skip: int, others_tree, geo, ext: float, space_clear: float):
+    """The keep-apart distance of a route of chain ``tag``: the smallest distance of its
+    layers (from the ``skip``-th on) to the layers of the other chains in ``space``; a
+    gate's points count as a layer nearer by the difference of the two clearances (sigma)."""
+    def gap_of(r) -> float:
+        m = _layers(r, geo, ext)[skip:]
+        g = space.nearest(m, tag)
+        if others_tree is not None and len(m):
+            g = min(g, float(others_tree.query(m)[0].min()) + space_clear - GATE_CLEAR)
+        return g
+    return gap_of
+
+
+def _route_chain(ch: _Chain, lanes, space, space_clear: float) -> None:
+    """Route ``ch`` and place it (``lanes``, ``space``): in up to PLANE_TRIES planes from
+    the first its lane fits, pulled towards the lane's rounded corners, keeping the route
+    farthest from the placed chains and gates (the first that keeps ``space_clear``); if
+    none keeps it, that plane's route again pushed away from them (kept if farther); if no
+    lane closes, a straight route.  ``ch.route`` stays None if nothing closes."""
+    from mlc.circuit.lanes import plane_y, rounded
+    from mlc.circuit.route import solve_route
+    lane = ch.lane
+    plane = lanes.assign(lane)
+    best = (-math.inf, None, plane, ())
+    for _ in range(PLANE_TRIES):
+        y_k = plane_y(plane)
+        corners = [(lane.x_r, y_k, lane.z_a), (lane.x_r, y_k, lane.z_run), (lane.x_in, y_k, lane.z_run),
+                   (lane.x_in, y_k, lane.z_in), (lane.x_end, ch.yp - 1.0, lane.z_end)]
+        wps = [tuple(p) for p in rounded(corners, TURN_RADIUS, WAYPOINT_STEP)]
+        r = solve_route(*ch.solve, waypoints=wps, **ch.kw)
+        if r is not None:
+            g = ch.gap_of(r)
+            if g > best[0]:
+                best = (g, r, plane, wps)
+            if g >= space_clear:
+                break
+        plane = lanes.assign(lane, plane + 1)
+    gap, route, plane, wps = best
+    if route is not None and gap < space_clear:
+        # no plane keeps it apart: the best plane's route again, pushed away from the
+        # layers of the chains placed so far and from the other gates' slabs
+        avoid = ((space.points(ch.tag), space_clear), (ch.others, GATE_CLEAR))
+        r = solve_route(*ch.solve, waypoints=wps, avoid=avoid, avoid_from=ch.skip, **ch.kw)
+        g = ch.gap_of(r) if r is not None else -math.inf
+        if g > gap:
+            gap, route = g, r
+    if route is None:        # the lanes are a preference: route straight if they cannot be kept
+        route = solve_route(*ch.solve, **ch.straight_kw)
+        gap = ch.gap_of(route) if route is not None else -math.inf
+    ch.route, ch.gap, ch.plane = route, gap, plane
+    if route is not None:
+        lanes.take(lane, plane)
+        space.add(_layers(route, *ch.geo_ext), ch.tag)
+
+
+def _unplace(ch: _Chain, lanes, space) -> None:
+    """Take ``ch``'s lane and layers out of ``lanes`` and ``space``."""
+    space.remove(ch.tag)
+    lanes.placed = [(k, ln) for k, ln in lanes.placed if ln is not ch.lane]
+
+
+def _rip_up(routed: dict, lanes, space, space_clear: float) -> list:
+    """Chains routed early cannot make room for later ones.  For each chain left closer
+    than ``RIP_GAP`` to another (closest first), the chain it comes closest to is
+    taken out and routed again (``_route_chain``: every plane, all other chains now in
+    place), then the chain itself; the two new routes are kept if the smaller of the two
+    chains' distances (each to every chain now placed) grew, else the old ones are put
+    back.  Returns the (chain, other chain) pairs re-routed; updates ``routed``, ``lanes``
+    and ``space``."""
+    done = []
+    for tag in sorted((t for t, ch in routed.items() if ch.gap < RIP_GAP), key=lambda t: routed[t].gap):
+        ch = routed[tag]
+        ch.gap = ch.gap_of(ch.route)             # other chains may have moved since
+        if ch.gap >= RIP_GAP:
+            continue
+        _, owner = space.nearest_owner(_layers(ch.route, *ch.geo_ext)[ch.skip:], tag)
+        if owner not in routed:              # a gate's points are nearest: nothing to move
+            continue
+        pair = [routed[owner], ch]
+        old = [(c.route, c.gap_of(c.route), c.plane) for c in pair]
+        for c in pair:                       # the other chain first, around this one as it is
+            _unplace(c, lanes, space)
+            _route_chain(c, lanes, space, space_clear)
+            if c.route is None:
+                break
+        if all(c.route is not None for c in pair) and min(c.gap_of(c.route) for c in pair) > min(o[1] for o in old):
+            for c in pair:
+                c.gap = c.gap_of(c.route)
+            done.append((tag, owner))
+            continue
+        for c, (route, gap, plane) in zip(pair, old):          # put the old routes back
+            _unplace(c, lanes, space)
+            c.route, c.gap, c.plane = route, gap, plane
+            lanes.take(c.lane, plane)
+            space.add(_layers(route, *c.geo_ext), c.tag)
+    return done
 
 
 def _slab_points(bodies: list[Body]) -> np.ndarray:

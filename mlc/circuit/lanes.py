@@ -139,7 +139,11 @@ class Space:
     def nearest(self, pts: np.ndarray, owner) -> float:
         """Smallest centre distance from ``pts`` to layers of other owners (inf if none
         within one cell)."""
-        best = math.inf
+        return self.nearest_owner(pts, owner)[0]
+
+    def nearest_owner(self, pts: np.ndarray, owner) -> tuple[float, object]:
+        """:meth:`nearest` and the owner of that layer (None if none within one cell)."""
+        best, who = math.inf, None
         for p in pts:
             i, j, k = self._keys(p)
             for di in (-1, 0, 1):
@@ -149,8 +153,8 @@ class Space:
                             if o != owner:
                                 d = float(np.linalg.norm(q - p))
                                 if d < best:
-                                    best = d
-        return best
+                                    best, who = d, o
+        return best, who
 
     def points(self, owner) -> np.ndarray:
         """Every layer centre of the other owners, (m, 3)."""
@@ -160,6 +164,15 @@ class Space:
     def add(self, pts: np.ndarray, owner) -> None:
         for p in pts:
             self.grid.setdefault(self._keys(p), []).append((np.asarray(p, float), owner))
+
+    def remove(self, owner) -> None:
+        """Forget every layer of ``owner``."""
+        for key, cell in list(self.grid.items()):
+            kept = [(q, o) for q, o in cell if o != owner]
+            if kept:
+                self.grid[key] = kept
+            else:
+                del self.grid[key]
 
 
 def rounded(points, radius: float, step: float) -> np.ndarray:
