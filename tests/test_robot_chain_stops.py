@@ -57,3 +57,22 @@ def test_chain_stops_one_per_junction_free_as_built(circuit, monkeypatch, stops)
         assert d["chain"]["contour"] == pytest.approx(contour, abs=2e-3)
         assert d["chain"]["reach_fraction"] == pytest.approx(d["chain"]["reach_max"] / contour, abs=2e-3)
         assert 0 < d["chain"]["reach_fraction"] < 1.0
+
+
+def test_avoid_chains_falls_back_to_the_plain_route(circuit, monkeypatch):
+    """AVOID_CHAINS (docs/robot.md 2.6): a chain after the first is routed kept apart from the
+    chains before it and records that; when no kept-apart route is found (or none is clear of
+    the others and of itself) the chain is the plain build's, body for body."""
+    import mlc.circuit.route as route
+    monkeypatch.setattr(rb, "AVOID_CHAINS", 1.5)
+    kept = _build(circuit, monkeypatch, True)
+    avoid = [d["chain"]["avoid"] for d in kept.meta["robot"]["dofs"] if "chain" in d]
+    assert avoid[0] == 0.0 and all(a == 1.5 for a in avoid[1:]) and len(avoid) >= 2
+    plain_solve = route.solve_route
+    monkeypatch.setattr(route, "solve_route", lambda *a, **k: None if "avoid" in k else plain_solve(*a, **k))
+    fell = _build(circuit, monkeypatch, True)
+    assert all(d["chain"]["avoid"] == 0.0 for d in fell.meta["robot"]["dofs"] if "chain" in d)
+    monkeypatch.setattr(rb, "AVOID_CHAINS", 0.0)
+    plain = _build(circuit, monkeypatch, True)
+    assert [b.name for b in fell.bodies] == [b.name for b in plain.bodies]
+    assert np.allclose([b.position for b in fell.bodies], [b.position for b in plain.bodies])

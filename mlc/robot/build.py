@@ -48,6 +48,13 @@ junction gets one too when it hangs on a half unit, or a tap stop (:func:`_lever
 when it hangs on a gate's output lever.  ``SLACK_FRACTION`` > 0 lengthens the chains so
 that none spans more than that fraction of its length in any row (section 2.4; off).
 
+**Chains kept apart** (docs/robot.md section 2.6; ``AVOID_CHAINS`` = 1.5 sigma, on since
+session 11).  Every chain after the first is routed with the router's ``avoid`` term, at least
+``AVOID_CHAINS`` from the body centres of the chains placed before; if no start gives a
+kept-apart route whose slabs are clear of the bodies near it and of itself
+(:func:`_chain_overlap`), the chain is routed as without it (``meta.robot.dofs[].chain.avoid``
+records which).
+
 **Stiffness.**  The coupling chains are connector chains like the circuit's: every bond
 of theirs (half-unit hinges, joins, the universal joints on the lever sites, junction and
 tap stops) gets the circuit's joint stiffness (``mlc compile --joint-k K``, recorded in the
@@ -95,7 +102,9 @@ SLACK_FRACTION = 0.0               # >0: a chain spans at most this fraction of 
 WRIST = True                       # each chain ends on a wrist of WRIST_UNITS long-post half units (docs/robot.md 2.2)
 WRIST_UNITS = 3
 WRIST_POST = 1.5                   # sigma: the wrist half units' input posts (the junction gap grows to WRIST_POST + gap/2)
-AVOID_CHAINS = 0.0                 # sigma, >0: routes pushed this far from the chains placed before (probe, off: docs/robot.md 2.6)
+WRIST_POSTS: dict = {}             # DOF name -> its own wrist posts (sigma), e.g. {"u4_up": 1.0} (probe)
+AVOID_CHAINS = 1.5                 # sigma, >0: routes pushed this far from the chains placed before, a start whose route
+                                   # is not clear (of the others or of itself) falling back to the plain route (docs/robot.md 2.6)
 CHAIN_STOPS = True                 # junction stops in the coupling chains (session 10, with the wrist; without
                                    # the wrist static row 11 of the Tetris robot folds wrong: docs/robot.md 2.2, 2.4, 6)
 
@@ -265,21 +274,23 @@ def _join_aligned(name: str, a: Pair, b: Pair, k: float) -> list[Bond]:
             Bond(f"{name}_hi", a.hi, b.lo, k, 0.0, 0.0, "universal", f"{name}_hi")]
 
 
-def _wrist(tag: str, tc, tax, state: int, geo):
+def _wrist(tag: str, tc, tax, state: int, geo, post: float | None = None):
     """WRIST_UNITS straight half units with long input posts, going up (+z) and ending on the
     lever pair (centre ``tc``, axis ``tax``): each of their junctions can bend far further than
     a chain's (gap WRIST_POST + gap/2 instead of gap), so together they can take the lever's
-    turn about z.  ``state``: the signal state at the wrist's input.  Returns (parts, pin, pout)."""
+    turn about z.  ``state``: the signal state at the wrist's input; ``post``: the input posts
+    (sigma; WRIST_POST when None).  Returns (parts, pin, pout)."""
     from mlc.gates.connector import Parts
     ez = np.array([0.0, 0.0, 1.0])
-    pitch = WRIST_POST + geo.width + 0.5 * geo.gap
+    post = WRIST_POST if post is None else post
+    pitch = post + geo.width + 0.5 * geo.gap
     u = np.asarray(tax, float) / np.linalg.norm(tax)
     for _ in range(WRIST_UNITS):                       # back down: u_out = ez x u_in, so u_in = -ez x u_out
         u = -np.cross(ez, u)
     c = np.asarray(tc, float) - WRIST_UNITS * pitch * ez
     parts, pin, prev = Parts(), None, None
     for i in range(WRIST_UNITS):
-        p, pi_, po = half_unit_parts(f"{tag}_w{i}", c, u, ez, (state + i) % 2, geo, in_post=WRIST_POST)
+        p, pi_, po = half_unit_parts(f"{tag}_w{i}", c, u, ez, (state + i) % 2, geo, in_post=post)
         parts.add(p)
         if prev is None:
             pin = pi_
@@ -531,7 +542,10 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
         stop_first = not on_lever and not shared
         sbm = BEND_FRACTION * max_bend(geo) if stop_first else math.radians(50.0)
         fans = PAGE_FANS if shared else ((0.0,) if stop_first else FAN_ANGLES)
-        for fan in fans:
+        # AVOID_CHAINS (docs/robot.md 2.6): first every start with the route pushed from the chains placed
+        # before; only if none of those is clear (of the others and of itself), the plain routes as without it
+        avoids = ((AVOID_CHAINS, 0.0) if AVOID_CHAINS > 0 and parts_bodies else (0.0,))
+        for fan, avoid in ((f, av) for av in avoids for f in fans):
             from mlc.geometry.rotation import expmap
             tv = expmap(start.axis * math.radians(fan)) @ t0v
             pg = None
@@ -545,10 +559,10 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
                 c_start, parity, cstate, free, sb = start, 0, sstate, fan == 0, sbm
             rc, rax = tc, tax
             if WRIST:                                 # the chain ends on a wrist under the lever sites
-                _, wpin0, _ = _wrist(tag, tc, tax, 0, geo)
+                _, wpin0, _ = _wrist(tag, tc, tax, 0, geo, WRIST_POSTS.get(name))
                 rc, rax, parity = wpin0.centre, wpin0.axis, (parity + WRIST_UNITS) % 2
-            avoid_kw = ({"avoid": (([b.position for b in parts_bodies], AVOID_CHAINS),), "avoid_from": 2}
-                        if AVOID_CHAINS > 0 and parts_bodies else {})
+            avoid_kw = ({"avoid": (([b.position for b in parts_bodies], avoid),), "avoid_from": 2}
+                        if avoid > 0 else {})
             for wp in (wps, []):
                 route = solve_route(c_start.centre, c_start.axis, rc, rax, geo, parity, waypoints=wp, tangent=tv,
                                     free_start=free, approach=ez, min_half=min_half + parity, start_bend_max=sb,
@@ -564,7 +578,8 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
                 parts.bodies = pg.bodies + parts.bodies
                 parts.bonds = pg.bonds + parts.bonds
             if WRIST:
-                wparts, wpin, wout = _wrist(tag, tc, tax, (cstate + len(route.bends)) % 2, geo)
+                wparts, wpin, wout = _wrist(tag, tc, tax, (cstate + len(route.bends)) % 2, geo,
+                                             WRIST_POSTS.get(name))
                 parts.bodies += wparts.bodies
                 parts.bonds += wparts.bonds + _join_aligned(f"{tag}_wj0", pairs[-1], wpin, geo.k)
                 pairs = pairs + [wout]
@@ -579,16 +594,16 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
             depth = _chain_overlap(list(by_body.values()) + bodies + parts_bodies,
                                    list(circuit.bonds) + bonds + parts_bonds, parts, first + ends)
             if depth <= 0.0:
-                found = (route, parts, pairs, c_start, pg is not None, tv, fan)
+                found = (route, parts, pairs, c_start, pg is not None, tv, fan, avoid)
                 break
             if fallback is None or depth < fallback[0]:
-                fallback = (depth, (route, parts, pairs, c_start, pg is not None, tv, fan))
+                fallback = (depth, (route, parts, pairs, c_start, pg is not None, tv, fan, avoid))
         if found is None and fallback is not None:      # every start overlaps: the least (mlc verify reports it)
             found = fallback[1]
         if found is None:
             raise MlcError(f"cannot route output {ds.output} to dof {name}: no connector chain reaches it "
                            "clear of the others", ds.loc, "this is a placement limit of mlc; try a larger skeleton height")
-        route, parts, pairs, c_start, paged, tv, fan = found
+        route, parts, pairs, c_start, paged, tv, fan, avoid = found
         new_c = np.array([b.position for b in parts.bodies])
         placed = np.vstack([placed, new_c])
         parts.bonds += join(f"{tag}_j0", c_start, pairs[0], geo.k)
@@ -609,10 +624,10 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
         n_chains += 1
         nh = len(route.bends) + (1 if paged else 0) + (WRIST_UNITS if WRIST else 0)
         contour = (len(route.bends) + (1 if paged else 0)) * geo.pitch + (
-            WRIST_UNITS * (WRIST_POST + geo.width + 0.5 * geo.gap) if WRIST else 0.0)   # sigma
+            WRIST_UNITS * (WRIST_POSTS.get(name, WRIST_POST) + geo.width + 0.5 * geo.gap) if WRIST else 0.0)   # sigma
         n_half += nh
         next(d for d in dofs_meta if d["name"] == name)["chain"] = {
-            "half_units": nh, "prefix": tag, "page": paged, "fan_deg": fan, "route_seconds": round(time.perf_counter() - tr, 2),
+            "half_units": nh, "prefix": tag, "page": paged, "fan_deg": fan, "avoid": avoid, "route_seconds": round(time.perf_counter() - tr, 2),
             "reach_max": round(max(d_rows), 3), "wrist_units": WRIST_UNITS if WRIST else 0,
             "contour": round(contour, 3), "reach_fraction": round(max(d_rows) / contour, 3)}
     rmeta = spec.as_dict()
