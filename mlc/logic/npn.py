@@ -43,16 +43,21 @@ _LUT: list[tuple[list[int], list[int]]] = []
 def _luts() -> list[tuple[list[int], list[int]]]:
     """Per input transform: the image of the low and of the high byte of a table."""
     if not _LUT:
+        # xmap is a permutation of the 16 minterms: bit x of f lands on bit y of the
+        # image, so a byte's image is the OR of its set bits' images (built up from
+        # the byte without its lowest bit: 2 x 256 steps per transform)
+        low = [0] + [(v & -v).bit_length() - 1 for v in range(1, 256)]
         for _perm, _neg, xmap in _TRANSFORMS:
+            one = [0] * 16
+            for y in range(16):
+                one[xmap[y]] = 1 << y
             lo = [0] * 256
             hi = [0] * 256
-            for y in range(16):
-                x = xmap[y]
-                tgt, src = (lo, x) if x < 8 else (hi, x - 8)
-                bit = 1 << y
-                for v in range(256):
-                    if (v >> src) & 1:
-                        tgt[v] |= bit
+            for v in range(1, 256):
+                b = low[v]
+                w = v & (v - 1)
+                lo[v] = lo[w] | one[b]
+                hi[v] = hi[w] | one[8 + b]
             _LUT.append((lo, hi))
     return _LUT
 
