@@ -83,21 +83,11 @@ class _Dec:
             vi, ni = pos[i], neg[i]
             if ((f & vi) >> s) == (f & ni) and ((care & vi) >> s) == (care & ni):
                 continue                      # depends on neither
-            off = care & ~f
-            lo = f & ni
-            on0 = lo | (lo << s)
-            hi = f & vi
-            on1 = hi | (hi >> s)
-            lo = off & ni
-            of0 = lo | (lo << s)
-            hi = off & vi
-            of1 = hi | (hi >> s)
+            on0, on1, of0, of1, c0, c1 = _cofactors(f, care & ~f, care, s, vi, ni)
             if on0 & of1 == 0 and on1 & of0 == 0:
                 # need not depend on i: merge the cofactors
                 f = on0 | on1
-                lo = care & ni
-                hi = care & vi
-                care = lo | (lo << s) | hi | (hi >> s)
+                care = c0 | c1
             else:
                 sup.append(i)
         r = (f & care, care, tuple(sup))
