@@ -37,8 +37,6 @@ import platform
 import sys
 import time
 
-import numpy as np
-
 
 def run_one(scene, state: str, seed: int, dt: float, tau: float, max_time: float, kT: float = 1e-5,
             every: float = 100.0, scheme: str = "stiff", min_time: float | None = None) -> dict:

@@ -29,10 +29,11 @@ from __future__ import annotations
 import argparse
 import collections
 import json
-import os
 import re
 import sys
 import time
+
+from mlc.io.atomic import atomic_path
 
 _RC = re.compile(r"^rc_(u\d+_(?:up|dn))_(pg|w\d+|\d+)_([A-D]{2})$")
 
@@ -124,9 +125,8 @@ def main(argv=None) -> int:
         print(f"row {row}: {r['shape_read']} (verdict {'ok' if r['row_ok'] else 'WRONG'}, DOF error "
               f"{r['max_dof_error_deg']:.1f} deg, stretch {r['joint_stretch']:.1e}), clearance {r['min_clearance']} {r['pair']}, {r['n_overlaps']} pairs: "
               + ", ".join(f"{k} {v['n']} (deepest {v['deepest']:.3f})" for k, v in r["by_class"].items()), flush=True)
-        with open(a.out + ".tmp", "w") as f:
+        with atomic_path(a.out) as tmp, open(tmp, "w") as f:
             json.dump(out, f, indent=1)
-        os.replace(a.out + ".tmp", a.out)
     return 0
 
 

@@ -36,6 +36,8 @@ import time
 
 import numpy as np
 
+from mlc.io.atomic import atomic_path
+
 
 def run_one(scene, row: str, dt: float, T: float, avg: float, seed: int, kT: float, scheme: str = "stiff") -> dict:
     from mlc.robot.verify import read_shape
@@ -262,9 +264,8 @@ def main(argv=None) -> int:
                 ok = [r for r in data["runs"] if "failed" not in r]
                 data["comparison"] = compare(ok)
                 data["seed_comparison"] = compare_seeds(ok)
-                with open(a.out + ".tmp", "w") as f:
+                with atomic_path(a.out) as tmp, open(tmp, "w") as f:
                     json.dump(data, f, indent=1)
-                os.replace(a.out + ".tmp", a.out)
     return 0
 
 

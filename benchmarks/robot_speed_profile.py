@@ -25,6 +25,8 @@ import platform
 import sys
 import time
 
+from mlc.io.atomic import atomic_path
+
 
 def main(argv=None) -> int:
     from mlc.scene.io import load_scene
@@ -76,9 +78,8 @@ def main(argv=None) -> int:
                  "load_1min": round(os.getloadavg()[0], 2)}
             out["runs"].append(r)
             print(r, flush=True)
-            with open(a.out + ".tmp", "w") as f:
+            with atomic_path(a.out) as tmp, open(tmp, "w") as f:
                 json.dump(out, f, indent=1)
-            os.replace(a.out + ".tmp", a.out)
     return 0
 
 

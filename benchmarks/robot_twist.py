@@ -23,11 +23,11 @@ from __future__ import annotations
 import argparse
 import json
 import math
-import os
 import sys
 import time
 
 import numpy as np
+from mlc.io.atomic import atomic_path
 
 
 def site_world(scene, idx, pos, R, site: str) -> np.ndarray:
@@ -99,9 +99,8 @@ def main(argv=None) -> int:
         print(f"row {row} ({r['shape_read']}): " + ", ".join(
             f"{k} {v['lever_turn_z_deg']:+.0f} deg / {v['lever_move_sigma']:.1f} s (start {v['start_turn_z_deg']:+.0f})"
             for k, v in r["dofs"].items()), flush=True)
-        with open(a.out + ".tmp", "w") as f:
+        with atomic_path(a.out) as tmp, open(tmp, "w") as f:
             json.dump(out, f, indent=1)
-        os.replace(a.out + ".tmp", a.out)
     return 0
 
 
