@@ -477,6 +477,8 @@ def resub_window(g: AIG, max_leaves: int | None = None, max_new: int = 2, max_wi
     if max_window is None:
         max_window = WINDOW_SIZE
     tick = WIDE_TICK if n > TT_LIMIT else 1.0
+    if KERNELS and max_leaves <= 14:
+        return _resub_window_nb(g, max_leaves, max_new, max_window, deadline, tick)
     refs = refcounts(g)
     fanouts: list[list[int]] = [[] for _ in range(g.num_nodes)]
     for k, (a, b) in enumerate(g.ands):
@@ -527,6 +529,40 @@ def resub_window(g: AIG, max_leaves: int | None = None, max_new: int = 2, max_wi
     return rebuild(g, repl)
 
 
+def _resub_window_nb(g: AIG, max_leaves: int, max_new: int, max_window: int,
+                     deadline: float | None, tick: float) -> AIG:
+    """:func:`resub_window` with its per-node work in :mod:`mlc.logic.kern` (the same moves)."""
+    import numpy as np
+    from mlc.logic import kern
+    n = g.num_inputs
+    N = g.num_nodes
+    fa, fb, fo_start, fo_list = kern.aig_arrays(g)
+    refs = np.array(refcounts(g), dtype=np.int64)
+    touched = bytearray(N)
+    tv = np.frombuffer(touched, dtype=np.uint8)
+    ws = kern.Workspace(N, max_leaves)
+    out = ws.out
+    cone_buf = ws.buf[1]
+    repl: dict[int, tuple] = {}
+    virt = _Virtual(g)
+    for x in range(n + 1, N):
+        if deadline is not None and work.now(N, tick) > deadline:
+            break
+        if touched[x] or refs[x] == 0:
+            continue
+        kern.window_node(x, fa, fb, n, fo_start, fo_list, refs, tv, max_leaves, max_window,
+                         max_new, ws.tabs, ws.slot, ws.ids, ws.mark, ws.seen, ws.buf, ws.vec, out)
+        e = kern.decode(out)
+        if e is None or not virt.accept(x, e):
+            continue
+        repl[x] = e
+        for y in cone_buf[:int(out[5])].tolist():
+            touched[y] = 1
+    if not repl:
+        return g
+    return rebuild(g, repl)
+
+
 def _in_tfo(g: AIG, x: int, v: int, memo: dict[int, bool], budget: list[int]) -> bool:
     """Whether ``v`` is in the transitive fanout of ``x`` (a search down from ``v``
     through nodes above ``x``); True (the safe answer) once ``budget[0]`` visits ran out."""
@@ -571,6 +607,8 @@ def resub_dc(g: AIG, max_leaves: int | None = None, levels: int | None = None,
     if max_fanout is None:
         max_fanout = DC_FANOUT
     tick = WIDE_TICK if n > TT_LIMIT else 1.0
+    if KERNELS and max_leaves <= 14:
+        return _resub_dc_nb(g, max_leaves, levels, max_fanout, max_window, max_new, deadline, tick)
     N = g.num_nodes
     ands = g.ands
     refs = refcounts(g)
@@ -695,6 +733,50 @@ def resub_dc(g: AIG, max_leaves: int | None = None, levels: int | None = None,
             if y > n:
                 a, b = ands[y - n - 1]
                 stack += [a >> 1, b >> 1]
+    if not repl:
+        return g
+    return rebuild(g, repl)
+
+
+def _resub_dc_nb(g: AIG, max_leaves: int, levels: int, max_fanout: int, max_window: int,
+                 max_new: int, deadline: float | None, tick: float) -> AIG:
+    """:func:`resub_dc` with its per-node work in :mod:`mlc.logic.kern` (the same moves)."""
+    import numpy as np
+    from mlc.logic import kern
+    n = g.num_inputs
+    N = g.num_nodes
+    fa, fb, fo_start, fo_list = kern.aig_arrays(g)
+    refs = np.array(refcounts(g), dtype=np.int64)
+    is_po = np.zeros(N, dtype=np.uint8)
+    for lit in g.output_lits:
+        is_po[lit >> 1] = 1
+    touched = np.zeros(N, dtype=np.uint8)
+    changed = np.zeros(N, dtype=np.uint8)
+    read = np.zeros(N, dtype=np.uint8)
+    ws = kern.Workspace(N, max_leaves)
+    ftabs = np.zeros_like(ws.tabs)
+    fslot = np.full(N + 1, -1, dtype=np.int64)
+    winmark = np.zeros(N + 1, dtype=np.int8)
+    memo = np.zeros(N + 1, dtype=np.int8)
+    lens = np.zeros(4, dtype=np.int64)
+    out = ws.out
+    repl: dict[int, tuple] = {}
+    virt = _Virtual(g)
+    for x in range(n + 1, N):
+        if deadline is not None and work.now(N, tick) > deadline:
+            break
+        if touched[x] or changed[x] or refs[x] == 0:
+            continue
+        kern.dc_node(x, fa, fb, n, fo_start, fo_list, refs, touched, changed, read, is_po,
+                     max_leaves, levels, max_fanout, max_window, max_new, ws.tabs, ftabs,
+                     ws.slot, fslot, ws.ids, ws.mark, winmark, memo, ws.seen, ws.buf, ws.vec,
+                     out, lens)
+        e = kern.decode(out)
+        if e is not None and virt.accept(x, e):
+            repl[x] = e
+            kern.dc_commit(x, fa, fb, n, touched, changed, read, ws.buf, lens, winmark,
+                           np.array(_expr_nodes(e, []), dtype=np.int64))
+        kern.dc_clear(ws.buf, lens, ws.mark, winmark)
     if not repl:
         return g
     return rebuild(g, repl)
@@ -916,6 +998,8 @@ def _place_cost(g: AIG, ent: dict, lits: list, incone: set[int], touched, refs, 
 
 CUT_LIMIT = 10
 STRUCT_VARIANTS = True
+# the windowed passes' per-node work in numba (mlc.logic.kern; the same networks)
+KERNELS = True
 ROUNDS_BIG = 30
 # resub_window in the plain rounds of wide networks: 14-leaf cuts, windows of up to
 # 300 nodes (was 10 and 150; with WIDE_TICK, EPFL i2c 1105 -> 1050, max 2860 -> 2795,

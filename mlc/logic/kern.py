@@ -1,0 +1,903 @@
+"""numba kernels of the windowed passes of :mod:`mlc.logic.opt` over array AIGs.
+
+The network is given as arrays indexed by node (``fa[y]``, ``fb[y]``: the fanin
+literals of AND node ``y``, -1 for inputs and the constant; ``fo_start``/``fo_list``:
+the fanouts of each node in increasing order, CSR) and a window's truth tables as
+rows of a ``uint64`` matrix (``W`` words per table; bit ``m`` of a table is its value
+on minterm ``m`` of the window's leaves, as in :mod:`mlc.logic.tt`).  Each kernel
+does exactly what the Python code it replaces did, in the same order (the same
+networks come out); :mod:`mlc.logic.opt` keeps the Python versions as the reference
+(``tests/test_logic_kern.py`` compares them).
+
+Kernels are compiled on first use and cached on disk (``cache=True``).
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+ONES = np.uint64(0xFFFFFFFFFFFFFFFF)
+ZERO = np.uint64(0)
+_VARW = np.array([0xAAAAAAAAAAAAAAAA, 0xCCCCCCCCCCCCCCCC, 0xF0F0F0F0F0F0F0F0,
+                  0xFF00FF00FF00FF00, 0xFFFF0000FFFF0000, 0xFFFFFFFF00000000], dtype=np.uint64)
+MAX_LEAVES = 14
+
+
+def aig_arrays(g):
+    """``(fa, fb, fo_start, fo_list)`` of AIG ``g`` (see the module docstring)."""
+    N = g.num_nodes
+    n = g.num_inputs
+    fa = np.full(N, -1, dtype=np.int64)
+    fb = np.full(N, -1, dtype=np.int64)
+    if g.ands:
+        arr = np.array(g.ands, dtype=np.int64).reshape(-1, 2)
+        fa[n + 1:] = arr[:, 0]
+        fb[n + 1:] = arr[:, 1]
+    fo_start, fo_list = _fanouts(fa, fb, n, N)
+    return fa, fb, fo_start, fo_list
+
+
+@njit(cache=True)
+def _fanouts(fa, fb, n, N):
+    cnt = np.zeros(N + 1, dtype=np.int64)
+    for y in range(n + 1, N):
+        a = fa[y] >> 1
+        b = fb[y] >> 1
+        cnt[a + 1] += 1
+        if b != a:
+            cnt[b + 1] += 1
+    for i in range(N):
+        cnt[i + 1] += cnt[i]
+    lst = np.zeros(cnt[N], dtype=np.int64)
+    pos = cnt[:N].copy()
+    for y in range(n + 1, N):
+        a = fa[y] >> 1
+        b = fb[y] >> 1
+        lst[pos[a]] = y
+        pos[a] += 1
+        if b != a:
+            lst[pos[b]] = y
+            pos[b] += 1
+    return cnt, lst
+
+
+class Workspace:
+    """Scratch arrays of the kernels for a network of ``N`` nodes (allocated once per pass)."""
+
+    def __init__(self, N: int, max_leaves: int = MAX_LEAVES):
+        wmax = max(1, (1 << max_leaves) // 64)
+        self.tabs = np.zeros((N + 2, wmax), dtype=np.uint64)
+        self.slot = np.full(N + 1, -1, dtype=np.int64)
+        self.ids = np.zeros(N + 2, dtype=np.int64)
+        self.mark = np.zeros(N + 1, dtype=np.int8)
+        self.seen = np.zeros(N + 1, dtype=np.int8)
+        self.buf = np.zeros((8, N + 2), dtype=np.int64)
+        self.vec = np.zeros((8, wmax), dtype=np.uint64)
+        self.out = np.zeros(6, dtype=np.int64)
+
+
+# ----------------------------------------------------------------------------- helpers
+
+@njit(cache=True, inline="always")
+def _popcount(x):
+    x = x - ((x >> np.uint64(1)) & np.uint64(0x5555555555555555))
+    x = (x & np.uint64(0x3333333333333333)) + ((x >> np.uint64(2)) & np.uint64(0x3333333333333333))
+    x = (x + (x >> np.uint64(4))) & np.uint64(0x0F0F0F0F0F0F0F0F)
+    return (x * np.uint64(0x0101010101010101)) >> np.uint64(56)
+
+
+@njit(cache=True)
+def expand_cut(fa, fb, n, mark, leaves, nl, inside, ni, max_leaves):
+    """:func:`mlc.logic.opt._expand_cut` on arrays: ``leaves[:nl]`` (``mark`` 1) and
+    ``inside[:ni]`` (``mark`` 2) grown in place; returns ``(nl, ni)``."""
+    while True:
+        best = -1
+        bcost = 3
+        bt = -1
+        for t in range(nl):
+            y = leaves[t]
+            if y <= n:
+                continue
+            za = fa[y] >> 1
+            zb = fb[y] >> 1
+            c = 0
+            if za != 0 and mark[za] == 0:
+                c += 1
+            if zb != 0 and mark[zb] == 0:
+                c += 1
+            if c < bcost or (c == bcost and y > best):
+                best = y
+                bcost = c
+                bt = t
+        if best < 0 or nl + bcost - 1 > max_leaves:
+            break
+        nl -= 1
+        leaves[bt] = leaves[nl]
+        mark[best] = 2
+        inside[ni] = best
+        ni += 1
+        for z in (fa[best] >> 1, fb[best] >> 1):
+            if z != 0 and mark[z] != 2:
+                if mark[z] != 1:
+                    mark[z] = 1
+                    leaves[nl] = z
+                    nl += 1
+    return nl, ni
+
+
+@njit(cache=True)
+def reconv_cut(fa, fb, n, x, max_leaves, mark, leaves, inside):
+    """:func:`mlc.logic.opt.reconv_cut`: the sorted leaves into ``leaves``, their count
+    returned; ``mark`` is left clear."""
+    nl = 0
+    for z in (fa[x] >> 1, fb[x] >> 1):
+        if z != 0 and mark[z] == 0:
+            mark[z] = 1
+            leaves[nl] = z
+            nl += 1
+    mark[x] = 2
+    inside[0] = x
+    nl, ni = expand_cut(fa, fb, n, mark, leaves, nl, inside, 1, max_leaves)
+    for t in range(nl):
+        mark[leaves[t]] = 0
+    for t in range(ni):
+        mark[inside[t]] = 0
+    leaves[:nl].sort()
+    return nl
+
+
+@njit(cache=True)
+def reconv_cut_py(fa, fb, n, x, max_leaves, mark, leaves, inside):
+    nl = reconv_cut(fa, fb, n, x, max_leaves, mark, leaves, inside)
+    return leaves[:nl].copy()
+
+
+@njit(cache=True)
+def mffc(fa, fb, n, x, refs, leafmark, out, stack, dec):
+    """:func:`mlc.logic.opt.mffc` (nodes into ``out``, their count returned); leaves
+    are the nodes with ``leafmark == 1``; ``refs`` is left unchanged."""
+    no = 1
+    out[0] = x
+    ns = 1
+    stack[0] = x
+    nd = 0
+    while ns > 0:
+        ns -= 1
+        y0 = stack[ns]
+        for f in (fa[y0], fb[y0]):
+            y = f >> 1
+            if y <= n or leafmark[y] == 1:
+                continue
+            refs[y] -= 1
+            dec[nd] = y
+            nd += 1
+            if refs[y] == 0:
+                out[no] = y
+                no += 1
+                stack[ns] = y
+                ns += 1
+    for t in range(nd):
+        refs[dec[t]] += 1
+    return no
+
+
+@njit(cache=True)
+def set_leaves(tabs, W, k, full, leaves, slot, ids):
+    """Rows 0..k-1: the variable tables of ``leaves[:k]``; ``full`` gets the all-ones table."""
+    for w in range(W):
+        full[w] = ONES
+    if k < 6:
+        full[0] = (np.uint64(1) << np.uint64(1 << k)) - np.uint64(1)
+    for i in range(k):
+        if i < 6:
+            v = _VARW[i]
+            for w in range(W):
+                tabs[i, w] = v & full[w]
+        else:
+            s = i - 6
+            for w in range(W):
+                tabs[i, w] = ONES if (w >> s) & 1 else ZERO
+        slot[leaves[i]] = i
+        ids[i] = leaves[i]
+
+
+@njit(cache=True, inline="always")
+def _and_row(tabs, W, full, r, ra, ca, rb, cb):
+    for w in range(W):
+        va = tabs[ra, w]
+        if ca:
+            va = va ^ full[w]
+        vb = tabs[rb, w]
+        if cb:
+            vb = vb ^ full[w]
+        tabs[r, w] = va & vb
+
+
+@njit(cache=True)
+def grow_window(fa, fb, n, fo_start, fo_list, tabs, W, full, slot, ids, nrows,
+                leaves, k, top, max_window, changed, use_changed, winmark, use_win, seen, seenlist):
+    """:func:`mlc.logic.opt._grow_window`: rows appended from ``nrows``; returns the
+    new row count.  The heap is a forward scan (nodes come off it in increasing order)."""
+    pending = 0
+    ns = 0
+    lo = 1 << 62
+    for t in range(k):
+        leaf = leaves[t]
+        for p in range(fo_start[leaf], fo_start[leaf + 1]):
+            z = fo_list[p]
+            if z <= top and seen[z] == 0:
+                seen[z] = 1
+                seenlist[ns] = z
+                ns += 1
+                pending += 1
+                if z < lo:
+                    lo = z
+    size = nrows
+    y = lo
+    while pending > 0 and size < max_window:
+        while seen[y] == 0:
+            y += 1
+        pending -= 1
+        cy = y
+        y += 1
+        if slot[cy] >= 0:
+            continue
+        if use_changed and changed[cy]:
+            continue
+        a = fa[cy]
+        b = fb[cy]
+        if use_win and (winmark[a >> 1] or winmark[b >> 1]):
+            continue
+        ra = slot[a >> 1]
+        if ra < 0:
+            continue
+        rb = slot[b >> 1]
+        if rb < 0:
+            continue
+        _and_row(tabs, W, full, nrows, ra, a & 1, rb, b & 1)
+        slot[cy] = nrows
+        ids[nrows] = cy
+        nrows += 1
+        size += 1
+        for p in range(fo_start[cy], fo_start[cy + 1]):
+            z = fo_list[p]
+            if z <= top and seen[z] == 0:
+                seen[z] = 1
+                seenlist[ns] = z
+                ns += 1
+                pending += 1
+    for t in range(ns):
+        seen[seenlist[t]] = 0
+    return nrows
+
+
+# ----------------------------------------------------------------------------- find_resub
+
+@njit(cache=True)
+def find_resub(tabs, W, f, care, nf, divrows, divids, D, max_new, or_width, out,
+               flags, cl, cr, cc, al, ar, ac, an, cnt, ex, e2, rest):
+    """:func:`mlc.logic.opt._find_resub`: ``f``, ``care`` as word arrays, divisors
+    ``divids[:D]`` with tables ``tabs[divrows[i]]``.  Answer in ``out``: ``out[0]`` =
+    -1 (none), 0 (literal ``out[1]``), 1 (``and(out[1], out[2])``), 2
+    (``and(out[1], and(out[2], out[3]))``), 3 (``and(out[1], !and(out[2], out[3]))``),
+    ``out[4]`` the output complement."""
+    out[0] = -1
+    if max_new < 0:
+        return
+    fz = True
+    nfz = True
+    for w in range(W):
+        nf[w] = ~f[w] & care[w]
+        if f[w] != ZERO:
+            fz = False
+        if nf[w] != ZERO:
+            nfz = False
+    if fz:
+        out[0] = 0
+        out[1] = 0
+        return
+    if nfz:
+        out[0] = 0
+        out[1] = 1
+        return
+    for i in range(D):
+        r = divrows[i]
+        A = True    # f & x == f
+        B = True    # f & x == 0
+        C = True    # nf & x == nf
+        E = True    # nf & x == 0
+        for w in range(W):
+            x = tabs[r, w]
+            if f[w] & ~x != ZERO:
+                A = False
+            if f[w] & x != ZERO:
+                B = False
+            if nf[w] & ~x != ZERO:
+                C = False
+            if nf[w] & x != ZERO:
+                E = False
+        d = divids[i]
+        if A:
+            if E:
+                out[0] = 0
+                out[1] = 2 * d
+                return
+        elif B and C:
+            out[0] = 0
+            out[1] = 2 * d + 1
+            return
+        flags[i] = (1 if A else 0) | (2 if B else 0) | (4 if C else 0) | (8 if E else 0)
+    if max_new < 1:
+        return
+    # candidate lists: pos at [0, Lp), neg at [D2, D2 + Ln)
+    D2 = 2 * D
+    Lp = 0
+    Ln = 0
+    for i in range(D):
+        fl = flags[i]
+        if fl == 0:
+            continue
+        d = divids[i]
+        r = divrows[i]
+        if fl & 1:
+            cl[Lp] = 2 * d
+            cr[Lp] = r
+            cc[Lp] = 0
+            Lp += 1
+        if fl & 4:
+            cl[D2 + Ln] = 2 * d
+            cr[D2 + Ln] = r
+            cc[D2 + Ln] = 0
+            Ln += 1
+        if fl & 2:
+            cl[Lp] = 2 * d + 1
+            cr[Lp] = r
+            cc[Lp] = 1
+            Lp += 1
+        if fl & 8:
+            cl[D2 + Ln] = 2 * d + 1
+            cr[D2 + Ln] = r
+            cc[D2 + Ln] = 1
+            Ln += 1
+    # 1-resub
+    for oc in range(2):
+        base = 0 if oc == 0 else D2
+        L = Lp if oc == 0 else Ln
+        tgt = f if oc == 0 else nf
+        for i in range(L):
+            li = cl[base + i]
+            ri = cr[base + i]
+            ci = ONES if cc[base + i] else ZERO
+            for j in range(i + 1, L):
+                lj = cl[base + j]
+                if (li >> 1) == (lj >> 1):
+                    continue
+                rj = cr[base + j]
+                cj = ONES if cc[base + j] else ZERO
+                ok = True
+                for w in range(W):
+                    if ((tabs[ri, w] ^ ci) & (tabs[rj, w] ^ cj) & care[w]) != tgt[w]:
+                        ok = False
+                        break
+                if ok:
+                    out[0] = 1
+                    out[1] = li
+                    out[2] = lj
+                    out[4] = oc
+                    return
+    if max_new < 2:
+        return
+    for oc in range(2):
+        base = 0 if oc == 0 else D2
+        L = Lp if oc == 0 else Ln
+        tgt = f if oc == 0 else nf
+        if L <= 30:
+            for i in range(L):
+                li = cl[base + i]
+                ri = cr[base + i]
+                ci = ONES if cc[base + i] else ZERO
+                for w in range(W):
+                    ex[w] = ((tabs[ri, w] ^ ci) & care[w]) & ~tgt[w]
+                for j in range(i + 1, L):
+                    lj = cl[base + j]
+                    rj = cr[base + j]
+                    cj = ONES if cc[base + j] else ZERO
+                    z = True
+                    for w in range(W):
+                        e2[w] = ex[w] & ((tabs[rj, w] ^ cj) & care[w])
+                        if e2[w] != ZERO:
+                            z = False
+                    if z and j + 1 < L:
+                        out[0] = 2
+                        out[1] = li
+                        out[2] = lj
+                        out[3] = cl[base + j + 1]
+                        out[4] = oc
+                        return
+                    for kk in range(j + 1, L):
+                        rk = cr[base + kk]
+                        ck = ONES if cc[base + kk] else ZERO
+                        ok = True
+                        for w in range(W):
+                            if e2[w] & ((tabs[rk, w] ^ ck) & care[w]) != ZERO:
+                                ok = False
+                                break
+                        if ok:
+                            out[0] = 2
+                            out[1] = li
+                            out[2] = lj
+                            out[3] = cl[base + kk]
+                            out[4] = oc
+                            return
+        if L == 0:
+            continue
+        ct = 0
+        for w in range(W):
+            ct += _popcount(tgt[w])
+        for i in range(D):
+            cnt[i] = -1
+        # A/B/C/E flags of meet m = tgt & x: m == tgt and m == 0
+        full_bit = 1 if oc == 0 else 4
+        zero_bit = 2 if oc == 0 else 8
+        for ii in range(min(L, or_width)):
+            li = cl[base + L - 1 - ii]
+            ri = cr[base + L - 1 - ii]
+            ci = ONES if cc[base + L - 1 - ii] else ZERO
+            for w in range(W):
+                ex[w] = ((tabs[ri, w] ^ ci) & care[w]) & ~tgt[w]
+            di = li >> 1
+            A = 0
+            for t in range(D):
+                d = divids[t]
+                if d == di:
+                    continue
+                r = divrows[t]
+                xz = True      # x & extra == 0
+                xf = True      # x & extra == extra
+                for w in range(W):
+                    xe = tabs[r, w] & ex[w]
+                    if xe != ZERO:
+                        xz = False
+                    if xe != ex[w]:
+                        xf = False
+                    if not xz and not xf:
+                        break
+                fl = flags[t]
+                m_nonzero = (fl & zero_bit) == 0
+                m_notfull = (fl & full_bit) == 0
+                if (m_nonzero and xz) or (m_notfull and xf):
+                    if cnt[t] < 0:
+                        s = 0
+                        for w in range(W):
+                            s += _popcount(tgt[w] & tabs[r, w])
+                        cnt[t] = s
+                if m_nonzero and xz:
+                    al[A] = 2 * d
+                    ar[A] = r
+                    ac[A] = 0
+                    an[A] = cnt[t]
+                    A += 1
+                if m_notfull and xf:
+                    al[A] = 2 * d + 1
+                    ar[A] = r
+                    ac[A] = 1
+                    an[A] = ct - cnt[t]
+                    A += 1
+            st = A - 60 if A > 60 else 0
+            for j in range(st, A):
+                lj = al[j]
+                rj = ar[j]
+                cj = ONES if ac[j] else ZERO
+                need = ct - an[j]
+                have_rest = False
+                for kk in range(j + 1, A):
+                    if an[kk] < need:
+                        continue
+                    if not have_rest:
+                        for w in range(W):
+                            rest[w] = tgt[w] & ~((tabs[rj, w] ^ cj) & care[w])
+                        have_rest = True
+                    lk = al[kk]
+                    rk = ar[kk]
+                    ck = ONES if ac[kk] else ZERO
+                    ok = True
+                    for w in range(W):
+                        if rest[w] & ~((tabs[rk, w] ^ ck) & care[w]) != ZERO:
+                            ok = False
+                            break
+                    if ok and (lk >> 1) != (lj >> 1):
+                        out[0] = 3
+                        out[1] = li
+                        out[2] = lj ^ 1
+                        out[3] = lk ^ 1
+                        out[4] = oc
+                        return
+
+
+def decode(out):
+    """The expression (see :func:`mlc.logic.opt.rebuild`) of a :func:`find_resub` answer."""
+    kind = int(out[0])
+    if kind < 0:
+        return None
+    l1, l2, l3, oc = int(out[1]), int(out[2]), int(out[3]), int(out[4])
+    if kind == 0:
+        return l1
+    if kind == 1:
+        return ("and", l1, l2, oc)
+    if kind == 2:
+        return ("and", l1, ("and", l2, l3, 0), oc)
+    return ("and", l1, ("and", l2, l3, 1), oc)
+
+
+# ----------------------------------------------------------------------------- resub_window
+
+@njit(cache=True)
+def window_node(x, fa, fb, n, fo_start, fo_list, refs, touched, max_leaves, max_window,
+                max_new, tabs, slot, ids, mark, seen, buf, vec, out):
+    """The body of :func:`mlc.logic.opt.resub_window` for node ``x``: ``out[0]`` as in
+    :func:`find_resub` (-1 also when the node is skipped); the freed cone is
+    ``buf[1, :out[5]]``."""
+    out[0] = -1
+    out[5] = 0
+    leaves = buf[0]
+    cone = buf[1]
+    stack = buf[2]
+    dec = buf[3]
+    inside = buf[4]
+    k = reconv_cut(fa, fb, n, x, max_leaves, mark, leaves, inside)
+    for t in range(k):
+        if touched[leaves[t]]:
+            return
+    for t in range(k):
+        mark[leaves[t]] = 1
+    nc = mffc(fa, fb, n, x, refs, mark, cone, stack, dec)
+    for t in range(k):
+        mark[leaves[t]] = 0
+    if nc < 2:
+        return
+    for t in range(nc):
+        if touched[cone[t]]:
+            return
+    W = max(1, (1 << k) // 64)
+    full = vec[0]
+    set_leaves(tabs, W, k, full, leaves, slot, ids)
+    nrows = grow_window(fa, fb, n, fo_start, fo_list, tabs, W, full, slot, ids, k,
+                        leaves, k, x + max_window, max_window, touched, False, mark, False,
+                        seen, stack)
+    _resub_tail(x, n, fa, fb, refs, touched, nrows, nc, max_new, tabs, W, full, full, slot,
+                ids, mark, buf, vec, out)
+    for t in range(nrows):
+        slot[ids[t]] = -1
+    out[5] = nc
+
+
+@njit(cache=True)
+def _resub_tail(x, n, fa, fb, refs, touched, nrows, nc, max_new, tabs, W, full, care, slot,
+                ids, mark, buf, vec, out):
+    if slot[x] < 0:
+        return
+    cone = buf[1]
+    order = np.argsort(ids[:nrows])
+    # bad = cone (mark 4) | tfo of x inside the window (mark 3)
+    for t in range(nc):
+        mark[cone[t]] = 4
+    mark[x] = 3
+    for t in range(nrows):
+        y = ids[order[t]]
+        if y > x and y > n:
+            if mark[fa[y] >> 1] == 3 or mark[fb[y] >> 1] == 3:
+                mark[y] = 3
+    divrows = buf[5]
+    divids = buf[6]
+    D = 0
+    for t in range(nrows):
+        d = ids[order[t]]
+        if mark[d] == 0 and not touched[d] and refs[d] > 0:
+            divrows[D] = order[t]
+            divids[D] = d
+            D += 1
+    for t in range(nrows):
+        mark[ids[t]] = 0
+    for t in range(nc):
+        mark[cone[t]] = 0
+    fx = vec[1]
+    for w in range(W):
+        fx[w] = tabs[slot[x], w] & care[w]
+    _call_find(tabs, W, fx, care, divrows, divids, D, min(max_new, nc - 1), 8, out, buf, vec)
+
+
+@njit(cache=True)
+def _call_find(tabs, W, f, care, divrows, divids, D, max_new, or_width, out, buf, vec):
+    n2 = 2 * D + 2
+    flags = np.empty(D + 1, dtype=np.int64)
+    cl = np.empty(2 * n2, dtype=np.int64)
+    cr = np.empty(2 * n2, dtype=np.int64)
+    cc = np.empty(2 * n2, dtype=np.int64)
+    al = np.empty(n2, dtype=np.int64)
+    ar = np.empty(n2, dtype=np.int64)
+    ac = np.empty(n2, dtype=np.int64)
+    an = np.empty(n2, dtype=np.int64)
+    cnt = np.empty(D + 1, dtype=np.int64)
+    find_resub(tabs, W, f, care, vec[2], divrows, divids, D, max_new, or_width, out,
+               flags, cl, cr, cc, al, ar, ac, an, cnt, vec[3], vec[4], vec[5])
+
+
+# ----------------------------------------------------------------------------- resub_dc
+
+@njit(cache=True)
+def _in_tfo(fa, fb, x, v0, memo, memolist, nm, budget, sv, ss):
+    """:func:`mlc.logic.opt._in_tfo` without recursion: ``(answer, memo count,
+    budget left)``; ``memo[v]`` 1 = True, 2 = False (``memolist[:nm]`` the set ones)."""
+    sv[0] = v0
+    ss[0] = 0
+    sp = 1
+    ret = False
+    while sp > 0:
+        v = sv[sp - 1]
+        s = ss[sp - 1]
+        if s == 0:
+            if v <= x:
+                ret = v == x
+                sp -= 1
+                continue
+            m = memo[v]
+            if m != 0:
+                ret = m == 1
+                sp -= 1
+                continue
+            budget -= 1
+            if budget < 0:
+                ret = True
+                sp -= 1
+                continue
+            ss[sp - 1] = 1
+            sv[sp] = fa[v] >> 1
+            ss[sp] = 0
+            sp += 1
+        elif s == 1:
+            if ret:
+                memo[v] = 1
+                memolist[nm] = v
+                nm += 1
+                sp -= 1
+                continue
+            ss[sp - 1] = 2
+            sv[sp] = fb[v] >> 1
+            ss[sp] = 0
+            sp += 1
+        else:
+            memo[v] = 1 if ret else 2
+            memolist[nm] = v
+            nm += 1
+            sp -= 1
+    return ret, nm, budget
+
+
+@njit(cache=True)
+def dc_node(x, fa, fb, n, fo_start, fo_list, refs, touched, changed, read, is_po, max_leaves,
+            levels, max_fanout, max_window, max_new, tabs, ftabs, slot, fslot, ids, mark,
+            winmark, memo, seen, buf, vec, out, lens):
+    """The body of :func:`mlc.logic.opt.resub_dc` for node ``x`` up to its
+    :func:`find_resub` (``out`` as there, -1 also when skipped).  For
+    :func:`dc_commit`: the window ``buf[4, :lens[0]]``, the cone ``buf[1, :lens[1]]``,
+    the leaves ``buf[0, :lens[2]]``, the inside nodes ``buf[7, :lens[3]]`` and the
+    roots marked 1 in ``winmark``... (kept until dc_clear)."""
+    out[0] = -1
+    lens[0] = 0
+    lens[1] = 0
+    lens[2] = 0
+    lens[3] = 0
+    leaves = buf[0]
+    cone = buf[1]
+    stack = buf[2]
+    dec = buf[3]
+    win = buf[4]
+    inside = buf[7]
+    memolist = dec
+    # the fanout window
+    win[0] = x
+    nw = 1
+    winmark[x] = 1
+    nm = 0
+    budget = 200
+    fstart = 0
+    fend = 1
+    sv = np.empty(512, dtype=np.int64)
+    ss = np.empty(512, dtype=np.int64)
+    for _lev in range(levels):
+        for t in range(fstart, fend):
+            y = win[t]
+            if fo_start[y + 1] - fo_start[y] > max_fanout:
+                continue
+            for p in range(fo_start[y], fo_start[y + 1]):
+                z = fo_list[p]
+                if winmark[z]:
+                    continue
+                va = fa[z] >> 1
+                vb = fb[z] >> 1
+                skip = False
+                if not winmark[va]:
+                    r, nm, budget = _in_tfo(fa, fb, x, va, memo, memolist, nm, budget, sv, ss)
+                    skip = r
+                if not skip and not winmark[vb]:
+                    r, nm, budget = _in_tfo(fa, fb, x, vb, memo, memolist, nm, budget, sv, ss)
+                    skip = r
+                if skip:
+                    continue
+                winmark[z] = 1
+                win[nw] = z
+                nw += 1
+        fstart = fend
+        fend = nw
+    for t in range(nm):
+        memo[memolist[t]] = 0
+    lens[0] = nw
+    if nw == 1:
+        return
+    for t in range(nw):
+        if changed[win[t]]:
+            return
+    # leaves below the window, then the reconvergence-driven cut
+    nl = 0
+    for t in range(nw):
+        y = win[t]
+        mark[y] = 2
+    for t in range(nw):
+        y = win[t]
+        for v in (fa[y] >> 1, fb[y] >> 1):
+            if v != 0 and winmark[v] == 0 and mark[v] == 0:
+                mark[v] = 1
+                leaves[nl] = v
+                nl += 1
+    for t in range(nw):
+        inside[t] = win[t]
+    ni = nw
+    lens[2] = nl
+    lens[3] = ni
+    if nl > max_leaves:
+        return
+    nl, ni = expand_cut(fa, fb, n, mark, leaves, nl, inside, ni, max_leaves)
+    lens[2] = nl
+    lens[3] = ni
+    for t in range(nl):
+        y = leaves[t]
+        if changed[y] or touched[y]:
+            return
+    for t in range(ni):
+        if changed[inside[t]]:
+            return
+    leaves[:nl].sort()
+    nc = mffc(fa, fb, n, x, refs, mark, cone, stack, dec)
+    lens[1] = nc
+    for t in range(nc):
+        if touched[cone[t]]:
+            return
+    k = nl
+    W = max(1, (1 << k) // 64)
+    full = vec[0]
+    set_leaves(tabs, W, k, full, leaves, slot, ids)
+    nrows = k
+    srt = np.sort(inside[:ni])
+    for t in range(ni):
+        y = srt[t]
+        a = fa[y]
+        b = fb[y]
+        _and_row(tabs, W, full, nrows, slot[a >> 1], a & 1, slot[b >> 1], b & 1)
+        slot[y] = nrows
+        ids[nrows] = y
+        nrows += 1
+    # care set of x: complement it and re-simulate the window
+    ws = np.sort(win[:nw])
+    nf = 0
+    rx = slot[x]
+    for w in range(W):
+        ftabs[nf, w] = tabs[rx, w] ^ full[w]
+    fslot[x] = nf
+    nf += 1
+    for t in range(nw):
+        y = ws[t]
+        if y == x:
+            continue
+        a = fa[y]
+        b = fb[y]
+        for w in range(W):
+            fr = fslot[a >> 1]
+            va = ftabs[fr, w] if fr >= 0 else tabs[slot[a >> 1], w]
+            if a & 1:
+                va = va ^ full[w]
+            fr = fslot[b >> 1]
+            vb = ftabs[fr, w] if fr >= 0 else tabs[slot[b >> 1], w]
+            if b & 1:
+                vb = vb ^ full[w]
+            ftabs[nf, w] = va & vb
+        fslot[y] = nf
+        nf += 1
+    care = vec[6]
+    for w in range(W):
+        care[w] = ZERO
+    blocked = False
+    for t in range(nw):
+        y = win[t]
+        root = is_po[y] != 0
+        if not root:
+            for p in range(fo_start[y], fo_start[y + 1]):
+                if winmark[fo_list[p]] == 0:
+                    root = True
+                    break
+        if root:
+            winmark[y] = 2
+            fr = fslot[y]
+            ry = slot[y]
+            for w in range(W):
+                care[w] |= ftabs[fr, w] ^ tabs[ry, w]
+        elif read[y]:
+            blocked = True
+    for t in range(nw):
+        fslot[win[t]] = -1
+    if not blocked:
+        nrows = grow_window(fa, fb, n, fo_start, fo_list, tabs, W, full, slot, ids, nrows,
+                            leaves, k, x + max_window, max_window, changed, True, winmark, True,
+                            seen, stack)
+        order = np.argsort(ids[:nrows])
+        for t in range(nc):
+            mark[cone[t]] = 4        # (leaves 1, inside 2: left as they are)
+        divrows = buf[5]
+        divids = buf[6]
+        D = 0
+        for t in range(nrows):
+            d = ids[order[t]]
+            if winmark[d] == 0 and mark[d] != 4 and not touched[d] and not changed[d] \
+                    and refs[d] > 0:
+                divrows[D] = order[t]
+                divids[D] = d
+                D += 1
+        for t in range(nc):
+            mark[cone[t]] = 0
+        fx = vec[1]
+        for w in range(W):
+            fx[w] = tabs[rx, w] & care[w]
+        _call_find(tabs, W, fx, care, divrows, divids, D, min(max_new, nc - 1), 8, out, buf, vec)
+    for t in range(nrows):
+        slot[ids[t]] = -1
+
+
+@njit(cache=True)
+def dc_clear(buf, lens, mark, winmark):
+    """Clear the marks :func:`dc_node` left (after :func:`dc_commit`, if any)."""
+    for t in range(lens[0]):
+        winmark[buf[4, t]] = 0
+    for t in range(lens[2]):
+        mark[buf[0, t]] = 0
+    for t in range(lens[3]):
+        mark[buf[7, t]] = 0
+
+
+@njit(cache=True)
+def dc_commit(x, fa, fb, n, touched, changed, read, buf, lens, winmark, enodes):
+    """The bookkeeping of an accepted :func:`dc_node` move (as in :func:`mlc.logic.opt.resub_dc`)."""
+    for t in range(lens[1]):
+        touched[buf[1, t]] = 1
+    for t in range(lens[0]):
+        y = buf[4, t]
+        if winmark[y] != 2:
+            changed[y] = 1
+    changed[x] = 1
+    for t in range(lens[2]):
+        read[buf[0, t]] = 1
+    for t in range(lens[3]):
+        read[buf[7, t]] = 1
+    stack = buf[2]
+    sp = 0
+    for t in range(len(enodes)):
+        stack[sp] = enodes[t]
+        sp += 1
+    while sp > 0:
+        sp -= 1
+        y = stack[sp]
+        if read[y]:
+            continue
+        read[y] = 1
+        if y > n:
+            stack[sp] = fa[y] >> 1
+            stack[sp + 1] = fb[y] >> 1
+            sp += 2
