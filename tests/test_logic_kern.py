@@ -79,3 +79,36 @@ def test_fanouts_csr():
             fo[b >> 1].append(n + 1 + k)
     for y in range(g.num_nodes):
         assert lst[start[y]:start[y + 1]].tolist() == fo[y]
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_rewrite_same_network(seed):
+    g = _random_aig(seed)
+    ref, new = _both(opt.rewrite, g)
+    assert new.to_text() == ref.to_text()
+    assert ref.to_text() != g.to_text()          # moves were made
+    for zg in (False, True):
+        h = opt.resub_window(ref)
+        r2, n2 = _both(opt.rewrite, h, zero_gain=zg)
+        assert n2.to_text() == r2.to_text()
+
+
+def test_cuts_same():
+    g = _random_aig(5, n_and=200)
+    fa, fb, _s, _l = kern.aig_arrays(g)
+    cl, cn, cc = kern.enumerate_cuts(fa, fb, g.num_inputs, g.num_nodes, 4, opt.CUT_LIMIT)
+    ref = opt.enumerate_cuts(g, limit=opt.CUT_LIMIT)
+    for x in range(g.num_inputs + 1, g.num_nodes):
+        got = [tuple(cl[x, c, :cn[x, c]].tolist()) for c in range(cc[x])]
+        assert got == ref[x]
+    # the strash table answers as AIG.lookup
+    keys, vals = kern.strash_table(fa, fb, g.num_inputs, g.num_nodes)
+    M = 2 * g.num_nodes + 2
+    rng = random.Random(0)
+    for _ in range(2000):
+        a = rng.randrange(2 * g.num_nodes)
+        b = rng.randrange(2 * g.num_nodes)
+        if rng.random() < 0.5:
+            a, b = g.ands[rng.randrange(len(g.ands))]
+        r = g.lookup(a, b)
+        assert kern.lookup(keys, vals, M, a, b) == (-1 if r is None else r)

@@ -901,3 +901,381 @@ def dc_commit(x, fa, fb, n, touched, changed, read, buf, lens, winmark, enodes):
             stack[sp] = fa[y] >> 1
             stack[sp + 1] = fb[y] >> 1
             sp += 2
+
+
+# ----------------------------------------------------------------------------- rewrite
+
+@njit(cache=True)
+def strash_table(fa, fb, n, N):
+    """Open-addressing hash of the AND nodes: keys ``a * 2N + b`` (a < b), values literals."""
+    size = 1
+    while size < 4 * max(N, 1):
+        size *= 2
+    keys = np.full(size, -1, dtype=np.int64)
+    vals = np.zeros(size, dtype=np.int64)
+    M = 2 * N + 2
+    for y in range(n + 1, N):
+        key = fa[y] * M + fb[y]
+        h = (key * 0x9E3779B1) & (size - 1)
+        while keys[h] >= 0 and keys[h] != key:
+            h = (h + 1) & (size - 1)
+        if keys[h] < 0:
+            keys[h] = key
+            vals[h] = 2 * y
+    return keys, vals
+
+
+@njit(cache=True, inline="always")
+def lookup(keys, vals, M, a, b):
+    """:meth:`mlc.logic.aig.AIG.lookup`: the literal, or -1 where it would be a new node."""
+    if a > b:
+        t = a
+        a = b
+        b = t
+    if a == 0:
+        return 0
+    if a == 1:
+        return b
+    if a == b:
+        return a
+    if a ^ b == 1:
+        return 0
+    key = a * M + b
+    size = len(keys)
+    h = (key * 0x9E3779B1) & (size - 1)
+    while keys[h] >= 0:
+        if keys[h] == key:
+            return vals[h]
+        h = (h + 1) & (size - 1)
+    return -1
+
+
+@njit(cache=True)
+def _cut_less(cand, cn, i, j):
+    # (len, tuple) order
+    if cn[i] != cn[j]:
+        return cn[i] < cn[j]
+    for t in range(cn[i]):
+        if cand[i, t] != cand[j, t]:
+            return cand[i, t] < cand[j, t]
+    return False
+
+
+@njit(cache=True)
+def enumerate_cuts(fa, fb, n, N, k, limit):
+    """:func:`mlc.logic.opt.enumerate_cuts`: node ``x``'s cuts are
+    ``cl[x, c, :cn[x, c]]`` for ``c < cc[x]`` (the trivial cut last)."""
+    C = limit + 1
+    cl = np.zeros((N, C, 4), dtype=np.int64)
+    cn = np.zeros((N, C), dtype=np.int64)
+    cc = np.zeros(N, dtype=np.int64)
+    cc[0] = 1
+    for i in range(1, n + 1):
+        cc[i] = 1
+        cn[i, 0] = 1
+        cl[i, 0, 0] = i
+    cand = np.zeros((C * C, 4), dtype=np.int64)
+    candn = np.zeros(C * C, dtype=np.int64)
+    order = np.zeros(C * C, dtype=np.int64)
+    u = np.zeros(8, dtype=np.int64)
+    for x in range(n + 1, N):
+        a = fa[x] >> 1
+        b = fb[x] >> 1
+        m = 0
+        for i in range(cc[a]):
+            na = cn[a, i]
+            for j in range(cc[b]):
+                nb = cn[b, j]
+                # merge two sorted lists
+                p = 0
+                q = 0
+                s = 0
+                while (p < na or q < nb) and s <= k:
+                    if q >= nb or (p < na and cl[a, i, p] < cl[b, j, q]):
+                        u[s] = cl[a, i, p]
+                        p += 1
+                    elif p >= na or cl[b, j, q] < cl[a, i, p]:
+                        u[s] = cl[b, j, q]
+                        q += 1
+                    else:
+                        u[s] = cl[a, i, p]
+                        p += 1
+                        q += 1
+                    s += 1
+                if s > k:
+                    continue
+                dup = False
+                for t in range(m):
+                    if candn[t] == s:
+                        same = True
+                        for r in range(s):
+                            if cand[t, r] != u[r]:
+                                same = False
+                                break
+                        if same:
+                            dup = True
+                            break
+                if dup:
+                    continue
+                for r in range(s):
+                    cand[m, r] = u[r]
+                candn[m] = s
+                m += 1
+        # insertion sort of the indices by (len, tuple)
+        for t in range(m):
+            order[t] = t
+        for t in range(1, m):
+            v = order[t]
+            r = t - 1
+            while r >= 0 and _cut_less(cand, candn, v, order[r]):
+                order[r + 1] = order[r]
+                r -= 1
+            order[r + 1] = v
+        nk = 0
+        for t in range(m):
+            ci = order[t]
+            s = candn[ci]
+            dom = False
+            for kk in range(nk):
+                # kept cut kk a subset of ci?
+                ks = cn[x, kk]
+                if ks > s:
+                    continue
+                p = 0
+                ok = True
+                for r in range(ks):
+                    v = cl[x, kk, r]
+                    while p < s and cand[ci, p] < v:
+                        p += 1
+                    if p >= s or cand[ci, p] != v:
+                        ok = False
+                        break
+                if ok:
+                    dom = True
+                    break
+            if dom:
+                continue
+            for r in range(s):
+                cl[x, nk, r] = cand[ci, r]
+            cn[x, nk] = s
+            nk += 1
+            if nk >= limit:
+                break
+        cl[x, nk, 0] = x
+        cn[x, nk] = 1
+        cc[x] = nk + 1
+    return cl, cn, cc
+
+
+def npn_arrays():
+    """The NPN look-up tables and the exact table of :mod:`mlc.logic.npn` as arrays
+    (cached): ``(lo, hi, perms, ands, ngates, gates, out_node, out_c)``."""
+    global _NPN
+    if _NPN is None:
+        from mlc.logic import npn
+        luts = npn._luts()
+        lo = np.array([l for l, _h in luts], dtype=np.int64)
+        hi = np.array([h for _l, h in luts], dtype=np.int64)
+        perms = np.array([p for p, _n, _x in npn._TRANSFORMS], dtype=np.int64)
+        negs = np.array([ng for _p, ng, _x in npn._TRANSFORMS], dtype=np.int64)
+        ands = np.full(1 << 16, 99, dtype=np.int64)
+        ngates = np.zeros(1 << 16, dtype=np.int64)
+        gates = np.zeros((1 << 16, 12, 5), dtype=np.int8)
+        out_node = np.zeros(1 << 16, dtype=np.int64)
+        out_c = np.zeros(1 << 16, dtype=np.int64)
+        for R, ent in npn.table().items():
+            ands[R] = ent["ands"]
+            ngates[R] = len(ent["gates"])
+            for t, gt in enumerate(ent["gates"]):
+                gates[R, t, :] = gt
+            out_node[R], out_c[R] = ent["out"]
+        _NPN = (lo, hi, perms, negs, ands, ngates, gates, out_node, out_c)
+    return _NPN
+
+
+_NPN = None
+
+
+@njit(cache=True)
+def cut_table(fa, fb, x, leaves, nl, tv, vis, stack, cstack):
+    """:func:`mlc.logic.opt.cut_table`: 16-bit table of ``x`` over ``leaves[:nl]``."""
+    VAR4 = (0xAAAA, 0xCCCC, 0xF0F0, 0xFF00)
+    nv = 0
+    for i in range(nl):
+        tv[leaves[i]] = VAR4[i]
+        vis[leaves[i]] = 1
+        stack[nv] = leaves[i]
+        nv += 1
+    cstack[0] = x
+    sp = 1
+    while sp > 0:
+        y = cstack[sp - 1]
+        if vis[y]:
+            sp -= 1
+            continue
+        ya = fa[y] >> 1
+        yb = fb[y] >> 1
+        if vis[ya] and vis[yb]:
+            sp -= 1
+            va = tv[ya] ^ 0xFFFF if fa[y] & 1 else tv[ya]
+            vb = tv[yb] ^ 0xFFFF if fb[y] & 1 else tv[yb]
+            tv[y] = va & vb
+            vis[y] = 1
+            stack[nv] = y
+            nv += 1
+            continue
+        if not vis[ya]:
+            cstack[sp] = ya
+            sp += 1
+        if not vis[yb]:
+            cstack[sp] = yb
+            sp += 1
+    r = tv[x]
+    for t in range(nv):
+        vis[stack[t]] = 0
+    return r
+
+
+@njit(cache=True)
+def npn_canon(f, lo, hi):
+    lo8 = f & 0xFF
+    hi8 = f >> 8
+    best = 1 << 17
+    for idx in range(lo.shape[0]):
+        g = lo[idx, lo8] | hi[idx, hi8]
+        if g < best:
+            best = g
+        h = g ^ 0xFFFF
+        if h < best:
+            best = h
+    return best
+
+
+@njit(cache=True)
+def rewrite_node(x, fa, fb, n, refs, touched, lev, cl, cn, cc, keys, hvals, M, zero_gain,
+                 lo, hi, perms, negs, ands, ngates, gates, out_node, out_c,
+                 mark, tv, vis, buf, res):
+    """The body of :func:`mlc.logic.opt.rewrite` for node ``x``, but building the
+    replacement: ``res[0]`` = 1 if a move is to be made (gain, and the zero-gain
+    depth rule passed), ``res[1]`` its class ``R``, ``res[2:6]`` the leaf literals,
+    ``res[6]`` the output complement, ``res[7]`` the cone size (cone in ``buf[1]``)."""
+    res[0] = 0
+    cone = buf[0]
+    stack = buf[2]
+    dec = buf[3]
+    bestcone = buf[1]
+    have = False
+    bgain = 0
+    bdep = 0
+    leaves = np.empty(4, dtype=np.int64)
+    lits = np.empty(20, dtype=np.int64)
+    dep = np.empty(20, dtype=np.int64)
+    seen = np.empty((1600, 5), dtype=np.int64)
+    for c in range(cc[x]):
+        s = cn[x, c]
+        if s < 2:
+            continue
+        skip = False
+        for t in range(s):
+            if touched[cl[x, c, t]]:
+                skip = True
+        if skip:
+            continue
+        for t in range(s):
+            mark[cl[x, c, t]] = 1
+            leaves[t] = cl[x, c, t]
+        nc = mffc(fa, fb, n, x, refs, mark, cone, stack, dec)
+        for t in range(s):
+            mark[cl[x, c, t]] = 0
+        for t in range(nc):
+            if touched[cone[t]]:
+                skip = True
+        if skip:
+            continue
+        f = cut_table(fa, fb, x, leaves, s, tv, vis, stack, buf[4])
+        R = npn_canon(f, lo, hi)
+        if ands[R] > nc or (ands[R] == nc and not zero_gain):
+            continue
+        for t in range(nc):
+            mark[cone[t]] = 2
+        ng = ngates[R]
+        nseen = 0
+        lo8 = f & 0xFF
+        hi8 = f >> 8
+        for idx in range(lo.shape[0]):
+            g = lo[idx, lo8] | hi[idx, hi8]
+            if g != R and g ^ 0xFFFF != R:
+                continue
+            out = 1 if g != R else 0
+            neg = negs[idx]
+            for i in range(4):
+                p = perms[idx, i]
+                lits[i] = (2 * leaves[p] if p < s else 0) ^ ((neg >> i) & 1)
+            dupl = False
+            for t in range(nseen):
+                if seen[t, 0] == lits[0] and seen[t, 1] == lits[1] and seen[t, 2] == lits[2] \
+                        and seen[t, 3] == lits[3] and seen[t, 4] == out:
+                    dupl = True
+                    break
+            if dupl:
+                continue
+            seen[nseen, 0] = lits[0]
+            seen[nseen, 1] = lits[1]
+            seen[nseen, 2] = lits[2]
+            seen[nseen, 3] = lits[3]
+            seen[nseen, 4] = out
+            nseen += 1
+            limit = nc - (0 if zero_gain else 1)
+            if have:
+                limit = min(limit, nc - bgain)
+            # _place_cost
+            new = 0
+            for t in range(ng):
+                j = gates[R, t, 0]
+                l = gates[R, t, 1]
+                a = lits[j]
+                b = lits[l]
+                r = -1
+                if a >= 0 and b >= 0:
+                    r = lookup(keys, hvals, M, a ^ gates[R, t, 2], b ^ gates[R, t, 3])
+                    if r >= 0 and (mark[r >> 1] == 2 or touched[r >> 1] or refs[r >> 1] == 0):
+                        r = -1
+                if r < 0:
+                    new += 1
+                    lits[4 + t] = -1
+                else:
+                    lits[4 + t] = r ^ gates[R, t, 4]
+            if new > limit:
+                continue
+            node = out_node[R]
+            if node < 0:
+                d = lev[0]
+            else:
+                for i in range(4):
+                    dep[i] = lev[lits[i] >> 1]
+                for t in range(ng):
+                    xl = lits[4 + t]
+                    if xl >= 0:
+                        dep[4 + t] = lev[xl >> 1]
+                    else:
+                        dep[4 + t] = 1 + max(dep[gates[R, t, 0]], dep[gates[R, t, 1]])
+                d = dep[node]
+            gain = nc - new
+            if not have or gain > bgain or (gain == bgain and -d > -bdep):
+                have = True
+                bgain = gain
+                bdep = d
+                res[1] = R
+                for i in range(4):
+                    res[2 + i] = seen[nseen - 1, i]
+                res[6] = out
+                res[7] = nc
+                for t in range(nc):
+                    bestcone[t] = cone[t]
+        for t in range(nc):
+            mark[cone[t]] = 0
+    if not have:
+        return
+    if bgain == 0 and -bdep <= -lev[x]:
+        return
+    res[0] = 1

@@ -1035,6 +1035,8 @@ def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> A
     n = g.num_inputs
     if not g.ands:
         return g
+    if KERNELS:
+        return _rewrite_nb(g, zero_gain, deadline)
     tab = npn.table()
     refs = refcounts(g)
     cuts = enumerate_cuts(g, limit=CUT_LIMIT)
@@ -1091,6 +1093,52 @@ def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> A
         repl[x] = best[1]
         for y in best[2]:
             touched[y] = 1
+    if not repl:
+        return g
+    return rebuild(g, repl)
+
+
+def _rewrite_nb(g: AIG, zero_gain: bool, deadline: float | None) -> AIG:
+    """:func:`rewrite` with its per-node work in :mod:`mlc.logic.kern` (the same moves)."""
+    import numpy as np
+    from mlc.logic import kern, npn
+    n = g.num_inputs
+    N = g.num_nodes
+    tab = npn.table()
+    fa, fb, _s, _l = kern.aig_arrays(g)
+    refs = np.array(refcounts(g), dtype=np.int64)
+    cl, cn, cc = kern.enumerate_cuts(fa, fb, n, N, 4, CUT_LIMIT)
+    keys, hvals = kern.strash_table(fa, fb, n, N)
+    lev = np.array(g.levels(), dtype=np.int64)
+    lo, hi, perms, negs, ands, ngates, gates, out_node, out_c = kern.npn_arrays()
+    tick = WIDE_TICK if n > TT_LIMIT else 1.0
+    touched = np.zeros(N, dtype=np.uint8)
+    mark = np.zeros(N + 1, dtype=np.int8)
+    vis = np.zeros(N + 1, dtype=np.int8)
+    tv = np.zeros(N + 1, dtype=np.int64)
+    buf = np.zeros((5, N + 2), dtype=np.int64)
+    res = np.zeros(8, dtype=np.int64)
+    M = 2 * N + 2
+    repl: dict[int, tuple] = {}
+    virt = _Virtual(g)
+    for x in range(n + 1, N):
+        if deadline is not None and work.now(N, tick) > deadline:
+            break
+        if touched[x] or refs[x] == 0:
+            continue
+        kern.rewrite_node(x, fa, fb, n, refs, touched, lev, cl, cn, cc, keys, hvals, M,
+                          zero_gain, lo, hi, perms, negs, ands, ngates, gates, out_node, out_c,
+                          mark, tv, vis, buf, res)
+        if not res[0]:
+            continue
+        cone = buf[1, :int(res[7])].tolist()
+        lits = [int(v) for v in res[2:6]]
+        e, _new = _place_class_circuit(g, tab[int(res[1])], lits, int(res[6]), set(cone),
+                                       touched, refs)
+        if not virt.accept(x, e):
+            continue
+        repl[x] = e
+        touched[cone] = 1
     if not repl:
         return g
     return rebuild(g, repl)
