@@ -112,3 +112,18 @@ def test_cuts_same():
             a, b = g.ands[rng.randrange(len(g.ands))]
         r = g.lookup(a, b)
         assert kern.lookup(keys, vals, M, a, b) == (-1 if r is None else r)
+
+
+@pytest.mark.parametrize("n_in", [5, 7, 11])
+def test_global_resub_same_network(n_in):
+    g = _random_aig(10 + n_in, n_in=n_in, n_and=150, n_out=6)
+    rng = random.Random(n_in)
+    full = (1 << (1 << n_in)) - 1
+    care = [full & ~rng.getrandbits(1 << n_in) & rng.getrandbits(1 << n_in) | (full if k % 2 else 0)
+            for k in range(len(g.outputs))]
+    for kw in ({}, {"care_out": care}, {"max_new": 1}):
+        ref, new = _both(opt.resub, g, **kw)
+        assert new.to_text() == ref.to_text()
+    ref, new = _both(opt.resub_odc, g, care_out=care)
+    assert new.to_text() == ref.to_text()
+    assert ref.num_ands() < g.num_ands()

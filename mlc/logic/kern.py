@@ -1279,3 +1279,27 @@ def rewrite_node(x, fa, fb, n, refs, touched, lev, cl, cn, cc, keys, hvals, M, z
     if bgain == 0 and -bdep <= -lev[x]:
         return
     res[0] = 1
+
+
+# ----------------------------------------------------------------------------- global tables
+
+def tables_array(vals, n: int):
+    """Truth tables over ``n`` variables (Python ints) as rows of a uint64 matrix."""
+    W = max(1, (1 << n) // 64)
+    nb = 8 * W
+    data = b"".join(v.to_bytes(nb, "little") for v in vals)
+    return np.frombuffer(data, dtype=np.uint64).reshape(-1, W), W
+
+
+def words(v: int, W: int):
+    return np.frombuffer(v.to_bytes(8 * W, "little"), dtype=np.uint64)
+
+
+@njit(cache=True)
+def find_resub_rows(tabs, W, f, care, divs, max_new, or_width):
+    """:func:`find_resub` with the divisors' tables in rows ``divs`` (their node ids)."""
+    out = np.zeros(6, dtype=np.int64)
+    vec = np.zeros((8, W), dtype=np.uint64)
+    buf = np.zeros((1, 1), dtype=np.int64)
+    _call_find(tabs, W, f, care, divs, divs, len(divs), max_new, or_width, out, buf, vec)
+    return out

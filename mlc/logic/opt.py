@@ -332,6 +332,11 @@ def resub(g: AIG, care_out: list[int] | None = None, max_new: int = 2, max_div: 
                 node_care[x] = full
     # output drivers whose function may change inside the don't cares are no divisors
     relaxed = {x for x, c in node_care.items() if c != full}
+    if KERNELS:
+        import numpy as np
+        from mlc.logic import kern
+        tabs, W = kern.tables_array(vals, n)
+        fullw = kern.words(full, W)
     touched = bytearray(g.num_nodes)
     repl: dict[int, tuple] = {}
     virt = _Virtual(g)
@@ -354,7 +359,12 @@ def resub(g: AIG, care_out: list[int] | None = None, max_new: int = 2, max_div: 
         divs = list(range(1, n + 1)) + [d for d in range(lo, hi) if d not in incone
                                         and not touched[d] and not tfo[d] and refs[d] > 0
                                         and d not in relaxed]
-        e = _find_resub(f, care, full, divs, vals, min(max_new, save - 1), or_width)
+        if KERNELS:
+            e = kern.decode(kern.find_resub_rows(
+                tabs, W, kern.words(f, W), fullw if care == full else kern.words(care, W),
+                np.array(divs, dtype=np.int64), min(max_new, save - 1), or_width))
+        else:
+            e = _find_resub(f, care, full, divs, vals, min(max_new, save - 1), or_width)
         if e is None or not virt.accept(x, e):
             continue
         repl[x] = e
@@ -395,8 +405,13 @@ def resub_odc(g: AIG, care_out: list[int] | None = None, max_new: int = 2,
     if n > TT_LIMIT or not g.ands or len(g.ands) > 400:
         return g
     full = T.mask(n)
+    if KERNELS:
+        import numpy as np
+        from mlc.logic import kern
     for _ in range(max_moves):
         vals = g.node_tables()
+        if KERNELS:
+            tabs, W = kern.tables_array(vals, n)
         refs = refcounts(g)
         N = g.num_nodes
         done = None
@@ -416,8 +431,13 @@ def resub_odc(g: AIG, care_out: list[int] | None = None, max_new: int = 2,
             tfo = tfo_mark(g, x, hi)
             divs = list(range(1, n + 1)) + [d for d in range(lo, hi) if d not in incone
                                             and not tfo[d] and refs[d] > 0]
-            e = _find_resub(vals[x] & care, care, full, divs, vals,
-                            min(max_new, len(cone) - 1), 16)
+            if KERNELS:
+                e = kern.decode(kern.find_resub_rows(
+                    tabs, W, kern.words(vals[x] & care, W), kern.words(care, W),
+                    np.array(divs, dtype=np.int64), min(max_new, len(cone) - 1), 16))
+            else:
+                e = _find_resub(vals[x] & care, care, full, divs, vals,
+                                min(max_new, len(cone) - 1), 16)
             if e is None:
                 continue
             done = (x, e)
