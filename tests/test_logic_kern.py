@@ -25,15 +25,32 @@ def _random_aig(seed: int, n_in: int = 20, n_and: int = 400, n_out: int = 12) ->
 
 
 def _both(fn, g, **kw):
-    old = opt.KERNELS
+    old = opt.KERNELS, opt.KERNEL_MIN_ANDS
     try:
         opt.KERNELS = False
         ref = fn(g, **kw)
-        opt.KERNELS = True
+        opt.KERNELS, opt.KERNEL_MIN_ANDS = True, 0
         new = fn(g, **kw)
     finally:
-        opt.KERNELS = old
+        opt.KERNELS, opt.KERNEL_MIN_ANDS = old
     return ref, new
+
+
+def test_warm_and_size_gate(monkeypatch):
+    assert kern.warm() >= 0.0
+    calls = []
+    monkeypatch.setattr(opt, "_rewrite_nb", lambda *a: calls.append(1) or a[0])
+    small = _random_aig(7, n_in=opt.TT_LIMIT, n_and=opt.KERNEL_MIN_ANDS - 20)
+    big = _random_aig(7, n_and=3 * opt.KERNEL_MIN_ANDS)
+    assert small.num_ands() < opt.KERNEL_MIN_ANDS <= big.num_ands()
+    opt.rewrite(small)
+    assert calls == []
+    opt.rewrite(big)
+    assert calls == [1]
+    wide = _random_aig(7, n_in=opt.TT_LIMIT + 1, n_and=opt.KERNEL_MIN_ANDS - 20)
+    assert wide.num_ands() < opt.KERNEL_MIN_ANDS
+    opt.rewrite(wide)
+    assert calls == [1, 1]
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
@@ -127,3 +144,12 @@ def test_global_resub_same_network(n_in):
     ref, new = _both(opt.resub_odc, g, care_out=care)
     assert new.to_text() == ref.to_text()
     assert ref.num_ands() < g.num_ands()
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_refactor_same_network(seed):
+    g = _random_aig(seed)
+    for kw in ({}, {"max_leaves": 10, "zero_gain": True}):
+        ref, new = _both(opt.refactor, g, **kw)
+        assert new.to_text() == ref.to_text()
+    assert ref.to_text() != g.to_text()

@@ -1303,3 +1303,33 @@ def find_resub_rows(tabs, W, f, care, divs, max_new, or_width):
     buf = np.zeros((1, 1), dtype=np.int64)
     _call_find(tabs, W, f, care, divs, divs, len(divs), max_new, or_width, out, buf, vec)
     return out
+
+
+def warm() -> float:
+    """Load (or compile) every kernel once, on a small network; seconds taken.  For
+    callers that time synthesis without numba's start-up (as Python's imports)."""
+    import time
+    from mlc.logic import opt
+    from mlc.logic.aig import AIG
+    t0 = time.perf_counter()
+    g = AIG([f"i{i}" for i in range(6)])
+    x = [g.input_lit(i) for i in range(6)]
+    a = g.and_(x[0], x[1])
+    b = g.and_(a, x[2])
+    c = g.and_(b ^ 1, g.and_(x[3], x[1]))
+    d = g.and_(g.and_(c, x[4]) ^ 1, g.and_(a, x[5]) ^ 1)
+    g.add_output("o0", d)
+    g.add_output("o1", b)
+    old = opt.KERNELS, opt.KERNEL_MIN_ANDS
+    opt.KERNELS, opt.KERNEL_MIN_ANDS = True, 0
+    try:
+        for h in (g, opt.rewrite(g)):
+            opt.rewrite(h, zero_gain=True)
+            opt.resub_window(h)
+            opt.resub_dc(h)
+            opt.resub(h)
+            opt.resub_odc(h)
+    finally:
+        opt.KERNELS, opt.KERNEL_MIN_ANDS = old
+    npn_arrays()
+    return time.perf_counter() - t0

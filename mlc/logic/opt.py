@@ -152,6 +152,7 @@ class _Virtual:
     def __init__(self, g: AIG):
         self.g = g
         self.repl_deps: dict[int, list[int]] = {}
+        self.min_repl = g.num_nodes      # the least replaced node (none yet: above all)
 
     def deps(self, x: int) -> list[int]:
         r = self.repl_deps.get(x)
@@ -170,21 +171,20 @@ class _Virtual:
             x = stack.pop()
             if x == target:
                 return True
-            if x in seen or x < target and x not in self.repl_deps and not self._any_repl_below:
+            # a node below the target and below every replaced node has only its own
+            # cone below it, all below the target: it cannot reach the target
+            if x in seen or x < target and x < self.min_repl:
                 continue
             seen.add(x)
             stack.extend(y for y in self.deps(x) if y > self.g.num_inputs)
         return False
-
-    @property
-    def _any_repl_below(self) -> bool:
-        return bool(self.repl_deps)
 
     def accept(self, x: int, e) -> bool:
         ds = _expr_nodes(e, [])
         if self.reaches(ds, x):
             return False
         self.repl_deps[x] = ds
+        self.min_repl = min(self.min_repl, x)
         return True
 
 
@@ -332,7 +332,8 @@ def resub(g: AIG, care_out: list[int] | None = None, max_new: int = 2, max_div: 
                 node_care[x] = full
     # output drivers whose function may change inside the don't cares are no divisors
     relaxed = {x for x, c in node_care.items() if c != full}
-    if KERNELS:
+    kernels = _use_kernels(g)
+    if kernels:
         import numpy as np
         from mlc.logic import kern
         tabs, W = kern.tables_array(vals, n)
@@ -359,7 +360,7 @@ def resub(g: AIG, care_out: list[int] | None = None, max_new: int = 2, max_div: 
         divs = list(range(1, n + 1)) + [d for d in range(lo, hi) if d not in incone
                                         and not touched[d] and not tfo[d] and refs[d] > 0
                                         and d not in relaxed]
-        if KERNELS:
+        if kernels:
             e = kern.decode(kern.find_resub_rows(
                 tabs, W, kern.words(f, W), fullw if care == full else kern.words(care, W),
                 np.array(divs, dtype=np.int64), min(max_new, save - 1), or_width))
@@ -405,12 +406,13 @@ def resub_odc(g: AIG, care_out: list[int] | None = None, max_new: int = 2,
     if n > TT_LIMIT or not g.ands or len(g.ands) > 400:
         return g
     full = T.mask(n)
-    if KERNELS:
+    kernels = _use_kernels(g)
+    if kernels:
         import numpy as np
         from mlc.logic import kern
     for _ in range(max_moves):
         vals = g.node_tables()
-        if KERNELS:
+        if kernels:
             tabs, W = kern.tables_array(vals, n)
         refs = refcounts(g)
         N = g.num_nodes
@@ -431,7 +433,7 @@ def resub_odc(g: AIG, care_out: list[int] | None = None, max_new: int = 2,
             tfo = tfo_mark(g, x, hi)
             divs = list(range(1, n + 1)) + [d for d in range(lo, hi) if d not in incone
                                             and not tfo[d] and refs[d] > 0]
-            if KERNELS:
+            if kernels:
                 e = kern.decode(kern.find_resub_rows(
                     tabs, W, kern.words(vals[x] & care, W), kern.words(care, W),
                     np.array(divs, dtype=np.int64), min(max_new, len(cone) - 1), 16))
@@ -497,7 +499,7 @@ def resub_window(g: AIG, max_leaves: int | None = None, max_new: int = 2, max_wi
     if max_window is None:
         max_window = WINDOW_SIZE
     tick = WIDE_TICK if n > TT_LIMIT else 1.0
-    if KERNELS and max_leaves <= 14:
+    if _use_kernels(g) and max_leaves <= 14:
         return _resub_window_nb(g, max_leaves, max_new, max_window, deadline, tick)
     refs = refcounts(g)
     fanouts: list[list[int]] = [[] for _ in range(g.num_nodes)]
@@ -627,7 +629,7 @@ def resub_dc(g: AIG, max_leaves: int | None = None, levels: int | None = None,
     if max_fanout is None:
         max_fanout = DC_FANOUT
     tick = WIDE_TICK if n > TT_LIMIT else 1.0
-    if KERNELS and max_leaves <= 14:
+    if _use_kernels(g) and max_leaves <= 14:
         return _resub_dc_nb(g, max_leaves, levels, max_fanout, max_window, max_new, deadline, tick)
     N = g.num_nodes
     ands = g.ands
@@ -1018,8 +1020,16 @@ def _place_cost(g: AIG, ent: dict, lits: list, incone: set[int], touched, refs, 
 
 CUT_LIMIT = 10
 STRUCT_VARIANTS = True
-# the windowed passes' per-node work in numba (mlc.logic.kern; the same networks)
+# the passes' per-node work in numba (mlc.logic.kern; the same networks), on networks
+# wider than TT_LIMIT inputs or of at least KERNEL_MIN_ANDS ANDs: below, Python is fast
+# enough, and synthesising a small function in a process that never calls a kernel saves
+# numba's start-up (0.4-0.5 s to load the cached kernels)
 KERNELS = True
+KERNEL_MIN_ANDS = 200
+
+
+def _use_kernels(g: AIG) -> bool:
+    return KERNELS and (g.num_inputs > TT_LIMIT or len(g.ands) >= KERNEL_MIN_ANDS)
 ROUNDS_BIG = 30
 # resub_window in the plain rounds of wide networks: 14-leaf cuts, windows of up to
 # 300 nodes (was 10 and 150; with WIDE_TICK, EPFL i2c 1105 -> 1050, max 2860 -> 2795,
@@ -1055,7 +1065,7 @@ def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> A
     n = g.num_inputs
     if not g.ands:
         return g
-    if KERNELS:
+    if _use_kernels(g):
         return _rewrite_nb(g, zero_gain, deadline)
     tab = npn.table()
     refs = refcounts(g)
@@ -1298,13 +1308,26 @@ def refactor(g: AIG, max_leaves: int = 8, zero_gain: bool = False,
     repl: dict[int, tuple] = {}
     virt = _Virtual(g)
     decs: dict[int, _Dec] = {}
+    # scratch AIG of each plan built in this pass (a plan is the memoised answer of
+    # _Dec.rec for one function; building it again gives the same AIG and adds nothing
+    # to the _Dec's available functions)
+    scratch: dict[int, AIG] = {}
     lev = None
+    kernels = _use_kernels(g) and max_leaves <= 14
+    if kernels:
+        from mlc.logic import kern
+        fa, fb, _s, _l = kern.aig_arrays(g)
+        ws = kern.Workspace(g.num_nodes, 6)
     for x in range(g.num_nodes - 1, n, -1):          # outputs first: large cones
         if deadline is not None and work.now(g.num_nodes) > deadline:
             break
         if touched[x] or refs[x] == 0:
             continue
-        leaves = reconv_cut(g, x, max_leaves)
+        if kernels:
+            leaves = kern.reconv_cut_py(fa, fb, n, x, max_leaves, ws.mark, ws.buf[0],
+                                        ws.buf[1]).tolist()
+        else:
+            leaves = reconv_cut(g, x, max_leaves)
         if len(leaves) < 3 or any(touched[y] for y in leaves):
             continue
         cone = mffc(g, x, refs, set(leaves))
@@ -1316,9 +1339,11 @@ def refactor(g: AIG, max_leaves: int = 8, zero_gain: bool = False,
         if d is None:
             d = decs[k] = _Dec(k, 2)
         _, plan = d.rec(f, T.mask(k))
-        s = AIG([f"l{i}" for i in range(k)])
-        s.add_output("f", d.build(s, plan))
-        s = s.cleanup()
+        s = scratch.get(id(plan))
+        if s is None:
+            s = AIG([f"l{i}" for i in range(k)])
+            s.add_output("f", d.build(s, plan))
+            s = scratch[id(plan)] = s.cleanup()
         e, new = _dag_expr(g, s, [2 * y for y in leaves], set(cone), touched, refs)
         if new > len(cone) or (new == len(cone) and not zero_gain):
             continue
