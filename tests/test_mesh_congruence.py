@@ -86,6 +86,24 @@ def test_isolated_work_is_capped():
     assert time.perf_counter() - t < 4
 
 
+def test_isolated_child_that_stalls_is_forked_again(tmp_path):
+    """A forked child asleep without CPU (a lock another thread held at the fork) is killed
+    and forked again within the time cap: the result comes back, not a cap (issue 10)."""
+    import time
+    from mlc.mesh import build as mb
+    flag = tmp_path / "first"
+
+    def work():
+        if not flag.exists():          # the first child stalls: sleeps forever, no CPU
+            flag.write_text("x")
+            time.sleep(60)
+        return 42
+    t = time.perf_counter()
+    assert mb._isolated(work, 20, 2 ** 30) == 42
+    assert time.perf_counter() - t < 15
+    assert flag.exists()
+
+
 def test_congruent_bodies_come_out_as_one_mesh(monkeypatch):
     """Large assemblies build each body in its own frame: the congruent half units of a chain
     (two units apart, and the two big slabs of a unit) are the same mesh moved, so they share

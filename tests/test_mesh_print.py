@@ -77,6 +77,25 @@ def test_wall_measure_finds_a_web_between_thick_blocks():
     assert thin_walls("blocks", _box([3, 3, 3], [0, 0, 0]) + _box([3, 3, 3], [5, 0, 0]), 0.6) == []
 
 
+def test_bounded_distance_transform_is_scipys_up_to_its_bound():
+    """The wall measure's distance transform (exact up to R cells, more than R beyond) gives
+    scipy's full Euclidean transform wherever that is at most R, on random masks (seeded)."""
+    from scipy import ndimage
+
+    from mlc.mesh.walls import _edt_upto
+    rng = np.random.default_rng(3)
+    for k in range(6):
+        shape = tuple(rng.integers(3, 30, 3))
+        mask = ndimage.binary_dilation(rng.random(shape) < 0.02 * (k + 1), iterations=2)
+        mask[0, 0, 0] = False           # scipy measures to a zero of the array: give it one
+        R = int(rng.integers(1, 7))
+        ref = ndimage.distance_transform_edt(mask)
+        got = _edt_upto(mask, R)
+        near = ref <= R
+        assert np.array_equal(got[near], ref[near]), k
+        assert np.all(got[~near] > R), k
+
+
 def test_wall_check_on_an_assembly():
     sc = ex.hinge_pair()
     good = build_assembly(sc, load_profile("mjp"), None, resolve=False)

@@ -1605,9 +1605,13 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
             if cong is None:
                 near = parts[i].solid.min_gap(parts[j].solid, c) < c - 1e-6
             else:     # one exact test per pair of shapes in one relative pose
-                near = cong.lookup(("gap", c, cong.key(i, parts[i].solid), cong.key(j, parts[j].solid),
+                # the gap itself, searched as far as the report's min_gap check searches and
+                # cached under its key: the check finds every pair the trims left alone cached
+                # (a gap under the clearance is the same number searched to c or to 2 c)
+                search = max(2 * c, 1e-3)
+                near = cong.lookup(("min_gap", search, cong.key(i, parts[i].solid), cong.key(j, parts[j].solid),
                                     cong.rel(i, j)),
-                                   lambda: parts[i].solid.min_gap(parts[j].solid, c) < c - 1e-6)
+                                   lambda: float(parts[i].solid.min_gap(parts[j].solid, search))) < c - 1e-6
             if near:
                 out.setdefault((i, j), []).append(None)
         llo, lhi = local_boxes([p.solid for p in parts], frames)
@@ -1633,7 +1637,7 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
                                        cong.rel(i, j, Tp[i], Tp[j])), lambda: meet(i, j))
                 if hit:
                     out.setdefault((i, j), []).append(T)
-            del posed
+            posed.clear()
         return out
 
     def settled(X, Xs, Y, sts):
@@ -1798,12 +1802,36 @@ def _best_mesh(cands, A):
             np.asarray(m.tri_verts, np.uint64).copy(), removed, not unsettled)
 
 
+#: a forked child that sleeps without using any CPU this long (s) is taken as deadlocked
+STALL_SECONDS = 1.0
+#: forks tried before a stalled pair counts as capped
+FORK_TRIES = 6
+
+
+def _cpu_state(pid: int):
+    """(state letter, user + system clock ticks) of process ``pid`` from /proc, or None."""
+    try:
+        with open(f"/proc/{pid}/stat") as f:
+            rest = f.read().rsplit(")", 1)[1].split()
+        return rest[0], int(rest[11]) + int(rest[12])
+    except (OSError, IndexError, ValueError):
+        return None
+
+
 def _isolated(fn, seconds: float, extra_bytes: float):
     """``fn()`` in a forked child whose address space may grow by ``extra_bytes`` and which may
     run ``seconds``; its (picklable) result, or None if it failed, ran out of memory or time.
-    Without ``os.fork`` (not Linux) ``fn()`` runs in this process."""
+    Without ``os.fork`` (not Linux) ``fn()`` runs in this process.
+
+    A child forked while another thread of this process (manifold3d's or the BLAS thread pool)
+    held a lock can wait on that lock forever: measured, about 1 fork in 30 after a large
+    boolean, and 3 of the Tetris circuit's 34 final trims, each then capped at ``seconds`` and
+    left untrimmed -- a different report from one run to the next.  A child asleep with no CPU
+    time used for :data:`STALL_SECONDS` is killed and forked again (up to :data:`FORK_TRIES`
+    times, within the same ``seconds``)."""
     import pickle
     import resource
+    import select
     import signal
     if not hasattr(os, "fork"):
         return fn()
@@ -1814,33 +1842,69 @@ def _isolated(fn, seconds: float, extra_bytes: float):
                 vm = int(ln.split()[1]) * 1024
     except OSError:
         return fn()
-    r, w = os.pipe()
-    pid = os.fork()
-    if pid == 0:       # child: never returns
-        code = 1
-        try:
-            os.close(r)
-            soft, hard = resource.getrlimit(resource.RLIMIT_AS)
-            cap = int(vm + extra_bytes)
-            if hard != resource.RLIM_INFINITY:
-                cap = min(cap, hard)
-            resource.setrlimit(resource.RLIMIT_AS, (cap, hard))
-            signal.alarm(max(1, int(np.ceil(seconds))))
-            data = pickle.dumps(fn(), protocol=pickle.HIGHEST_PROTOCOL)
-            with os.fdopen(w, "wb") as f:
-                f.write(data)
-            code = 0
-        except BaseException:
-            pass
-        finally:
-            os._exit(code)
-    os.close(w)
-    with os.fdopen(r, "rb") as f:
-        data = f.read()
-    _, status = os.waitpid(pid, 0)
-    if not (os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0) or not data:
-        return None
-    return pickle.loads(data)
+    deadline = time.monotonic() + seconds
+    for _try in range(FORK_TRIES):
+        left = deadline - time.monotonic()
+        if left <= 0:
+            return None
+        r, w = os.pipe()
+        pid = os.fork()
+        if pid == 0:       # child: never returns
+            code = 1
+            try:
+                os.close(r)
+                soft, hard = resource.getrlimit(resource.RLIMIT_AS)
+                cap = int(vm + extra_bytes)
+                if hard != resource.RLIM_INFINITY:
+                    cap = min(cap, hard)
+                resource.setrlimit(resource.RLIMIT_AS, (cap, hard))
+                signal.alarm(max(1, int(np.ceil(left))))
+                data = pickle.dumps(fn(), protocol=pickle.HIGHEST_PROTOCOL)
+                with os.fdopen(w, "wb") as f:
+                    f.write(data)
+                code = 0
+            except BaseException:
+                pass
+            finally:
+                os._exit(code)
+        os.close(w)
+        chunks = []
+        stalled = False
+        last = (None, time.monotonic())      # (CPU ticks, since when)
+        with os.fdopen(r, "rb", buffering=0) as f:
+            while True:
+                ready, _, _ = select.select([f], [], [], 0.2)
+                if ready:
+                    b = f.read(1 << 20)
+                    if not b:
+                        break                # end of file: the child is done
+                    chunks.append(b)
+                    last = (None, time.monotonic())
+                    continue
+                st = _cpu_state(pid)
+                now = time.monotonic()
+                if st is None or st[0] in "ZX":
+                    continue                 # exiting: its end of file comes next
+                if st[0] == "S" and st[1] == last[0]:
+                    if now - last[1] >= STALL_SECONDS:
+                        stalled = True
+                        break
+                elif st[1] != last[0] or st[0] != "S":
+                    last = (st[1], now)
+        if stalled:
+            try:
+                os.kill(pid, signal.SIGKILL)
+            except OSError:
+                pass
+            os.waitpid(pid, 0)
+            _log(f"  forked child stalled (no CPU for {STALL_SECONDS:g} s): forked again")
+            continue
+        data = b"".join(chunks)
+        _, status = os.waitpid(pid, 0)
+        if not (os.WIFEXITED(status) and os.WEXITSTATUS(status) == 0) or not data:
+            return None
+        return pickle.loads(data)
+    return None
 
 
 def _locked(A, B, protected: dict, fat: dict) -> bool:
