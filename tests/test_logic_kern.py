@@ -153,3 +153,21 @@ def test_refactor_same_network(seed):
         ref, new = _both(opt.refactor, g, **kw)
         assert new.to_text() == ref.to_text()
     assert ref.to_text() != g.to_text()
+
+
+def test_npn_canon_same():
+    from mlc.logic import npn
+    kern.aig_arrays(_random_aig(0, n_and=100))         # READY: npn.canon goes to numba
+    assert kern.READY
+    rng = random.Random(1)
+    lo, hi = kern.npn_arrays()[:2]
+    for f in [0, 0xFFFF, 0x8000, 0x6996, 0x1669] + [rng.getrandbits(16) for _ in range(300)]:
+        npn.canon.cache_clear()
+        got = npn.canon(f)
+        kern.READY = False
+        npn.canon.cache_clear()
+        ref = npn.canon(f)
+        kern.READY = True
+        assert got == ref
+        assert type(got[0]) is int and type(got[3]) is int
+    npn.canon.cache_clear()

@@ -23,8 +23,15 @@ _VARW = np.array([0xAAAAAAAAAAAAAAAA, 0xCCCCCCCCCCCCCCCC, 0xF0F0F0F0F0F0F0F0,
 MAX_LEAVES = 14
 
 
+# set once a kernel has run in this process (numba's start-up paid): from then on
+# npn.canon uses canon_index too
+READY = False
+
+
 def aig_arrays(g):
     """``(fa, fb, fo_start, fo_list)`` of AIG ``g`` (see the module docstring)."""
+    global READY
+    READY = True
     N = g.num_nodes
     n = g.num_inputs
     fa = np.full(N, -1, dtype=np.int64)
@@ -1333,3 +1340,26 @@ def warm() -> float:
         opt.KERNELS, opt.KERNEL_MIN_ANDS = old
     npn_arrays()
     return time.perf_counter() - t0
+
+
+@njit(cache=True)
+def canon_index(f, lo, hi):
+    """:func:`mlc.logic.npn.canon`'s search: ``(R, transform index, out)``, the first
+    transform reaching the least table (the table before its complement)."""
+    lo8 = f & 0xFF
+    hi8 = f >> 8
+    best = 1 << 17
+    bi = 0
+    bo = 0
+    for idx in range(lo.shape[0]):
+        g = lo[idx, lo8] | hi[idx, hi8]
+        if g < best:
+            best = g
+            bi = idx
+            bo = 0
+        h = g ^ 0xFFFF
+        if h < best:
+            best = h
+            bi = idx
+            bo = 1
+    return best, bi, bo

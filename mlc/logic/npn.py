@@ -66,6 +66,14 @@ def _luts() -> list[tuple[list[int], list[int]]]:
 def canon(f: int) -> tuple[int, tuple[int, ...], int, int]:
     """``(R, perm, neg, out)`` with R the least table of f's NPN class and
     ``f(x) = R(y) ^ out`` where ``y_i = x[perm[i]] ^ ((neg >> i) & 1)``."""
+    import sys
+    kern = sys.modules.get("mlc.logic.kern")
+    if kern is not None and kern.READY:
+        # the same search in numba, once a kernel has run (numba's start-up is paid)
+        lo, hi = kern.npn_arrays()[:2]
+        best, bi, bo = kern.canon_index(f, lo, hi)
+        perm, neg, _ = _TRANSFORMS[bi]
+        return int(best), perm, neg, int(bo)
     luts = _luts()
     lo8, hi8 = f & 0xFF, f >> 8
     best, bi, bo = 1 << 17, 0, 0

@@ -152,7 +152,9 @@ class _Virtual:
     def __init__(self, g: AIG):
         self.g = g
         self.repl_deps: dict[int, list[int]] = {}
-        self.min_repl = g.num_nodes      # the least replaced node (none yet: above all)
+        # the least replaced node with a dependency above itself (none yet: above all);
+        # every other edge of the virtual network goes down
+        self.min_up = g.num_nodes
 
     def deps(self, x: int) -> list[int]:
         r = self.repl_deps.get(x)
@@ -171,9 +173,10 @@ class _Virtual:
             x = stack.pop()
             if x == target:
                 return True
-            # a node below the target and below every replaced node has only its own
-            # cone below it, all below the target: it cannot reach the target
-            if x in seen or x < target and x < self.min_repl:
+            # a path from a node below the target up to the target needs an upward
+            # edge, i.e. a replaced node with a dependency above it, at or below the
+            # node (only downward edges lead there): none below min_up
+            if x in seen or x < target and x < self.min_up:
                 continue
             seen.add(x)
             stack.extend(y for y in self.deps(x) if y > self.g.num_inputs)
@@ -184,7 +187,8 @@ class _Virtual:
         if self.reaches(ds, x):
             return False
         self.repl_deps[x] = ds
-        self.min_repl = min(self.min_repl, x)
+        if x < self.min_up and any(d > x for d in ds):
+            self.min_up = x
         return True
 
 
