@@ -38,6 +38,7 @@ def _both(fn, g, **kw):
 
 def test_warm_and_size_gate(monkeypatch):
     assert kern.warm() >= 0.0
+    monkeypatch.setattr(kern, "READY", False)      # as in a process without numba yet
     calls = []
     monkeypatch.setattr(opt, "_rewrite_nb", lambda *a: calls.append(1) or a[0])
     small = _random_aig(7, n_in=opt.TT_LIMIT, n_and=opt.KERNEL_MIN_ANDS - 20)
@@ -51,6 +52,9 @@ def test_warm_and_size_gate(monkeypatch):
     assert wide.num_ands() < opt.KERNEL_MIN_ANDS
     opt.rewrite(wide)
     assert calls == [1, 1]
+    monkeypatch.setattr(kern, "READY", True)       # numba running: small ones too
+    opt.rewrite(small)
+    assert calls == [1, 1, 1]
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])

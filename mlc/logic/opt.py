@@ -17,6 +17,7 @@ Passes
 from __future__ import annotations
 
 import random
+import sys
 from heapq import heappop, heappush
 
 from mlc.spec import NetworkSpec, TableSpec
@@ -1025,15 +1026,20 @@ def _place_cost(g: AIG, ent: dict, lits: list, incone: set[int], touched, refs, 
 CUT_LIMIT = 10
 STRUCT_VARIANTS = True
 # the passes' per-node work in numba (mlc.logic.kern; the same networks), on networks
-# wider than TT_LIMIT inputs or of at least KERNEL_MIN_ANDS ANDs: below, Python is fast
-# enough, and synthesising a small function in a process that never calls a kernel saves
-# numba's start-up (0.4-0.5 s to load the cached kernels)
+# wider than TT_LIMIT inputs or of at least KERNEL_MIN_ANDS ANDs, and on any network
+# once numba runs in the process: synthesising a small function in a process that never
+# calls a kernel saves numba's start-up (0.4-0.5 s to load the cached kernels)
 KERNELS = True
 KERNEL_MIN_ANDS = 200
 
 
 def _use_kernels(g: AIG) -> bool:
-    return KERNELS and (g.num_inputs > TT_LIMIT or len(g.ands) >= KERNEL_MIN_ANDS)
+    if not KERNELS:
+        return False
+    if g.num_inputs > TT_LIMIT or len(g.ands) >= KERNEL_MIN_ANDS:
+        return True
+    kern = sys.modules.get("mlc.logic.kern")
+    return kern is not None and kern.READY
 ROUNDS_BIG = 30
 # resub_window in the plain rounds of wide networks: 14-leaf cuts, windows of up to
 # 300 nodes (was 10 and 150; with WIDE_TICK, EPFL i2c 1105 -> 1050, max 2860 -> 2795,
