@@ -606,6 +606,10 @@ class _Chain:
     gap: float = -math.inf
     plane: int = 0
 
+    def layers(self, route=None) -> np.ndarray:
+        """Layer centres of ``route`` (default the chain's own) as this chain's layers."""
+        return _layers(self.route if route is None else route, *self.geo_ext)
+
 
 def _layers(route, geo, ext: float) -> np.ndarray:
     """Layer centres of a routed chain whose last half unit's post is ``ext`` longer (sigma)."""
@@ -668,7 +672,7 @@ def _route_chain(ch: _Chain, lanes, space, space_clear: float) -> None:
     ch.route, ch.gap, ch.plane = route, gap, plane
     if route is not None:
         lanes.take(lane, plane)
-        space.add(_layers(route, *ch.geo_ext), ch.tag)
+        space.add(ch.layers(route), ch.tag)
 
 
 def _unplace(ch: _Chain, lanes, space) -> None:
@@ -691,7 +695,7 @@ def _rip_up(routed: dict, lanes, space, space_clear: float) -> list:
         ch.gap = ch.gap_of(ch.route)             # other chains may have moved since
         if ch.gap >= RIP_GAP:
             continue
-        _, owner = space.nearest_owner(_layers(ch.route, *ch.geo_ext)[ch.skip:], tag)
+        _, owner = space.nearest_owner(ch.layers()[ch.skip:], tag)
         if owner not in routed:              # a gate's points are nearest: nothing to move
             continue
         pair = [routed[owner], ch]
@@ -710,7 +714,7 @@ def _rip_up(routed: dict, lanes, space, space_clear: float) -> list:
             _unplace(c, lanes, space)
             c.route, c.gap, c.plane = route, gap, plane
             lanes.take(c.lane, plane)
-            space.add(_layers(route, *c.geo_ext), c.tag)
+            space.add(c.layers(route), c.tag)
     return done
 
 
