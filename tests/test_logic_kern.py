@@ -175,3 +175,16 @@ def test_npn_canon_same():
         assert got == ref
         assert type(got[0]) is int and type(got[3]) is int
     npn.canon.cache_clear()
+
+
+def test_table_rows_grow_on_demand(monkeypatch):
+    # few table rows at first: windows that may not fit are retried after grow()
+    monkeypatch.setattr(kern.Workspace, "ROWS", 40)
+    grown = []
+    real = kern.Workspace.grow
+    monkeypatch.setattr(kern.Workspace, "grow", lambda self: grown.append(1) or real(self))
+    g = _random_aig(1)
+    for fn in (opt.resub_window, opt.resub_dc):
+        ref, new = _both(fn, g)
+        assert new.to_text() == ref.to_text()
+    assert grown

@@ -71,9 +71,14 @@ def _fanouts(fa, fb, n, N):
 class Workspace:
     """Scratch arrays of the kernels for a network of ``N`` nodes (allocated once per pass)."""
 
+    # table rows allocated at first (a window needs at most its leaves, inside nodes and
+    # max_window more; the kernels answer -2 when a window may not fit, and the caller
+    # calls grow() and retries the node)
+    ROWS = 2048
+
     def __init__(self, N: int, max_leaves: int = MAX_LEAVES):
         wmax = max(1, (1 << max_leaves) // 64)
-        self.tabs = np.zeros((N + 2, wmax), dtype=np.uint64)
+        self.tabs = np.zeros((min(N + 2, self.ROWS), wmax), dtype=np.uint64)
         self.slot = np.full(N + 1, -1, dtype=np.int64)
         self.ids = np.zeros(N + 2, dtype=np.int64)
         self.mark = np.zeros(N + 1, dtype=np.int8)
@@ -81,6 +86,11 @@ class Workspace:
         self.buf = np.zeros((8, N + 2), dtype=np.int64)
         self.vec = np.zeros((8, wmax), dtype=np.uint64)
         self.out = np.zeros(6, dtype=np.int64)
+
+    def grow(self) -> None:
+        """Twice the table rows (at most one per node and two more)."""
+        rows = min(2 * self.tabs.shape[0], self.slot.shape[0] + 1)
+        self.tabs = np.zeros((rows, self.tabs.shape[1]), dtype=np.uint64)
 
 
 # ----------------------------------------------------------------------------- helpers
@@ -565,6 +575,9 @@ def window_node(x, fa, fb, n, fo_start, fo_list, refs, touched, max_leaves, max_
     for t in range(nc):
         if touched[cone[t]]:
             return
+    if k + max_window + 2 > tabs.shape[0] and tabs.shape[0] < slot.shape[0] + 1:
+        out[0] = -2              # more table rows needed: the caller enlarges and retries
+        return
     W = max(1, (1 << k) // 64)
     full = vec[0]
     set_leaves(tabs, W, k, full, leaves, slot, ids)
@@ -780,6 +793,9 @@ def dc_node(x, fa, fb, n, fo_start, fo_list, refs, touched, changed, read, is_po
         if touched[cone[t]]:
             return
     k = nl
+    if k + ni + max_window + 2 > tabs.shape[0] and tabs.shape[0] < slot.shape[0] + 1:
+        out[0] = -2              # more table rows needed: the caller enlarges and retries
+        return
     W = max(1, (1 << k) // 64)
     full = vec[0]
     set_leaves(tabs, W, k, full, leaves, slot, ids)

@@ -577,8 +577,13 @@ def _resub_window_nb(g: AIG, max_leaves: int, max_new: int, max_window: int,
             break
         if touched[x] or refs[x] == 0:
             continue
-        kern.window_node(x, fa, fb, n, fo_start, fo_list, refs, tv, max_leaves, max_window,
-                         max_new, ws.tabs, ws.slot, ws.ids, ws.mark, ws.seen, ws.buf, ws.vec, out)
+        while True:
+            kern.window_node(x, fa, fb, n, fo_start, fo_list, refs, tv, max_leaves, max_window,
+                             max_new, ws.tabs, ws.slot, ws.ids, ws.mark, ws.seen, ws.buf, ws.vec,
+                             out)
+            if out[0] != -2:
+                break
+            ws.grow()
         e = kern.decode(out)
         if e is None or not virt.accept(x, e):
             continue
@@ -781,7 +786,9 @@ def _resub_dc_nb(g: AIG, max_leaves: int, levels: int, max_fanout: int, max_wind
     changed = np.zeros(N, dtype=np.uint8)
     read = np.zeros(N, dtype=np.uint8)
     ws = kern.Workspace(N, max_leaves)
-    ftabs = np.zeros_like(ws.tabs)
+    # flipped tables of the fanout window: at most 1 + f + f^2 + ... nodes (f = max_fanout)
+    wmax = sum(max_fanout ** i for i in range(levels + 1))
+    ftabs = np.zeros((min(N + 2, wmax + 2), ws.tabs.shape[1]), dtype=np.uint64)
     fslot = np.full(N + 1, -1, dtype=np.int64)
     winmark = np.zeros(N + 1, dtype=np.int8)
     memo = np.zeros(N + 1, dtype=np.int8)
@@ -794,10 +801,15 @@ def _resub_dc_nb(g: AIG, max_leaves: int, levels: int, max_fanout: int, max_wind
             break
         if touched[x] or changed[x] or refs[x] == 0:
             continue
-        kern.dc_node(x, fa, fb, n, fo_start, fo_list, refs, touched, changed, read, is_po,
-                     max_leaves, levels, max_fanout, max_window, max_new, ws.tabs, ftabs,
-                     ws.slot, fslot, ws.ids, ws.mark, winmark, memo, ws.seen, ws.buf, ws.vec,
-                     out, lens)
+        while True:
+            kern.dc_node(x, fa, fb, n, fo_start, fo_list, refs, touched, changed, read, is_po,
+                         max_leaves, levels, max_fanout, max_window, max_new, ws.tabs, ftabs,
+                         ws.slot, fslot, ws.ids, ws.mark, winmark, memo, ws.seen, ws.buf, ws.vec,
+                         out, lens)
+            if out[0] != -2:
+                break
+            kern.dc_clear(ws.buf, lens, ws.mark, winmark)
+            ws.grow()
         e = kern.decode(out)
         if e is not None and virt.accept(x, e):
             repl[x] = e
