@@ -188,3 +188,18 @@ def test_table_rows_grow_on_demand(monkeypatch):
         ref, new = _both(fn, g)
         assert new.to_text() == ref.to_text()
     assert grown
+
+
+def test_mffc_same():
+    g = _random_aig(6)
+    fa, fb, _s, _l = kern.aig_arrays(g)
+    ws = kern.Workspace(g.num_nodes)
+    refs = opt.refcounts(g)
+    import numpy as np
+    r = np.array(refs, dtype=np.int64)
+    for x in range(g.num_inputs + 1, g.num_nodes):
+        if refs[x] == 0:
+            continue
+        k = kern.mffc(fa, fb, g.num_inputs, x, r, ws.mark, ws.buf[1], ws.buf[2], ws.buf[3])
+        assert sorted(ws.buf[1, :k].tolist()) == sorted(opt.mffc(g, x, refs))
+    assert r.tolist() == refs

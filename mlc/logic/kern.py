@@ -83,7 +83,8 @@ class Workspace:
         self.ids = np.zeros(N + 2, dtype=np.int64)
         self.mark = np.zeros(N + 1, dtype=np.int8)
         self.seen = np.zeros(N + 1, dtype=np.int8)
-        self.buf = np.zeros((8, N + 2), dtype=np.int64)
+        # (2N: an MFFC records up to two decrements per node, a DFS stack two per level)
+        self.buf = np.zeros((8, 2 * N + 4), dtype=np.int64)
         self.vec = np.zeros((8, wmax), dtype=np.uint64)
         self.out = np.zeros(6, dtype=np.int64)
 

@@ -1168,7 +1168,7 @@ def _rewrite_nb(g: AIG, zero_gain: bool, deadline: float | None) -> AIG:
     mark = np.zeros(N + 1, dtype=np.int8)
     vis = np.zeros(N + 1, dtype=np.int8)
     tv = np.zeros(N + 1, dtype=np.int64)
-    buf = np.zeros((5, N + 2), dtype=np.int64)
+    buf = np.zeros((5, 2 * N + 4), dtype=np.int64)    # (MFFC decrements, DFS stack: <= 2N)
     res = np.zeros(8, dtype=np.int64)
     M = 2 * N + 2
     repl: dict[int, tuple] = {}
