@@ -231,12 +231,13 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
                         posed[k] = transform_solid(parts[k].solid, Tp[k])
                 return float((posed[i] ^ posed[j]).volume())
 
-            for i, j in cand:
+            rels = cong.rel_many(cand, Tp) if cong is not None else None
+            for k, (i, j) in enumerate(cand):
                 if cong is None:
                     v = vol(i, j)
                 else:
                     v = cong.lookup(("volume", cong.key(i, parts[i].solid), cong.key(j, parts[j].solid),
-                                     cong.rel(i, j, Tp[i], Tp[j])), lambda: vol(i, j))
+                                     rels[k]), lambda: vol(i, j))
                 worst = max(worst, v)
                 if v > VOL_EPS:
                     fails.append(f"state {st}: {parts[i].name} intersects {parts[j].name} ({v:.4g} mm^3)")
@@ -442,6 +443,8 @@ def _retention(asm: Assembly) -> Check:
     for name, partners, d, jn, centre, Fc, size in tests:
         if cong is None:
             free = free_moves(name, partners, d, centre, Fc, size)
+        elif cores:     # the joint material first (its own cache key, in core_first)
+            free = core_first(name, partners, d, centre, Fc, size, jn in axis_names)
         else:       # once per congruent joint: the part, its partners where they are, the test box
             i = index[name]
             Fi = np.linalg.inv(cong.frames[i])
@@ -451,8 +454,7 @@ def _retention(asm: Assembly) -> Check:
                    tuple((cong.key(index[o], by[o].solid), cong.rel(i, index[o])) for o in partners),
                    np.round(Fi[:3, :3] @ _perp_frame(d) / 1e-7).astype(np.int64).tobytes(),
                    cong.rel(i, i, None, T @ np.linalg.inv(cong.frames[i])), tuple(np.round(size, 6).tolist()))
-            free = core_first(name, partners, d, centre, Fc, size, jn in axis_names) if cores else \
-                cong.lookup(key, lambda: free_moves(name, partners, d, centre, Fc, size))
+            free = cong.lookup(key, lambda: free_moves(name, partners, d, centre, Fc, size))
         for k, f in enumerate(free):
             n += 1
             if f:
