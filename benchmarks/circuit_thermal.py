@@ -29,6 +29,7 @@ import subprocess
 import time
 from pathlib import Path
 
+import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 
 from mlc.gates.connector import chain_scene

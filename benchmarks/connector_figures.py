@@ -16,6 +16,7 @@ import math
 import os
 import sys
 
+import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 
 HERE = os.path.dirname(os.path.abspath(__file__))

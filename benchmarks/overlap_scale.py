@@ -17,6 +17,7 @@ import sys
 import time
 from pathlib import Path
 
+import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]

@@ -24,6 +24,7 @@ import math
 import sys
 import time
 
+import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 
 

@@ -25,6 +25,7 @@ import json
 import math
 import sys
 
+import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 
 

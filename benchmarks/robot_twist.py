@@ -26,6 +26,7 @@ import math
 import sys
 import time
 
+import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 from mlc.io.atomic import atomic_path
 

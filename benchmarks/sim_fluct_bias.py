@@ -34,6 +34,7 @@ import sys
 import time
 from pathlib import Path
 
+import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 
 from mlc.sim.integrator import SimOptions, Simulation

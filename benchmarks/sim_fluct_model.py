@@ -21,6 +21,7 @@ import json
 import math
 from pathlib import Path
 
+import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 
 RESULTS = Path(__file__).resolve().parent / "results"

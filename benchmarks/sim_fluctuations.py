@@ -24,6 +24,7 @@ import math
 import os
 from pathlib import Path
 
+import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 from scipy.integrate import quad
 

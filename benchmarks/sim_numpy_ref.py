@@ -4,6 +4,7 @@ body sites), WCA between body centres (pairs from scipy's cKDTree, bonded pairs
 excluded), translation noise, torque-driven rotation by the exponential map."""
 from __future__ import annotations
 
+import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 from scipy.spatial import cKDTree
 

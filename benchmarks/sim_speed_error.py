@@ -33,6 +33,7 @@ import platform
 import time
 from pathlib import Path
 
+import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 
 from mlc.errors import MlcError

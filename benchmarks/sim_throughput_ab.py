@@ -21,6 +21,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 
 from mlc.sim import kernels as NK
