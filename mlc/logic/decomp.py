@@ -196,15 +196,7 @@ class _Dec:
             # Shannon on the variables whose cofactors are simplest
             scored = []
             for i in sup:
-                sh_, vi, ni = 1 << i, pos[i], neg[i]
-                t = f & ni
-                on0 = t | (t << sh_)
-                t = f & vi
-                on1 = t | (t >> sh_)
-                t = care & ni
-                c0 = t | (t << sh_)
-                t = care & vi
-                c1 = t | (t >> sh_)
+                on0, on1, _, _, c0, c1 = _cofactors(f, off, care, 1 << i, pos[i], neg[i])
                 s0 = len(self.reduce_support(on0, c0)[2])
                 s1 = len(self.reduce_support(on1, c1)[2])
                 noise = self.rng.random() * 3 if self.rng is not None else 0.0
