@@ -76,8 +76,14 @@ class _Dec:
         r = _support_cache.get(key)
         if r is not None:
             return r[0], r[1], list(r[2])
-        sup = []
         pos, neg = T.var_tables(n)
+        if care == self.full:
+            # completely specified (refactoring's cones, their cofactors): a variable
+            # can be dropped only where f does not depend on it
+            sup = [i for i in range(n) if ((f & pos[i]) >> (1 << i)) != (f & neg[i])]
+            _cache_put(_support_cache, key, (f, care, tuple(sup)))
+            return f, care, sup
+        sup = []
         for i in range(n):
             s = 1 << i
             vi, ni = pos[i], neg[i]

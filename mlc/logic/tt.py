@@ -84,14 +84,19 @@ def isop(lower: int, upper: int, n: int) -> tuple[list[Cube], int]:
     full = mask(n)
     if lower & ~upper & full:
         raise ValueError("isop: lower bound not contained in upper bound")
-    memo: dict[tuple[int, int, int], tuple[list[Cube], int]] = {}
+    memo: dict[tuple[int, int, int], tuple[object, int]] = {}
     pos, neg = var_tables(n)
+    taut = ()                    # the cover of the tautology: one empty cube
 
-    def rec(L: int, U: int, top: int) -> tuple[list[Cube], int]:
+    # A cover is built as a tree (None: empty; taut; (c0, c1, c2, bit): the cubes of
+    # c0 with !x_bit, of c1 with x_bit, then c2's) and listed once at the end: the same
+    # cubes in the same order as concatenating the lists at every level, without
+    # copying them once per level.
+    def rec(L: int, U: int, top: int) -> tuple[object, int]:
         if L == 0:
-            return [], 0
+            return None, 0
         if U == full:
-            return [(0, 0)], full
+            return taut, full
         key = (L, U, top)
         r = memo.get(key)
         if r is not None:
@@ -115,13 +120,25 @@ def isop(lower: int, upper: int, n: int) -> tuple[list[Cube], int]:
         c1, f1 = rec(L1 & ~U0 & full, U1, v)
         Ln = (L0 & ~f0 | L1 & ~f1) & full
         c2, f2 = rec(Ln, U0 & U1, v)
-        bit = 1 << v
-        cubes = [(p, q | bit) for p, q in c0] + [(p | bit, q) for p, q in c1] + c2
         f = f2 | (f0 & nx) | (f1 & x)
-        memo[key] = (cubes, f)
-        return cubes, f
+        r = memo[key] = ((c0, c1, c2, 1 << v), f)
+        return r
 
-    return rec(lower, upper, n)
+    tree, f = rec(lower, upper, n)
+    cubes: list[Cube] = []
+    stack = [(tree, 0, 0)]
+    while stack:
+        c, p, q = stack.pop()
+        if c is None:
+            continue
+        if c is taut:
+            cubes.append((p, q))
+            continue
+        c0, c1, c2, bit = c
+        stack.append((c2, p, q))
+        stack.append((c1, p | bit, q))
+        stack.append((c0, p, q | bit))
+    return cubes, f
 
 
 def cube_tt(c: Cube, n: int) -> int:

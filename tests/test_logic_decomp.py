@@ -1,0 +1,88 @@
+"""Truth-table helpers of the decomposition (mlc.logic.tt.isop, decomp._Dec.reduce_support):
+their fast paths give the same answers, in the same order, as the plain algorithms
+(refactoring's networks depend on both)."""
+import random
+
+from mlc.logic import decomp
+from mlc.logic import tt as T
+
+
+def _isop_lists(lower, upper, n):
+    """Minato-Morreale as it was written first: cube lists concatenated at every level."""
+    full = T.mask(n)
+    memo = {}
+
+    def rec(L, U, top):
+        if L == 0:
+            return [], 0
+        if U == full:
+            return [(0, 0)], full
+        if (L, U, top) in memo:
+            return memo[L, U, top]
+        v = top - 1
+        while not (T.depends(L, n, v) or T.depends(U, n, v)):
+            v -= 1
+        L0, L1 = T.cof0(L, n, v), T.cof1(L, n, v)
+        U0, U1 = T.cof0(U, n, v), T.cof1(U, n, v)
+        c0, f0 = rec(L0 & ~U1 & full, U0, v)
+        c1, f1 = rec(L1 & ~U0 & full, U1, v)
+        c2, f2 = rec((L0 & ~f0 | L1 & ~f1) & full, U0 & U1, v)
+        bit = 1 << v
+        cubes = [(p, q | bit) for p, q in c0] + [(p | bit, q) for p, q in c1] + c2
+        f = f2 | (f0 & T.nvar(n, v)) | (f1 & T.var(n, v))
+        memo[L, U, top] = (cubes, f)
+        return cubes, f
+
+    return rec(lower, upper, n)
+
+
+def test_isop_same_cubes_as_list_version_and_a_valid_cover():
+    rng = random.Random(16)
+    for _ in range(400):
+        n = rng.randint(0, 8)
+        full = T.mask(n)
+        lower = rng.getrandbits(1 << n) & rng.getrandbits(1 << n) & full
+        upper = (lower | (rng.getrandbits(1 << n) if rng.random() < 0.5 else 0)) & full
+        cubes, tab = T.isop(lower, upper, n)
+        assert (cubes, tab) == _isop_lists(lower, upper, n)
+        cover = 0
+        for c in cubes:
+            cover |= T.cube_tt(c, n)
+        assert cover == tab and lower & ~cover == 0 and cover & ~upper == 0
+        for j in range(len(cubes)):            # irredundant: no cube can be dropped
+            rest = 0
+            for c in cubes[:j] + cubes[j + 1:]:
+                rest |= T.cube_tt(c, n)
+            assert lower & ~rest
+
+
+def _support_general(n, f, care):
+    """reduce_support's loop for incompletely specified functions."""
+    sup = []
+    for i in range(n):
+        if not (T.depends(f, n, i) or T.depends(care, n, i)):
+            continue
+        on0, on1 = T.cof0(f, n, i), T.cof1(f, n, i)
+        off = care & ~f
+        of0, of1 = T.cof0(off, n, i), T.cof1(off, n, i)
+        if on0 & of1 == 0 and on1 & of0 == 0:
+            f, care = on0 | on1, T.cof0(care, n, i) | T.cof1(care, n, i)
+        else:
+            sup.append(i)
+    return f & care, care, sup
+
+
+def test_reduce_support_full_care_path_matches_general_loop():
+    rng = random.Random(12)
+    for _ in range(300):
+        n = rng.randint(1, 8)
+        full = T.mask(n)
+        f = rng.getrandbits(1 << n) & full
+        for i in range(n):                     # make some variables irrelevant
+            if rng.random() < 0.3:
+                f = T.cof0(f, n, i)
+        for care in (full, full & ~(rng.getrandbits(1 << n) & rng.getrandbits(1 << n))):
+            d = decomp._Dec(n, 2)
+            got = d.reduce_support(f & care, care)
+            assert got == _support_general(n, f & care, care)
+            assert d.reduce_support(f & care, care) == got          # from the cache
