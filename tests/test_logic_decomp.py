@@ -86,3 +86,23 @@ def test_reduce_support_full_care_path_matches_general_loop():
             got = d.reduce_support(f & care, care)
             assert got == _support_general(n, f & care, care)
             assert d.reduce_support(f & care, care) == got          # from the cache
+
+
+def test_factor_sop_tautology_cube_and_covers():
+    from mlc.logic.aig import AIG
+    from mlc.logic.lower import factor_sop
+    g = AIG(["a", "b", "c"])
+    lits = [2, 4, 6]
+    assert factor_sop(g, [(1, 0), (0, 0)], lits) == 1          # the empty cube
+    assert factor_sop(g, [[1, 0], [0, 0]], lits) == 1          # given as lists
+    assert factor_sop(g, [], lits) == 0
+    rng = random.Random(3)
+    for _ in range(100):                                       # the cover's function
+        cubes = [(p & ~q, q) for p, q in ((rng.getrandbits(3), rng.getrandbits(3))
+                                           for _ in range(rng.randint(1, 5)))]
+        h = AIG(["a", "b", "c"])
+        h.add_output("f", factor_sop(h, cubes, lits))
+        want = 0
+        for c in cubes:
+            want |= T.cube_tt(c, 3)
+        assert h.truth_tables()[0] == want

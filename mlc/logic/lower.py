@@ -31,7 +31,7 @@ def factor_sop(g: AIG, cubes: Sequence[tuple[int, int]], var_lits: Sequence[int]
     def rec(cs: list[tuple[int, int]]) -> int:
         if not cs:
             return 0
-        if any(p == 0 and q == 0 for p, q in cs):
+        if (0, 0) in cs:                       # the empty cube: a tautology
             return 1
         if len(cs) == 1:
             return cube_lit(*cs[0])
@@ -73,7 +73,7 @@ def factor_sop(g: AIG, cubes: Sequence[tuple[int, int]], var_lits: Sequence[int]
         t = g.and_(var_lits[i] ^ neg, rec(inside))
         return g.or_(t, rec(outside)) if outside else t
 
-    return rec(list(cs for cs in cubes))
+    return rec([(p, q) for p, q in cubes])       # tuples, as `(0, 0) in cs` compares
 
 
 def table_output(g: AIG, on: int, dc: int, n: int, var_lits: Sequence[int] | None = None,
