@@ -106,3 +106,18 @@ def test_factor_sop_tautology_cube_and_covers():
         for c in cubes:
             want |= T.cube_tt(c, 3)
         assert h.truth_tables()[0] == want
+
+
+def test_cofactors_off_set_from_care_and_on_set():
+    rng = random.Random(21)
+    for _ in range(300):
+        n = rng.randint(1, 8)
+        full = T.mask(n)
+        care = full & ~(rng.getrandbits(1 << n) & rng.getrandbits(1 << n))
+        f = rng.getrandbits(1 << n) & care
+        pos, neg = T.var_tables(n)
+        i = rng.randrange(n)
+        off = care & ~f
+        want = (T.cof0(f, n, i), T.cof1(f, n, i), T.cof0(off, n, i), T.cof1(off, n, i),
+                T.cof0(care, n, i), T.cof1(care, n, i))
+        assert decomp._cofactors(f, care, 1 << i, pos[i], neg[i]) == want

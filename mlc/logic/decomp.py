@@ -36,23 +36,20 @@ def _cache_put(cache: dict, key, value) -> None:
     cache[key] = value
 
 
-def _cofactors(f: int, off: int, care: int, s: int, vi: int, ni: int):
-    """The cofactors of the interval (on-set ``f``, off-set ``off``, care set ``care``)
-    with respect to variable ``i`` (``s = 1 << i``, ``vi``/``ni`` its positive and
-    negative tables), each spread over both halves: (on0, on1, of0, of1, c0, c1)."""
+def _cofactors(f: int, care: int, s: int, vi: int, ni: int):
+    """The cofactors of the interval (on-set ``f``, care set ``care``, off-set
+    ``care & ~f``) with respect to variable ``i`` (``s = 1 << i``, ``vi``/``ni`` its
+    positive and negative tables), each spread over both halves: (on0, on1, of0, of1,
+    c0, c1).  Spreading acts bit by bit, so the off-set's cofactors are ``c & ~on``."""
     t = f & ni
     on0 = t | (t << s)
     t = f & vi
     on1 = t | (t >> s)
-    t = off & ni
-    of0 = t | (t << s)
-    t = off & vi
-    of1 = t | (t >> s)
     t = care & ni
     c0 = t | (t << s)
     t = care & vi
     c1 = t | (t >> s)
-    return on0, on1, of0, of1, c0, c1
+    return on0, on1, c0 & ~on0, c1 & ~on1, c0, c1
 
 
 class _Dec:
@@ -89,7 +86,7 @@ class _Dec:
             vi, ni = pos[i], neg[i]
             if ((f & vi) >> s) == (f & ni) and ((care & vi) >> s) == (care & ni):
                 continue                      # depends on neither
-            on0, on1, of0, of1, c0, c1 = _cofactors(f, care & ~f, care, s, vi, ni)
+            on0, on1, of0, of1, c0, c1 = _cofactors(f, care, s, vi, ni)
             if on0 & of1 == 0 and on1 & of0 == 0:
                 # need not depend on i: merge the cofactors
                 f = on0 | on1
@@ -119,11 +116,10 @@ class _Dec:
         if not self.avail:
             return None
         n = self.n
-        off = care & ~f
         best = None
         pos, neg = T.var_tables(n)
         for i in sup:
-            on0, on1, of0, of1, c0, c1 = _cofactors(f, off, care, 1 << i, pos[i], neg[i])
+            on0, on1, of0, of1, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i])
             x = 2 * (i + 1)
             steps = []
             if on0 == 0:
@@ -173,11 +169,10 @@ class _Dec:
             return sh if sh is not None and sh[0] < ex[0] else ex
         if sh is not None:
             return sh
-        off = care & ~f
         pos, neg = T.var_tables(n)
         # disjoint-support steps
         for i in sup:
-            on0, on1, of0, of1, c0, c1 = _cofactors(f, off, care, 1 << i, pos[i], neg[i])
+            on0, on1, of0, of1, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i])
             x = 2 * (i + 1)
             if on0 == 0:                 # f = x & f1
                 c, p = self.rec(on1, c1)
@@ -202,7 +197,7 @@ class _Dec:
             # Shannon on the variables whose cofactors are simplest
             scored = []
             for i in sup:
-                on0, on1, _, _, c0, c1 = _cofactors(f, off, care, 1 << i, pos[i], neg[i])
+                on0, on1, _, _, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i])
                 s0 = len(self.reduce_support(on0, c0)[2])
                 s1 = len(self.reduce_support(on1, c1)[2])
                 noise = self.rng.random() * 3 if self.rng is not None else 0.0
