@@ -3,13 +3,17 @@
     python benchmarks/circuit_rows.py --width 3 --rows 8 --seed 0
 
 The all-zero and all-one rows are always checked, plus ``--rows`` - 2 others drawn with
-``--seed`` (numpy default_rng) from the rest.  Per row: every probe's bit, the joint
+``--seed`` (numpy default_rng) from the rest.  With ``--rest NAME`` every row not yet in the
+result files ``--done`` (default circuit_rows_w<width>*.json) is checked instead, and the
+results are written after each row to benchmarks/results/circuit_rows_w<width>_NAME.json
+(so a stopped run keeps its rows).  Per row: every probe's bit, the joint
 stretch, the smallest slab clearance (exact oriented-box test) and its pair.  Writes
 benchmarks/results/circuit_rows_w<width>.json.  Times are wall seconds on this machine.
 """
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import os
 import subprocess
@@ -20,8 +24,10 @@ import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.
 import numpy as np
 
 from mlc.circuit.build import build_circuit
+from mlc.io.atomic import atomic_path
 from mlc.logic.library import ripple_adder
 from mlc.pipeline import compile_spec
+from mlc.scene.io import dump_scene
 from mlc.verify.circuit import verify_static
 
 OUT = Path(__file__).resolve().parent / "results"
@@ -32,6 +38,8 @@ def main():
     ap.add_argument("--width", type=int, default=3)
     ap.add_argument("--rows", type=int, default=8)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--rest", default=None, help="check every row not in the --done files; name of the output")
+    ap.add_argument("--done", nargs="*", default=None, help="result files whose rows are done (default: all of this width)")
     args = ap.parse_args()
     spec = ripple_adder(args.width)
     c = compile_spec(spec)
@@ -45,22 +53,45 @@ def main():
     rng = np.random.default_rng(args.seed)
     pick = sorted(rng.choice(len(rest), size=min(len(rest), max(0, args.rows - 2)), replace=False))
     rows = ["0" * n] + [rest[i] for i in pick] + ["1" * n]
+    name = f"circuit_rows_w{args.width}.json"
+    if args.rest:
+        done_files = ([Path(f) for f in args.done] if args.done is not None
+                      else sorted(OUT.glob(f"circuit_rows_w{args.width}*.json")))
+        name = f"circuit_rows_w{args.width}_{args.rest}.json"
+        done = set()
+        for f in done_files:
+            if f.name == name:
+                continue
+            d = json.loads(f.read_text())
+            if d.get("bodies") != len(sc.bodies):
+                raise SystemExit(f"{f}: built {d.get('bodies')} bodies, this build {len(sc.bodies)}: not the same circuit")
+            done |= {r["row"] for r in d["rows"]}
+        rows = [format(i, f"0{n}b") for i in range(2 ** n) if format(i, f"0{n}b") not in done]
+        print(f"{len(done)} rows done in {', '.join(f.name for f in done_files)}; {len(rows)} to check", flush=True)
+    git = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
+                         cwd=Path(__file__).resolve().parent).stdout.strip()
     out = []
+
+    def result():
+        return {"width": args.width, "seed": None if args.rest else args.seed, "git": git, "load": load0,
+                "bodies": len(sc.bodies), "scene_sha256": hashlib.sha256(dump_scene(sc).encode()).hexdigest()[:16],
+                "build_s": t_build, "tight_chains": sc.meta["connector"]["tight_chains"],
+                "rerouted": sc.meta["connector"].get("rerouted", []), "rows": out,
+                "all_ok": all(r["ok"] for r in out),
+                "min_clearance": min((r["clearance"] for r in out if r["clearance"] is not None), default=None)}
+    OUT.mkdir(exist_ok=True)
     for row in rows:
         rep = verify_static(sc, rows=[row])
         r = rep.rows[0]
         out.append({"row": row, "ok": rep.ok, "seconds": r["seconds"], "clearance": r.get("clearance"),
                     "clearance_pair": r.get("clearance_pair"), "joint_stretch": r["joint_stretch"]})
         print(json.dumps(out[-1]), flush=True)
-    git = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                         cwd=Path(__file__).resolve().parent).stdout.strip()
-    res = {"width": args.width, "seed": args.seed, "git": git, "load": load0, "bodies": len(sc.bodies),
-           "build_s": t_build, "tight_chains": sc.meta["connector"]["tight_chains"],
-           "rerouted": sc.meta["connector"].get("rerouted", []), "rows": out,
-           "all_ok": all(r["ok"] for r in out),
-           "min_clearance": min(r["clearance"] for r in out if r["clearance"] is not None)}
-    OUT.mkdir(exist_ok=True)
-    (OUT / f"circuit_rows_w{args.width}.json").write_text(json.dumps(res, indent=1))
+        if args.rest:
+            with atomic_path(OUT / name) as tmp:
+                Path(tmp).write_text(json.dumps(result(), indent=1))
+    res = result()
+    with atomic_path(OUT / name) as tmp:
+        Path(tmp).write_text(json.dumps(res, indent=1))
     print(json.dumps({k: v for k, v in res.items() if k != "rows"}))
 
 
