@@ -29,6 +29,8 @@ import tempfile
 import time
 from pathlib import Path
 
+import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
