@@ -21,7 +21,6 @@ import os as _os
 import sys as _sys
 
 
-
 def _avx2_fma() -> bool:
     """True on an x86-64 Linux CPU that lists the avx2 and fma flags (OpenBLAS's Haswell kernels run there)."""
     import platform
