@@ -42,6 +42,23 @@ OUT = ROOT / "benchmarks" / "results" / "circuit_dynamic.json"
 DEFAULT = ("tetris.tt", "full_adder.expr", "mux4.blif")
 
 
+def scene_key(sc, res: dict) -> str:
+    """The scene's key: sha256 prefix of its text with ``meta.source`` relative to the checkout
+    (so clones at other paths resume the same runs); a key of the older kind (the absolute
+    path in the text) is kept when the results already hold it."""
+    legacy = hashlib.sha256(dump_scene(sc).encode()).hexdigest()[:16]
+    if legacy in res["scenes"]:
+        return legacy
+    src = sc.meta.get("source")
+    if isinstance(src, str) and Path(src).is_absolute():
+        try:
+            sc.meta["source"] = str(Path(src).resolve().relative_to(ROOT))
+            return hashlib.sha256(dump_scene(sc).encode()).hexdigest()[:16]
+        finally:
+            sc.meta["source"] = src
+    return legacy
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--only", nargs="*", default=list(DEFAULT), help="example file names")
@@ -60,7 +77,7 @@ def main():
         compiled = build(compile_spec(load(str(ROOT / "examples" / name))),
                          options=CircuitOptions(joint_k=args.joint_k))
         sc = compiled.circuit.scene
-        key = hashlib.sha256(dump_scene(sc).encode()).hexdigest()[:16]
+        key = scene_key(sc, res)
         info = res["scenes"].get(key)
         if info is None:
             info = {"example": name, "bodies": len(sc.bodies), "tau": None, "commit": commit,
