@@ -231,25 +231,32 @@ def _and_row(tabs, W, full, r, ra, ca, rb, cb):
         tabs[r, w] = va & vb
 
 
+@njit(cache=True, inline="always")
+def _push_fanouts(fo_start, fo_list, node, top, seen, seenlist, ns):
+    """Appends the fanouts of ``node`` up to ``top`` not yet ``seen`` to ``seenlist``
+    (from index ``ns``) and marks them; returns the new length."""
+    for p in range(fo_start[node], fo_start[node + 1]):
+        z = fo_list[p]
+        if z <= top and seen[z] == 0:
+            seen[z] = 1
+            seenlist[ns] = z
+            ns += 1
+    return ns
+
+
 @njit(cache=True)
 def grow_window(fa, fb, n, fo_start, fo_list, tabs, W, full, slot, ids, nrows,
                 leaves, k, top, max_window, changed, use_changed, winmark, use_win, seen, seenlist):
     """:func:`mlc.logic.opt._grow_window`: rows appended from ``nrows``; returns the
     new row count.  The heap is a forward scan (nodes come off it in increasing order)."""
-    pending = 0
     ns = 0
-    lo = 1 << 62
     for t in range(k):
-        leaf = leaves[t]
-        for p in range(fo_start[leaf], fo_start[leaf + 1]):
-            z = fo_list[p]
-            if z <= top and seen[z] == 0:
-                seen[z] = 1
-                seenlist[ns] = z
-                ns += 1
-                pending += 1
-                if z < lo:
-                    lo = z
+        ns = _push_fanouts(fo_start, fo_list, leaves[t], top, seen, seenlist, ns)
+    pending = ns
+    lo = 1 << 62
+    for t in range(ns):
+        if seenlist[t] < lo:
+            lo = seenlist[t]
     size = nrows
     y = lo
     while pending > 0 and size < max_window:
@@ -277,13 +284,9 @@ def grow_window(fa, fb, n, fo_start, fo_list, tabs, W, full, slot, ids, nrows,
         ids[nrows] = cy
         nrows += 1
         size += 1
-        for p in range(fo_start[cy], fo_start[cy + 1]):
-            z = fo_list[p]
-            if z <= top and seen[z] == 0:
-                seen[z] = 1
-                seenlist[ns] = z
-                ns += 1
-                pending += 1
+        ns2 = _push_fanouts(fo_start, fo_list, cy, top, seen, seenlist, ns)
+        pending += ns2 - ns
+        ns = ns2
     for t in range(ns):
         seen[seenlist[t]] = 0
     return nrows
