@@ -193,6 +193,46 @@ class _Virtual:
         return True
 
 
+class _Pass:
+    """The skeleton of the local passes: :meth:`nodes` visits the live nodes not
+    ``touched`` by an accepted move (each visit one tick of the work clock, stopping past
+    ``deadline`` in virtual seconds), :meth:`replace` keeps a replacement that
+    :class:`_Virtual` accepts and marks its freed cone, :meth:`result` rebuilds."""
+
+    def __init__(self, g: AIG, touched, refs, deadline: float | None, tick: float = 1.0):
+        self.g = g
+        self.touched = touched
+        self.refs = refs
+        self.deadline = deadline
+        self.tick = tick
+        self.repl: dict[int, tuple] = {}
+        self.virt = _Virtual(g)
+
+    def nodes(self, order=None):
+        """The AND nodes in ``order`` (default: inputs to outputs) still worth a visit."""
+        N = self.g.num_nodes
+        touched, refs = self.touched, self.refs
+        for x in range(self.g.num_inputs + 1, N) if order is None else order:
+            if self.deadline is not None and work.now(N, self.tick) > self.deadline:
+                return
+            if touched[x] or refs[x] == 0:
+                continue
+            yield x
+
+    def replace(self, x: int, e, cone=()) -> bool:
+        """Replace ``x`` by expression ``e`` (None: no move) and mark ``cone`` touched;
+        False where there is no move or it would make a cycle."""
+        if e is None or not self.virt.accept(x, e):
+            return False
+        self.repl[x] = e
+        for y in cone:
+            self.touched[y] = 1
+        return True
+
+    def result(self) -> AIG:
+        return rebuild(self.g, self.repl) if self.repl else self.g
+
+
 def reorder(g: AIG, rng: random.Random | None = None) -> AIG:
     """Re-number nodes in DFS order from the outputs (optionally shuffled order)."""
     h = AIG(g.inputs)
@@ -344,15 +384,10 @@ def resub(g: AIG, care_out: list[int] | None = None, max_new: int = 2, max_div: 
         tabs, W = kern.tables_array(vals, n)
         fullw = kern.words(full, W)
     touched = bytearray(g.num_nodes)
-    repl: dict[int, tuple] = {}
-    virt = _Virtual(g)
+    ps = _Pass(g, touched, refs, deadline)
     N = g.num_nodes
     or_width = 16 if len(g.ands) < 300 else 2
-    for x in range(n + 1, N):
-        if deadline is not None and work.now(g.num_nodes) > deadline:
-            break
-        if touched[x] or refs[x] == 0:
-            continue
+    for x in ps.nodes():
         cone = mffc(g, x, refs)
         save = len(cone)
         if any(touched[y] for y in cone):
@@ -371,14 +406,8 @@ def resub(g: AIG, care_out: list[int] | None = None, max_new: int = 2, max_div: 
                 np.array(divs, dtype=np.int64), min(max_new, save - 1), or_width))
         else:
             e = _find_resub(f, care, full, divs, vals, min(max_new, save - 1), or_width)
-        if e is None or not virt.accept(x, e):
-            continue
-        repl[x] = e
-        for y in cone:
-            touched[y] = 1
-    if not repl:
-        return g
-    return rebuild(g, repl)
+        ps.replace(x, e, cone)
+    return ps.result()
 
 
 def odc_care(g: AIG, x: int, vals: list[int], care_out: list[int] | None, full: int) -> int:
@@ -514,13 +543,8 @@ def resub_window(g: AIG, max_leaves: int | None = None, max_new: int = 2, max_wi
         if (b >> 1) != (a >> 1):
             fanouts[b >> 1].append(x)
     touched = bytearray(g.num_nodes)
-    repl: dict[int, tuple] = {}
-    virt = _Virtual(g)
-    for x in range(n + 1, g.num_nodes):
-        if deadline is not None and work.now(g.num_nodes, tick) > deadline:
-            break
-        if touched[x] or refs[x] == 0:
-            continue
+    ps = _Pass(g, touched, refs, deadline, tick)
+    for x in ps.nodes():
         leaves = reconv_cut(g, x, max_leaves)
         if any(touched[y] for y in leaves):
             continue
@@ -546,14 +570,8 @@ def resub_window(g: AIG, max_leaves: int | None = None, max_new: int = 2, max_wi
         bad |= tfo
         divs = [d for d in sorted(vals) if d not in bad and not touched[d] and refs[d] > 0]
         e = _find_resub(vals[x], full, full, divs, vals, min(max_new, len(cone) - 1), 8)
-        if e is None or not virt.accept(x, e):
-            continue
-        repl[x] = e
-        for y in cone:
-            touched[y] = 1
-    if not repl:
-        return g
-    return rebuild(g, repl)
+        ps.replace(x, e, cone)
+    return ps.result()
 
 
 def _resub_window_nb(g: AIG, max_leaves: int, max_new: int, max_window: int,
@@ -570,13 +588,8 @@ def _resub_window_nb(g: AIG, max_leaves: int, max_new: int, max_window: int,
     ws = kern.Workspace(N, max_leaves)
     out = ws.out
     cone_buf = ws.buf[1]
-    repl: dict[int, tuple] = {}
-    virt = _Virtual(g)
-    for x in range(n + 1, N):
-        if deadline is not None and work.now(N, tick) > deadline:
-            break
-        if touched[x] or refs[x] == 0:
-            continue
+    ps = _Pass(g, touched, refs, deadline, tick)
+    for x in ps.nodes():
         while True:
             kern.window_node(x, fa, fb, n, fo_start, fo_list, refs, tv, max_leaves, max_window,
                              max_new, ws.tabs, ws.slot, ws.ids, ws.mark, ws.seen, ws.buf, ws.vec,
@@ -585,14 +598,9 @@ def _resub_window_nb(g: AIG, max_leaves: int, max_new: int, max_window: int,
                 break
             ws.grow()
         e = kern.decode(out)
-        if e is None or not virt.accept(x, e):
-            continue
-        repl[x] = e
-        for y in cone_buf[:int(out[5])].tolist():
-            touched[y] = 1
-    if not repl:
-        return g
-    return rebuild(g, repl)
+        if e is not None:
+            ps.replace(x, e, cone_buf[:int(out[5])].tolist())
+    return ps.result()
 
 
 def _in_tfo(g: AIG, x: int, v: int, memo: dict[int, bool], budget: list[int]) -> bool:
@@ -656,12 +664,9 @@ def resub_dc(g: AIG, max_leaves: int | None = None, levels: int | None = None,
     touched = bytearray(N)       # the freed cones of accepted moves
     changed = bytearray(N)       # nodes whose function an accepted move changed
     read = bytearray(N)          # nodes whose function an accepted move relies on
-    repl: dict[int, tuple] = {}
-    virt = _Virtual(g)
-    for x in range(n + 1, N):
-        if deadline is not None and work.now(N, tick) > deadline:
-            break
-        if touched[x] or changed[x] or refs[x] == 0:
+    ps = _Pass(g, touched, refs, deadline, tick)
+    for x in ps.nodes():
+        if changed[x]:
             continue
         # the fanout window: nodes up to `levels` levels above x whose fanins in
         # the fanout of x are all in the window (then every leaf below is outside it)
@@ -742,11 +747,8 @@ def resub_dc(g: AIG, max_leaves: int | None = None, levels: int | None = None,
         divs = [d for d in sorted(vals) if d not in win and d not in incone and not touched[d]
                 and not changed[d] and refs[d] > 0]
         e = _find_resub(vals[x] & care, care, full, divs, vals, min(max_new, len(cone) - 1), 8)
-        if e is None or not virt.accept(x, e):
+        if not ps.replace(x, e, cone):
             continue
-        repl[x] = e
-        for y in cone:
-            touched[y] = 1
         for y in win:
             if y not in rootset:
                 changed[y] = 1
@@ -765,9 +767,7 @@ def resub_dc(g: AIG, max_leaves: int | None = None, levels: int | None = None,
             if y > n:
                 a, b = ands[y - n - 1]
                 stack += [a >> 1, b >> 1]
-    if not repl:
-        return g
-    return rebuild(g, repl)
+    return ps.result()
 
 
 def _resub_dc_nb(g: AIG, max_leaves: int, levels: int, max_fanout: int, max_window: int,
@@ -794,12 +794,9 @@ def _resub_dc_nb(g: AIG, max_leaves: int, levels: int, max_fanout: int, max_wind
     memo = np.zeros(N + 1, dtype=np.int8)
     lens = np.zeros(4, dtype=np.int64)
     out = ws.out
-    repl: dict[int, tuple] = {}
-    virt = _Virtual(g)
-    for x in range(n + 1, N):
-        if deadline is not None and work.now(N, tick) > deadline:
-            break
-        if touched[x] or changed[x] or refs[x] == 0:
+    ps = _Pass(g, touched, refs, deadline, tick)
+    for x in ps.nodes():
+        if changed[x]:
             continue
         while True:
             kern.dc_node(x, fa, fb, n, fo_start, fo_list, refs, touched, changed, read, is_po,
@@ -811,14 +808,11 @@ def _resub_dc_nb(g: AIG, max_leaves: int, levels: int, max_fanout: int, max_wind
             kern.dc_clear(ws.buf, lens, ws.mark, winmark)
             ws.grow()
         e = kern.decode(out)
-        if e is not None and virt.accept(x, e):
-            repl[x] = e
+        if ps.replace(x, e):
             kern.dc_commit(x, fa, fb, n, touched, changed, read, ws.buf, lens, winmark,
                            np.array(_expr_nodes(e, []), dtype=np.int64))
         kern.dc_clear(ws.buf, lens, ws.mark, winmark)
-    if not repl:
-        return g
-    return rebuild(g, repl)
+    return ps.result()
 
 
 def _find_resub(f: int, care: int, full: int, divs: list[int], vals: list[int], max_new: int,
@@ -1095,13 +1089,8 @@ def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> A
     lev = g.levels()
     tick = WIDE_TICK if n > TT_LIMIT else 1.0
     touched = bytearray(g.num_nodes)
-    repl: dict[int, tuple] = {}
-    virt = _Virtual(g)
-    for x in range(n + 1, g.num_nodes):
-        if deadline is not None and work.now(g.num_nodes, tick) > deadline:
-            break
-        if touched[x] or refs[x] == 0:
-            continue
+    ps = _Pass(g, touched, refs, deadline, tick)
+    for x in ps.nodes():
         best = None
         for c in cuts[x]:
             if len(c) < 2 or c == (x,):
@@ -1140,14 +1129,8 @@ def rewrite(g: AIG, zero_gain: bool = False, deadline: float | None = None) -> A
             continue
         if best[0][0] == 0 and best[0][1] <= -lev[x]:
             continue                       # zero gain must at least not worsen depth
-        if not virt.accept(x, best[1]):
-            continue
-        repl[x] = best[1]
-        for y in best[2]:
-            touched[y] = 1
-    if not repl:
-        return g
-    return rebuild(g, repl)
+        ps.replace(x, best[1], best[2])
+    return ps.result()
 
 
 def _rewrite_nb(g: AIG, zero_gain: bool, deadline: float | None) -> AIG:
@@ -1171,13 +1154,8 @@ def _rewrite_nb(g: AIG, zero_gain: bool, deadline: float | None) -> AIG:
     buf = np.zeros((5, 2 * N + 4), dtype=np.int64)    # (MFFC decrements, DFS stack: <= 2N)
     res = np.zeros(8, dtype=np.int64)
     M = 2 * N + 2
-    repl: dict[int, tuple] = {}
-    virt = _Virtual(g)
-    for x in range(n + 1, N):
-        if deadline is not None and work.now(N, tick) > deadline:
-            break
-        if touched[x] or refs[x] == 0:
-            continue
+    ps = _Pass(g, touched, refs, deadline, tick)
+    for x in ps.nodes():
         kern.rewrite_node(x, fa, fb, n, refs, touched, lev, cl, cn, cc, keys, hvals, M,
                           zero_gain, lo, hi, perms, negs, ands, ngates, gates, out_node, out_c,
                           mark, tv, vis, buf, res)
@@ -1187,13 +1165,8 @@ def _rewrite_nb(g: AIG, zero_gain: bool, deadline: float | None) -> AIG:
         lits = [int(v) for v in res[2:6]]
         e, _new = _place_class_circuit(g, tab[int(res[1])], lits, int(res[6]), set(cone),
                                        touched, refs)
-        if not virt.accept(x, e):
-            continue
-        repl[x] = e
-        touched[cone] = 1
-    if not repl:
-        return g
-    return rebuild(g, repl)
+        ps.replace(x, e, cone)
+    return ps.result()
 
 
 def _neg(e, c):
@@ -1327,8 +1300,7 @@ def refactor(g: AIG, max_leaves: int = 8, zero_gain: bool = False,
         return g
     refs = refcounts(g)
     touched = bytearray(g.num_nodes)
-    repl: dict[int, tuple] = {}
-    virt = _Virtual(g)
+    ps = _Pass(g, touched, refs, deadline)
     decs: dict[int, _Dec] = {}
     # scratch AIG of each plan built in this pass (a plan is the memoised answer of
     # _Dec.rec for one function; building it again gives the same AIG and adds nothing
@@ -1340,11 +1312,7 @@ def refactor(g: AIG, max_leaves: int = 8, zero_gain: bool = False,
         from mlc.logic import kern
         fa, fb, _s, _l = kern.aig_arrays(g)
         ws = kern.Workspace(g.num_nodes, 6)
-    for x in range(g.num_nodes - 1, n, -1):          # outputs first: large cones
-        if deadline is not None and work.now(g.num_nodes) > deadline:
-            break
-        if touched[x] or refs[x] == 0:
-            continue
+    for x in ps.nodes(range(g.num_nodes - 1, n, -1)):      # outputs first: large cones
         if kernels:
             leaves = kern.reconv_cut_py(fa, fb, n, x, max_leaves, ws.mark, ws.buf[0],
                                         ws.buf[1]).tolist()
@@ -1374,14 +1342,8 @@ def refactor(g: AIG, max_leaves: int = 8, zero_gain: bool = False,
                 lev = g.levels()
             if _expr_depth(e, lev) >= lev[x]:
                 continue
-        if not virt.accept(x, e):
-            continue
-        repl[x] = e
-        for y in cone:
-            touched[y] = 1
-    if not repl:
-        return g
-    return rebuild(g, repl)
+        ps.replace(x, e, cone)
+    return ps.result()
 
 
 # ----------------------------------------------------------------------------- balance
