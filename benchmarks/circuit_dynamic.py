@@ -12,7 +12,10 @@ margin, the relaxation time (t0) and the wall time.
                                          [--joint-k 100] [--rows 000 101]
 
 ``--joint-k K`` builds the circuit as ``mlc compile --joint-k K`` does (connector joints K
-times stiffer); ``--rows`` limits the rows run.
+times stiffer; default: mlc compile's default, 100 k0 since 2026-11-25; runs before that
+date used 1 unless they record ``joint_k``); ``--rows`` limits the rows run; ``--out F``
+writes to F instead (runs already in circuit_dynamic.json are skipped as well), so two
+campaigns can run at once without overwriting each other.
 
 Writes benchmarks/results/circuit_dynamic.json after every run and resumes from it (a
 (example, row, seed) already recorded for the same scene is skipped), so a long
@@ -33,6 +36,7 @@ import time
 from pathlib import Path
 
 from mlc.circuit.build import CircuitOptions
+from mlc.io.atomic import atomic_path
 from mlc.pipeline import build, compile_spec, load
 from mlc.scene.io import dump_scene
 from mlc.verify.dynamic import check_scene_dynamic_multi
@@ -65,14 +69,20 @@ def main():
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("--kT", type=float, default=1e-5)
     ap.add_argument("--scheme", default="stiff", choices=("stiff", "euler"))
-    ap.add_argument("--joint-k", type=float, default=1.0, help="connector joint stiffness (k0), as mlc compile")
+    ap.add_argument("--joint-k", type=float, default=CircuitOptions().joint_k,
+                    help="connector joint stiffness (k0), as mlc compile (default: its default)")
+    ap.add_argument("--out", type=Path, default=OUT,
+                    help="results file (default benchmarks/results/circuit_dynamic.json); runs already in "
+                         "circuit_dynamic.json are skipped too, so two campaigns can run at once on two files")
     ap.add_argument("--rows", nargs="*", default=None, help="rows to run (default all)")
     ap.add_argument("--reuse-tau", action="store_true",
                     help="use the scene's tau recorded by an earlier run (default: the verifier's signal_time)")
     args = ap.parse_args()
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
                             text=True).stdout.strip()
-    res = json.loads(OUT.read_text()) if OUT.exists() else {"runs": [], "scenes": {}}
+    out = args.out
+    res = json.loads(out.read_text()) if out.exists() else {"runs": [], "scenes": {}}
+    main_runs = json.loads(OUT.read_text())["runs"] if out != OUT and OUT.exists() else []
     for name in args.only:
         compiled = build(compile_spec(load(str(ROOT / "examples" / name))),
                          options=CircuitOptions(joint_k=args.joint_k))
@@ -83,7 +93,7 @@ def main():
             info = {"example": name, "bodies": len(sc.bodies), "tau": None, "commit": commit,
                     "joint_k": args.joint_k}
             res["scenes"][key] = info
-        done = {(r["scene"], r["state"], r["seed"]) for r in res["runs"] if "tau" in r or args.reuse_tau}
+        done = {(r["scene"], r["state"], r["seed"]) for r in res["runs"] + main_runs if "tau" in r or args.reuse_tau}
         for seed in range(args.seeds):
             for state in sc.states():
                 if (key, state, seed) in done or (args.rows and state not in args.rows):
@@ -103,11 +113,12 @@ def main():
                        "commit": commit, "load": list(os.getloadavg())}
                 res["runs"].append(run)
                 res["machine"] = {"platform": platform.platform(), "cpus": os.cpu_count()}
-                OUT.write_text(json.dumps(res, indent=1))
+                with atomic_path(out) as tmp:
+                    tmp.write_text(json.dumps(res, indent=1))
                 print(f"{name} row {state} seed {seed}: {'right' if run['ok'] else 'WRONG'}, relaxed at "
                       f"{run['relax_time']:.1f} t0, {wall:.0f} s", flush=True)
     rows = [r for r in res["runs"]]
-    print(f"{sum(r['ok'] for r in rows)}/{len(rows)} runs right; wrote {OUT}")
+    print(f"{sum(r['ok'] for r in rows)}/{len(rows)} runs right; wrote {out}")
 
 
 if __name__ == "__main__":
