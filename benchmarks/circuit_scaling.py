@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import argparse
 import json
+import math
 import os
 import platform
 import time
@@ -30,6 +31,7 @@ import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.
 import numpy as np
 
 from mlc.circuit.build import build_circuit
+from mlc.io.atomic import atomic_path
 from mlc.logic.library import ripple_adder
 from mlc.pipeline import compile_spec
 from mlc.verify.circuit import verify_dynamic, verify_static
@@ -57,13 +59,53 @@ def adder_point(w: int) -> dict:
             "clearance": rep.rows[0].get("clearance"), "joint_stretch": rep.rows[0]["joint_stretch"]}
 
 
+def fit_and_goals(points: list[dict]):
+    """(fit, goals, extrapolated): power-law exponents of build CPU/wall time and one row's
+    static check against bodies, and of bodies against gates; the goals (None when no point
+    has 200 gates); and, when no point reaches 200 gates, the power laws carried to 200
+    gates (bodies, build CPU s, one row's check s, and each time over its goal).  A straight
+    line in log-log through a few small adders: an order of magnitude, not a prediction."""
+    g = np.array([p["gates"] for p in points], float)
+    b = np.array([p["bodies"] for p in points], float)
+    tb = np.array([p["build_s"] for p in points])
+    cb = np.array([p["build_cpu_s"] for p in points])
+    tv = np.array([p["verify_row_s"] for p in points])
+    fit, extra = {}, None
+    if len(points) >= 3:
+        fit["build_exponent_in_bodies"] = float(np.polyfit(np.log(b), np.log(tb), 1)[0])
+        fit["build_cpu_exponent_in_bodies"] = float(np.polyfit(np.log(b), np.log(cb), 1)[0])
+        fit["verify_exponent_in_bodies"] = float(np.polyfit(np.log(b), np.log(tv), 1)[0])
+        fit["bodies_exponent_in_gates"] = float(np.polyfit(np.log(g), np.log(b), 1)[0])
+    biggest = max(points, key=lambda p: p["gates"])
+    goals = {"build_200_gates_under_2s": None, "verify_row_200_gates_under_10s": None}
+    if biggest["gates"] >= 200:
+        goals = {"build_200_gates_under_2s": biggest["build_s"] < 2.0,
+                 "verify_row_200_gates_under_10s": biggest["verify_row_s"] < 10.0}
+    elif len(points) >= 3:
+        lb = np.polyval(np.polyfit(np.log(g), np.log(b), 1), math.log(200.0))
+        build_cpu = float(np.exp(np.polyval(np.polyfit(np.log(b), np.log(cb), 1), lb)))
+        verify = float(np.exp(np.polyval(np.polyfit(np.log(b), np.log(tv), 1), lb)))
+        extra = {"from_gates": [int(x) for x in g], "bodies": float(np.exp(lb)), "build_cpu_s": build_cpu,
+                 "verify_row_s": verify, "build_over_goal": build_cpu / 2.0, "verify_over_goal": verify / 10.0}
+    return fit, goals, extra
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--max-width", type=int, default=30)
     ap.add_argument("--widths", type=int, nargs="*")
     ap.add_argument("--skip-dynamic", action="store_true")
     ap.add_argument("--budget", type=float, default=1800.0, help="stop growing after this many seconds")
+    ap.add_argument("--refit", action="store_true",
+                    help="recompute fit, goals and extrapolation from the committed JSON's points; run nothing")
     args = ap.parse_args()
+    if args.refit:
+        res = json.loads((OUT / "circuit_scaling.json").read_text())
+        res["fit"], res["goals"], res["extrapolated_200_gates"] = fit_and_goals(res["adders"])
+        with atomic_path(OUT / "circuit_scaling.json") as tmp:
+            tmp.write_text(json.dumps(res, indent=1))
+        print(json.dumps({k: res[k] for k in ("fit", "goals", "extrapolated_200_gates")}, indent=1))
+        return
     widths = args.widths or [w for w in (1, 2, 3, 4, 6, 8, 12, 16, 20, 25, 30) if w <= args.max_width]
     points = []
     t_all = time.perf_counter()
@@ -95,20 +137,14 @@ def main():
     b = np.array([p["bodies"] for p in points], float)
     tb = np.array([p["build_s"] for p in points])
     tv = np.array([p["verify_row_s"] for p in points])
-    fit = {}
-    if len(points) >= 3:
-        fit["build_exponent_in_bodies"] = float(np.polyfit(np.log(b), np.log(tb), 1)[0])
-        fit["verify_exponent_in_bodies"] = float(np.polyfit(np.log(b), np.log(tv), 1)[0])
-    biggest = points[-1]
-    goals = {"build_200_gates_under_2s": None, "verify_row_200_gates_under_10s": None}
-    if biggest["gates"] >= 200:
-        goals = {"build_200_gates_under_2s": biggest["build_s"] < 2.0,
-                 "verify_row_200_gates_under_10s": biggest["verify_row_s"] < 10.0}
+    fit, goals, extra = fit_and_goals(points)
     res = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
                        "load": os.getloadavg()[0] if hasattr(os, "getloadavg") else None},
-           "adders": points, "dynamic_full_adder": dyn, "fit": fit, "goals": goals}
+           "adders": points, "dynamic_full_adder": dyn, "fit": fit, "goals": goals,
+           "extrapolated_200_gates": extra}
     OUT.mkdir(exist_ok=True)
-    (OUT / "circuit_scaling.json").write_text(json.dumps(res, indent=1))
+    with atomic_path(OUT / "circuit_scaling.json") as tmp:
+        tmp.write_text(json.dumps(res, indent=1))
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
