@@ -203,3 +203,79 @@ def test_mffc_same():
         k = kern.mffc(fa, fb, g.num_inputs, x, r, ws.mark, ws.buf[1], ws.buf[2], ws.buf[3])
         assert sorted(ws.buf[1, :k].tolist()) == sorted(opt.mffc(g, x, refs))
     assert r.tolist() == refs
+
+
+def _sop_reference(f, care, n):
+    """decomp._Dec._sop_plan's Python work: tt.isop of each phase, factor_sop's count."""
+    from mlc.logic import tt as T
+    from mlc.logic.lower import factor_sop
+    full = T.mask(n)
+    out = []
+    for on in (f, care & ~f):
+        cubes, _ = T.isop(on, on | (full & ~care), n)
+        g = AIG([f"x{i}" for i in range(n)])
+        factor_sop(g, cubes, [2 * (i + 1) for i in range(n)])
+        out.append((g.num_ands(), cubes))
+    return tuple(out)
+
+
+def test_sop_costs_same_as_isop_and_factor_sop(monkeypatch):
+    from mlc.logic import decomp
+    from mlc.logic import tt as T
+    monkeypatch.setattr(kern, "READY", True)
+    rng = random.Random(5)
+    cases = []
+    for n in range(1, kern.SOP_MAX_VARS + 1):
+        full = T.mask(n)
+        parity = 0
+        for m in range(1 << n):
+            parity |= (bin(m).count("1") & 1) << m
+        cases += [(0, full, n), (full, full, n), (parity, full, n)]     # 2^(n-1) cubes
+        for _ in range(40):
+            f = rng.getrandbits(1 << n)
+            for _ in range(rng.randint(0, 3)):                          # sparser, structured
+                f &= rng.getrandbits(1 << n) | rng.getrandbits(1 << n)
+            care = full if rng.random() < 0.4 else (rng.getrandbits(1 << n)
+                                                      | rng.getrandbits(1 << n))
+            cases.append((f & care, care, n))
+    for f, care, n in cases:
+        got = kern.sop_costs(f, care, n)
+        assert got == _sop_reference(f, care, n), (f, care, n)
+        full = T.mask(n)
+        for (_k, cubes), on in zip(got, (f, care & ~f)):
+            cover = 0
+            for c in cubes:
+                cover |= T.cube_tt(c, n)
+            assert cover & care == on                  # the cover is in the interval
+        plans = []
+        for on in (False, True):                       # _Dec's choice of phase (ties: on-set)
+            monkeypatch.setattr(opt, "KERNELS", on)
+            plans.append(decomp._Dec(n, 2)._sop_plan(f, care))
+        assert plans[0] == plans[1]
+
+
+@pytest.mark.parametrize("seed", [0, 1])
+def test_refactor_decomposition_kernel_same_network(seed, monkeypatch):
+    # the decomposition's caches are cleared between the paths, so that the kernel
+    # path computes its factored-SOP costs itself (kern.sop_costs) instead of reading
+    # the Python path's
+    from mlc.logic import decomp
+    calls = []
+    real = kern.sop_costs
+    monkeypatch.setattr(kern, "sop_costs", lambda *a: calls.append(1) or real(*a))
+    g = _random_aig(seed + 10)
+    for kw in ({}, {"max_leaves": 10, "zero_gain": True}):
+        texts = []
+        for on in (False, True):
+            for c in (decomp._support_cache, decomp._sop_cache, decomp._exact_cache):
+                c.clear()
+            old = opt.KERNELS, opt.KERNEL_MIN_ANDS
+            opt.KERNELS, opt.KERNEL_MIN_ANDS = on, 0
+            try:
+                n_calls = len(calls)
+                texts.append(opt.refactor(g, **kw).to_text())
+                assert (len(calls) > n_calls) == on
+            finally:
+                opt.KERNELS, opt.KERNEL_MIN_ANDS = old
+        assert texts[0] == texts[1]
+    assert texts[0] != g.to_text()

@@ -14,6 +14,8 @@ Sub-results are memoised by (function, care set), so equal cofactors are shared.
 """
 from __future__ import annotations
 
+import sys
+
 from mlc.spec import TableSpec
 from mlc.logic import npn
 from mlc.logic import tt as T
@@ -28,6 +30,19 @@ _CACHE_MAX = 200_000
 _support_cache: dict = {}
 _sop_cache: dict = {}
 _exact_cache: dict = {}
+
+
+def _kernels(n: int):
+    """:mod:`mlc.logic.kern` where its kernels serve a decomposition over ``n``
+    variables: numba already running in the process (``kern.READY``), kernels not
+    switched off (``opt.KERNELS``) and ``n <= kern.SOP_MAX_VARS``; else None."""
+    kern = sys.modules.get("mlc.logic.kern")
+    if kern is None or not kern.READY or n > kern.SOP_MAX_VARS:
+        return None
+    opt = sys.modules.get("mlc.logic.opt")
+    if opt is not None and not opt.KERNELS:
+        return None
+    return kern
 
 
 def _cache_put(cache: dict, key, value) -> None:
@@ -222,6 +237,11 @@ class _Dec:
 
     def _sop_plan(self, f: int, care: int):
         n, full = self.n, self.full
+        kern = _kernels(n)
+        if kern is not None:
+            # the same covers and counts in numba (kern.sop_costs); the on-set wins ties
+            (k0, cs0), (k1, cs1) = kern.sop_costs(f, care, n)
+            return (k0, ("sop", cs0, 0)) if k0 <= k1 else (k1, ("sop", cs1, 1))
         cubes, _ = T.isop(f, f | (full & ~care), n)
         off = care & ~f
         cubes_n, _ = T.isop(off, off | (full & ~care), n)

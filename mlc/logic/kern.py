@@ -1383,3 +1383,419 @@ def canon_index(f, lo, hi):
             bi = idx
             bo = 1
     return best, bi, bo
+
+
+# ----------------------------------------------------------------------------- factored-SOP costing
+
+# refactoring's decompositions have at most 10 variables (its largest cuts); wider
+# tables (TableSpec decompositions) keep the Python path
+SOP_MAX_VARS = 10
+
+
+def sop_costs(f: int, care: int, n: int):
+    """:meth:`mlc.logic.decomp._Dec._sop_plan`'s work for the interval (on-set ``f``,
+    care set ``care``; Python ints over ``n <= SOP_MAX_VARS`` variables): the irredundant
+    SOP of each phase (:func:`mlc.logic.tt.isop`'s cubes, in its order) and the AND count
+    of its factored form (:func:`mlc.logic.lower.factor_sop` into an empty AIG of ``n``
+    inputs).  Returns ``((ands, cubes) of the on-set, (ands, cubes) of the off-set)``,
+    cubes as lists of ``(pos_mask, neg_mask)``."""
+    W = max(1, (1 << n) >> 6)
+    full = (1 << (1 << n)) - 1
+    off = care & ~f
+    dc = full & ~care
+    nb = 8 * W
+    words = [np.frombuffer(t.to_bytes(nb, "little"), dtype="<u8").astype(np.uint64)
+             for t in (f, f | dc, off, off | dc)]
+    fullw = np.frombuffer(full.to_bytes(nb, "little"), dtype="<u8").astype(np.uint64)
+    out = []
+    for L, U in ((words[0], words[1]), (words[2], words[3])):
+        k, P, Q, m = _sop_phase(L, U, n, W, fullw)
+        out.append((int(k), list(zip(P[:m].tolist(), Q[:m].tolist()))))
+    return out[0], out[1]
+
+
+@njit(cache=True)
+def _tw_depends(t, v, W):
+    """Whether table ``t`` (``W`` words) depends on variable ``v``."""
+    if v < 6:
+        s = np.uint64(1 << v)
+        x = _VARW[v]
+        for w in range(W):
+            if ((t[w] & x) >> s) != (t[w] & ~x):
+                return True
+        return False
+    st = 1 << (v - 6)
+    for w in range(W):
+        if w & st == 0 and t[w] != t[w | st]:
+            return True
+    return False
+
+
+@njit(cache=True)
+def _tw_cof(t, v, W, pos):
+    """The cofactor of ``t`` for variable ``v`` = ``pos``, spread over both halves."""
+    r = np.empty(W, dtype=np.uint64)
+    if v < 6:
+        s = np.uint64(1 << v)
+        x = _VARW[v]
+        for w in range(W):
+            if pos:
+                u = t[w] & x
+                r[w] = u | (u >> s)
+            else:
+                u = t[w] & ~x
+                r[w] = u | (u << s)
+    else:
+        st = 1 << (v - 6)
+        for w in range(W):
+            r[w] = t[w | st] if pos else t[w & ~st]
+    return r
+
+
+@njit(cache=True)
+def _isop(L, U, n, W, full, outp, outq):
+    """:func:`mlc.logic.tt.isop`'s recursion on word tables, with an explicit stack
+    (numba's disk cache does not hold recursive functions) and without its memo (a
+    repeated interval gives the same cubes): the cubes go to ``outp``/``outq`` in the
+    order ``tt.isop`` lists them; returns their number."""
+    D = n + 2
+    SL = np.empty((D, W), dtype=np.uint64)
+    SU = np.empty((D, W), dtype=np.uint64)
+    L0 = np.empty((D, W), dtype=np.uint64)
+    L1 = np.empty((D, W), dtype=np.uint64)
+    U0 = np.empty((D, W), dtype=np.uint64)
+    U1 = np.empty((D, W), dtype=np.uint64)
+    F0 = np.empty((D, W), dtype=np.uint64)
+    F1 = np.empty((D, W), dtype=np.uint64)
+    stop = np.empty(D, dtype=np.int64)
+    sp = np.empty(D, dtype=np.int64)
+    sq = np.empty(D, dtype=np.int64)
+    stage = np.empty(D, dtype=np.int64)
+    sv = np.empty(D, dtype=np.int64)
+    ret = np.empty(W, dtype=np.uint64)
+    cnt = 0
+    d = 0
+    SL[0] = L
+    SU[0] = U
+    stop[0] = n
+    sp[0] = 0
+    sq[0] = 0
+    stage[0] = 0
+    while d >= 0:
+        stg = stage[d]
+        if stg == 0:
+            zero = True
+            for w in range(W):
+                if SL[d, w] != ZERO:
+                    zero = False
+                    break
+            if zero:
+                for w in range(W):
+                    ret[w] = ZERO
+                d -= 1
+                continue
+            isfull = True
+            for w in range(W):
+                if SU[d, w] != full[w]:
+                    isfull = False
+                    break
+            if isfull:
+                outp[cnt] = sp[d]
+                outq[cnt] = sq[d]
+                cnt += 1
+                for w in range(W):
+                    ret[w] = full[w]
+                d -= 1
+                continue
+            v = stop[d] - 1
+            while v >= 0:
+                if _tw_depends(SL[d], v, W) or _tw_depends(SU[d], v, W):
+                    break
+                v -= 1
+            sv[d] = v
+            L0[d] = _tw_cof(SL[d], v, W, False)
+            L1[d] = _tw_cof(SL[d], v, W, True)
+            U0[d] = _tw_cof(SU[d], v, W, False)
+            U1[d] = _tw_cof(SU[d], v, W, True)
+            for w in range(W):
+                SL[d + 1, w] = L0[d, w] & ~U1[d, w] & full[w]
+                SU[d + 1, w] = U0[d, w]
+            sp[d + 1] = sp[d]
+            sq[d + 1] = sq[d] | (1 << v)
+        elif stg == 1:
+            v = sv[d]
+            F0[d] = ret
+            for w in range(W):
+                SL[d + 1, w] = L1[d, w] & ~U0[d, w] & full[w]
+                SU[d + 1, w] = U1[d, w]
+            sp[d + 1] = sp[d] | (1 << v)
+            sq[d + 1] = sq[d]
+        elif stg == 2:
+            v = sv[d]
+            F1[d] = ret
+            for w in range(W):
+                SL[d + 1, w] = ((L0[d, w] & ~F0[d, w]) | (L1[d, w] & ~F1[d, w])) & full[w]
+                SU[d + 1, w] = U0[d, w] & U1[d, w]
+            sp[d + 1] = sp[d]
+            sq[d + 1] = sq[d]
+        else:
+            v = sv[d]
+            if v < 6:
+                x = _VARW[v]
+                for w in range(W):
+                    ret[w] = ret[w] | (F0[d, w] & ~x & full[w]) | (F1[d, w] & x & full[w])
+            else:
+                st = 1 << (v - 6)
+                for w in range(W):
+                    ret[w] = ret[w] | (F1[d, w] if w & st else F0[d, w])
+            d -= 1
+            continue
+        stage[d] = stg + 1
+        stop[d + 1] = sv[d]
+        stage[d + 1] = 0
+        d += 1
+    return cnt
+
+
+@njit(cache=True)
+def _fx_and(a, b, keys, vals, M, st):
+    """:meth:`mlc.logic.aig.AIG.and_` on a scratch AIG held as a hash table; ``st[0]``
+    is its node count."""
+    r = lookup(keys, vals, M, a, b)
+    if r >= 0:
+        return r
+    if a > b:
+        t = a
+        a = b
+        b = t
+    r = 2 * st[0]
+    st[0] += 1
+    key = a * M + b
+    size = len(keys)
+    h = (key * 0x9E3779B1) & (size - 1)
+    while keys[h] >= 0:
+        h = (h + 1) & (size - 1)
+    keys[h] = key
+    vals[h] = r
+    return r
+
+
+@njit(cache=True)
+def _fx_and_many(xs, m, keys, vals, M, st):
+    """:meth:`mlc.logic.aig.AIG.and_many` (the balanced tree) of ``xs[:m]``, in place."""
+    if m == 0:
+        return 1
+    while m > 1:
+        k = 0
+        i = 0
+        while i < m - 1:
+            xs[k] = _fx_and(xs[i], xs[i + 1], keys, vals, M, st)
+            k += 1
+            i += 2
+        if m % 2:
+            xs[k] = xs[m - 1]
+            k += 1
+        m = k
+    return xs[0]
+
+
+@njit(cache=True)
+def _fx_cube(p, q, nv, keys, vals, M, st):
+    xs = np.empty(2 * nv, dtype=np.int64)
+    m = 0
+    for i in range(nv):
+        if (p >> i) & 1:
+            xs[m] = 2 * (i + 1)
+            m += 1
+    for i in range(nv):
+        if (q >> i) & 1:
+            xs[m] = 2 * (i + 1) + 1
+            m += 1
+    return _fx_and_many(xs, m, keys, vals, M, st)
+
+
+@njit(cache=True)
+def _fx_factor(P0, Q0, nv, keys, vals, M, st):
+    """:func:`mlc.logic.lower.factor_sop`'s recursion on the cubes ``P0``/``Q0``, with an
+    explicit stack (frames' cubes one after the other in an arena); returns the literal."""
+    m0 = len(P0)
+    cap = max(64, 4 * m0)
+    AP = np.empty(cap, dtype=np.int64)
+    AQ = np.empty(cap, dtype=np.int64)
+    AP[:m0] = P0
+    AQ[:m0] = Q0
+    D = 64
+    fs = np.empty(D, dtype=np.int64)       # a frame's first cube in the arena
+    fm = np.empty(D, dtype=np.int64)       # its cube count
+    fstage = np.empty(D, dtype=np.int64)
+    fa = np.empty(D, dtype=np.int64)       # the literal waiting for the child's
+    fb = np.empty(D, dtype=np.int64)       # the chosen literal's variable
+    fn = np.empty(D, dtype=np.int64)       # ... and its polarity
+    cnt_p = np.empty(nv, dtype=np.int64)
+    cnt_q = np.empty(nv, dtype=np.int64)
+    d = 0
+    fs[0] = 0
+    fm[0] = m0
+    fstage[0] = 0
+    ret = 0
+    while d >= 0:
+        s = fs[d]
+        m = fm[d]
+        e = s + m
+        stg = fstage[d]
+        cm = 0                              # the child's cube count (-1: no child)
+        if stg == 0:
+            if m == 0:
+                ret = 0
+                d -= 1
+                continue
+            taut = False
+            for j in range(s, e):
+                if AP[j] == 0 and AQ[j] == 0:
+                    taut = True
+                    break
+            if taut:
+                ret = 1
+                d -= 1
+                continue
+            if m == 1:
+                ret = _fx_cube(AP[s], AQ[s], nv, keys, vals, M, st)
+                d -= 1
+                continue
+            cp = -1
+            cq = -1
+            for j in range(s, e):
+                cp &= AP[j]
+                cq &= AQ[j]
+            if cp != 0 or cq != 0:
+                fa[d] = _fx_cube(cp, cq, nv, keys, vals, M, st)
+                fstage[d] = 1
+                cm = m
+                if e + cm > cap:
+                    while e + cm > cap:
+                        cap *= 2
+                    AP = _grown(AP, cap)
+                    AQ = _grown(AQ, cap)
+                for j in range(m):
+                    AP[e + j] = AP[s + j] & ~cp
+                    AQ[e + j] = AQ[s + j] & ~cq
+            else:
+                for i in range(nv):
+                    cnt_p[i] = 0
+                    cnt_q[i] = 0
+                for j in range(s, e):
+                    for i in range(nv):
+                        cnt_p[i] += (AP[j] >> i) & 1
+                        cnt_q[i] += (AQ[j] >> i) & 1
+                best = -1
+                neg = 0
+                bestc = 1
+                for i in range(nv):
+                    if cnt_p[i] > bestc:
+                        best = i
+                        neg = 0
+                        bestc = cnt_p[i]
+                    if cnt_q[i] > bestc:
+                        best = i
+                        neg = 1
+                        bestc = cnt_q[i]
+                if best < 0:
+                    xs = np.empty(m, dtype=np.int64)
+                    for j in range(m):
+                        xs[j] = _fx_cube(AP[s + j], AQ[s + j], nv, keys, vals, M, st) ^ 1
+                    ret = _fx_and_many(xs, m, keys, vals, M, st) ^ 1
+                    d -= 1
+                    continue
+                fb[d] = best
+                fn[d] = neg
+                fstage[d] = 2
+                bit = 1 << best
+                cm = bestc
+                if e + cm > cap:
+                    while e + cm > cap:
+                        cap *= 2
+                    AP = _grown(AP, cap)
+                    AQ = _grown(AQ, cap)
+                k = e
+                for j in range(s, e):
+                    if neg:
+                        if AQ[j] & bit:
+                            AP[k] = AP[j]
+                            AQ[k] = AQ[j] & ~bit
+                            k += 1
+                    elif AP[j] & bit:
+                        AP[k] = AP[j] & ~bit
+                        AQ[k] = AQ[j]
+                        k += 1
+        elif stg == 1:
+            ret = _fx_and(fa[d], ret, keys, vals, M, st)
+            d -= 1
+            continue
+        elif stg == 2:
+            t = _fx_and(2 * (fb[d] + 1) + fn[d], ret, keys, vals, M, st)
+            bit = 1 << fb[d]
+            if e + m > cap:
+                while e + m > cap:
+                    cap *= 2
+                AP = _grown(AP, cap)
+                AQ = _grown(AQ, cap)
+            k = e
+            for j in range(s, e):
+                if not ((AQ[j] if fn[d] else AP[j]) & bit):
+                    AP[k] = AP[j]
+                    AQ[k] = AQ[j]
+                    k += 1
+            cm = k - e
+            if cm == 0:
+                ret = t
+                d -= 1
+                continue
+            fa[d] = t
+            fstage[d] = 3
+        else:
+            ret = _fx_and(fa[d] ^ 1, ret ^ 1, keys, vals, M, st) ^ 1
+            d -= 1
+            continue
+        if d + 1 >= D:
+            D *= 2
+            fs = _grown(fs, D)
+            fm = _grown(fm, D)
+            fstage = _grown(fstage, D)
+            fa = _grown(fa, D)
+            fb = _grown(fb, D)
+            fn = _grown(fn, D)
+        fs[d + 1] = e
+        fm[d + 1] = cm
+        fstage[d + 1] = 0
+        d += 1
+    return ret
+
+
+@njit(cache=True)
+def _grown(a, size):
+    b = np.empty(size, dtype=a.dtype)
+    b[:len(a)] = a
+    return b
+
+
+@njit(cache=True)
+def _sop_phase(L, U, n, W, full):
+    """``(ANDs of the factored form, cube masks P, Q, cube count)`` of the ISOP of [L, U]."""
+    cap = 1 << n                   # an irredundant cover has at most one cube a minterm
+    P = np.zeros(cap, dtype=np.int64)
+    Q = np.zeros(cap, dtype=np.int64)
+    m = _isop(L, U, n, W, full, P, Q)
+    lits = 0
+    for j in range(m):
+        for i in range(n):
+            lits += ((P[j] >> i) & 1) + ((Q[j] >> i) & 1)
+    # the factored form of a cover with l literals has at most l ANDs
+    N = n + 2 + lits
+    size = 1
+    while size < 4 * N:
+        size *= 2
+    keys = np.full(size, -1, dtype=np.int64)
+    vals = np.zeros(size, dtype=np.int64)
+    st = np.full(1, n + 1, dtype=np.int64)
+    _fx_factor(P[:m].copy(), Q[:m].copy(), n, keys, vals, 2 * N + 2, st)
+    return st[0] - (n + 1), P, Q, m
