@@ -1619,12 +1619,12 @@ def _fx_factor(P0, Q0, nv, keys, vals, M, st):
     """:func:`mlc.logic.lower.factor_sop`'s recursion on the cubes ``P0``/``Q0``, with an
     explicit stack (frames' cubes one after the other in an arena); returns the literal."""
     m0 = len(P0)
-    cap = max(64, 4 * m0)
+    cap = 2 * m0 + 1                      # grown on demand (as the frames)
     AP = np.empty(cap, dtype=np.int64)
     AQ = np.empty(cap, dtype=np.int64)
     AP[:m0] = P0
     AQ[:m0] = Q0
-    D = 64
+    D = 8
     fs = np.empty(D, dtype=np.int64)       # a frame's first cube in the arena
     fm = np.empty(D, dtype=np.int64)       # its cube count
     fstage = np.empty(D, dtype=np.int64)
@@ -1643,7 +1643,12 @@ def _fx_factor(P0, Q0, nv, keys, vals, M, st):
         m = fm[d]
         e = s + m
         stg = fstage[d]
-        cm = 0                              # the child's cube count (-1: no child)
+        cm = 0                              # the child's cube count (at most m)
+        if e + m > cap:                     # room for a child's cubes after this frame's
+            while e + m > cap:
+                cap *= 2
+            AP = _grown(AP, cap)
+            AQ = _grown(AQ, cap)
         if stg == 0:
             if m == 0:
                 ret = 0
@@ -1671,11 +1676,6 @@ def _fx_factor(P0, Q0, nv, keys, vals, M, st):
                 fa[d] = _fx_cube(cp, cq, nv, keys, vals, M, st)
                 fstage[d] = 1
                 cm = m
-                if e + cm > cap:
-                    while e + cm > cap:
-                        cap *= 2
-                    AP = _grown(AP, cap)
-                    AQ = _grown(AQ, cap)
                 for j in range(m):
                     AP[e + j] = AP[s + j] & ~cp
                     AQ[e + j] = AQ[s + j] & ~cq
@@ -1711,11 +1711,6 @@ def _fx_factor(P0, Q0, nv, keys, vals, M, st):
                 fstage[d] = 2
                 bit = 1 << best
                 cm = bestc
-                if e + cm > cap:
-                    while e + cm > cap:
-                        cap *= 2
-                    AP = _grown(AP, cap)
-                    AQ = _grown(AQ, cap)
                 k = e
                 for j in range(s, e):
                     if neg:
@@ -1734,11 +1729,6 @@ def _fx_factor(P0, Q0, nv, keys, vals, M, st):
         elif stg == 2:
             t = _fx_and(2 * (fb[d] + 1) + fn[d], ret, keys, vals, M, st)
             bit = 1 << fb[d]
-            if e + m > cap:
-                while e + m > cap:
-                    cap *= 2
-                AP = _grown(AP, cap)
-                AQ = _grown(AQ, cap)
             k = e
             for j in range(s, e):
                 if not ((AQ[j] if fn[d] else AP[j]) & bit):
