@@ -51,15 +51,19 @@ def _cache_put(cache: dict, key, value) -> None:
     cache[key] = value
 
 
-def _cofactors(f: int, care: int, s: int, vi: int, ni: int):
+def _cofactors(f: int, care: int, s: int, vi: int, ni: int, full: int):
     """The cofactors of the interval (on-set ``f``, care set ``care``, off-set
     ``care & ~f``) with respect to variable ``i`` (``s = 1 << i``, ``vi``/``ni`` its
-    positive and negative tables), each spread over both halves: (on0, on1, of0, of1,
-    c0, c1).  Spreading acts bit by bit, so the off-set's cofactors are ``c & ~on``."""
+    positive and negative tables, ``full`` the all-ones table), each spread over both
+    halves: (on0, on1, of0, of1, c0, c1).  Spreading acts bit by bit, so the off-set's
+    cofactors are ``c & ~on``; a full care set (refactoring's cones and all their
+    cofactors) has full cofactors."""
     t = f & ni
     on0 = t | (t << s)
     t = f & vi
     on1 = t | (t >> s)
+    if care == full:
+        return on0, on1, full ^ on0, full ^ on1, full, full
     t = care & ni
     c0 = t | (t << s)
     t = care & vi
@@ -101,7 +105,7 @@ class _Dec:
             vi, ni = pos[i], neg[i]
             if ((f & vi) >> s) == (f & ni) and ((care & vi) >> s) == (care & ni):
                 continue                      # depends on neither
-            on0, on1, of0, of1, c0, c1 = _cofactors(f, care, s, vi, ni)
+            on0, on1, of0, of1, c0, c1 = _cofactors(f, care, s, vi, ni, self.full)
             if on0 & of1 == 0 and on1 & of0 == 0:
                 # need not depend on i: merge the cofactors
                 f = on0 | on1
@@ -134,7 +138,7 @@ class _Dec:
         best = None
         pos, neg = T.var_tables(n)
         for i in sup:
-            on0, on1, of0, of1, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i])
+            on0, on1, of0, of1, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i], self.full)
             x = 2 * (i + 1)
             steps = []
             if on0 == 0:
@@ -187,7 +191,7 @@ class _Dec:
         pos, neg = T.var_tables(n)
         # disjoint-support steps
         for i in sup:
-            on0, on1, of0, of1, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i])
+            on0, on1, of0, of1, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i], self.full)
             x = 2 * (i + 1)
             if on0 == 0:                 # f = x & f1
                 c, p = self.rec(on1, c1)
@@ -212,7 +216,7 @@ class _Dec:
             # Shannon on the variables whose cofactors are simplest
             scored = []
             for i in sup:
-                on0, on1, _, _, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i])
+                on0, on1, _, _, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i], self.full)
                 s0 = len(self.reduce_support(on0, c0)[2])
                 s1 = len(self.reduce_support(on1, c1)[2])
                 noise = self.rng.random() * 3 if self.rng is not None else 0.0
