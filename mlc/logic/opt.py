@@ -1451,28 +1451,7 @@ def extract_and(g: AIG, max_leaves: int = 16) -> AIG:
                     absorbed[z] = 0
                 leaves.append(lit)
         roots[y] = set(leaves)
-    # greedy pair extraction
-    virt = []          # virt[i] = (u, v): pseudo-literal ('v', i)
-    while True:
-        cnt = {}
-        for y, s in roots.items():
-            if len(s) < 2:
-                continue
-            ls = sorted(s, key=repr)
-            for i in range(len(ls)):
-                for j in range(i + 1, len(ls)):
-                    p = (ls[i], ls[j])
-                    cnt[p] = cnt.get(p, 0) + 1
-        if not cnt:
-            break
-        p, c = max(cnt.items(), key=lambda kv: (kv[1], repr(kv[0])))
-        if c < 2:
-            break
-        v = ("v", len(virt))
-        virt.append(p)
-        for s in roots.values():
-            if p[0] in s and p[1] in s:
-                s.discard(p[0]); s.discard(p[1]); s.add(v)
+    virt = _extract_pairs(roots)
     R = _Rebuild(g)
     memo = {}
 
@@ -1497,6 +1476,62 @@ def extract_and(g: AIG, max_leaves: int = 16) -> AIG:
             ls = ls[2:] + [R.and_(ls[0], ls[1])]
         R.m[y] = ls[0] if ls else 1
     return R.finish()
+
+
+def _extract_pairs(roots: dict) -> list:
+    """:func:`extract_and`'s greedy pair extraction on the operand sets ``roots``
+    (changed in place): while some pair of operands is in two or more sets, the pair
+    in most sets (ties: the greatest ``repr``) becomes a pseudo-literal ``("v", i)``
+    replacing it in every set that has both; returns the pairs, ``virt[i] = (u, w)``.
+    A pair is ordered by ``repr``; the counts of all pairs are kept up to date as
+    pairs are extracted (bucketed by count) instead of recounted every step."""
+    cnt: dict = {}
+    byc: dict[int, set] = {}          # count -> the pairs with that count
+    rep: dict = {}
+
+    def r(x):
+        t = rep.get(x)
+        if t is None:
+            t = rep[x] = repr(x)
+        return t
+
+    def bump(a, b, d: int) -> None:
+        p = (a, b) if r(a) <= r(b) else (b, a)
+        c = cnt.get(p, 0)
+        if c:
+            byc[c].discard(p)
+        c += d
+        if c:
+            cnt[p] = c
+            byc.setdefault(c, set()).add(p)
+        else:
+            del cnt[p]
+
+    for s in roots.values():
+        ls = list(s)
+        for i in range(len(ls)):
+            for j in range(i + 1, len(ls)):
+                bump(ls[i], ls[j], 1)
+    virt = []
+    while True:
+        top = max((c for c, ps in byc.items() if ps), default=0)
+        if top < 2:
+            break
+        p = max(byc[top], key=repr)
+        v = ("v", len(virt))
+        virt.append(p)
+        a, b = p
+        for s in roots.values():
+            if a in s and b in s:
+                s.discard(a)
+                s.discard(b)
+                bump(a, b, -1)
+                for o in s:
+                    bump(a, o, -1)
+                    bump(b, o, -1)
+                    bump(v, o, 1)
+                s.add(v)
+    return virt
 
 
 def _xor_gadget(g: AIG, x: int):
