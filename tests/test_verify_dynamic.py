@@ -201,3 +201,45 @@ def test_circuit_verify_takes_tau_and_dt():
     rep = verify_dynamic(chain_scene(2, "expand"), ["1"], seeds=1, tau=0.3, dt=0.02, progress=False)
     assert rep.ok and rep.params["tau"] == 0.3 and rep.params["dt"] == 0.02
     assert all(e["tau"] == 0.3 for e in rep.entries)
+
+
+def test_the_bar_moves_within_one_long_run(monkeypatch):
+    """One row and one seed is one item: the bar must still move (and give an ETA) while
+    that run goes on, by the time run over the time it usually takes (issue 9: a progress
+    bar with ETA on every run longer than a few seconds)."""
+    import io
+
+    import mlc.io.progress as P
+    s = io.StringIO()
+    lines = []
+
+    class Spy(P.Progress):
+        def __init__(self, label, total=None, expect=None, show=None, delay=2.0, stream=None):
+            super().__init__(label, total, expect, show, 0.0, s)
+
+        def update(self, done):
+            super().update(done)
+            lines.append((done, self.line()))
+
+    monkeypatch.setattr(P, "Progress", Spy)
+    sc = gate_scene("NAND", "expand")
+    rows = check_scene_dynamic_multi(sc, kT=1e-5, seeds=1, rows=["11"], progress=True)
+    assert rows[0]["ok"]
+    fractions = [d for d, _ in lines if 0 < d < 1]
+    assert len(fractions) >= 2 and fractions == sorted(fractions) and max(fractions) <= 0.95
+    assert lines[-1][0] == 1 and "1/1" in lines[-1][1]
+    mids = [t for d, t in lines if 0 < d < 1]
+    assert all("0/1" in t for t in mids)                                # whole items counted
+    assert mids[-1].split("[")[1].count("#") == int(24 * fractions[-1])  # the bar moved
+    assert any("ETA     ? s" not in t for t in mids)                    # a finite ETA mid-run
+
+
+def test_fractional_progress_shows_whole_items():
+    import io
+
+    from mlc.io.progress import Progress
+    s = io.StringIO()
+    bar = Progress("rows", total=2, show=True, delay=0.0, stream=s)
+    bar.update(1.5)
+    line = bar.line()
+    assert "1/2" in line and line.count("#") == 18 and "ETA" in line

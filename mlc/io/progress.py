@@ -53,8 +53,9 @@ class Progress:
         while not self._stop.wait(0.5):
             self._draw()
 
-    def update(self, done: int) -> None:
-        """``done`` of ``total`` items finished."""
+    def update(self, done: float) -> None:
+        """``done`` of ``total`` items finished (a fraction counts the part of an item done
+        so far: the bar and the ETA move within a long item, the count shows whole items)."""
         self.done = done
         if self.show:
             self._draw()
@@ -68,7 +69,7 @@ class Progress:
             w = 24
             fill = int(w * frac)
             eta_s = f"ETA {eta:5.0f} s" if eta == eta else "ETA     ? s"
-            return f"{self.label} [{'#' * fill}{'.' * (w - fill)}] {self.done}/{self.total}  {eta_s}"
+            return f"{self.label} [{'#' * fill}{'.' * (w - fill)}] {int(self.done)}/{self.total}  {eta_s}"
         s = f"{self.label}  {el:4.0f} s"
         if self.expect:
             s += f" (about {max(self.expect - el, 0):.0f} s left)"

@@ -262,12 +262,13 @@ def plateau_tol(kT: float, k0: float = 1.0, sd: float = 0.0, tau: float = 0.0, b
 
 
 def relax_all(sim: Simulation, probes: list[str], kT: float, t_min: float = 0.0, window: float = WINDOW,
-              max_time: float = MAX_TIME, sd: dict | None = None, tau: float = 0.0):
+              max_time: float = MAX_TIME, sd: dict | None = None, tau: float = 0.0, on_window=None):
     """Run ``sim`` until every probe in ``probes`` has relaxed: time >= ``t_min`` t0, and the
     three block means of the last third of the run (at least ``MIN_WINDOWS`` windows of
     ``window`` t0) agree within :func:`plateau_tol` (``sd``: probe -> thermal standard
     deviation in sigma, ``tau``: slowest relaxation time in t0).  Returns (means: probe ->
-    plateau mean in sigma, time t0, relaxed)."""
+    plateau mean in sigma, time t0, relaxed).  ``on_window(t)``, if given, is called after
+    every window with the time run so far (t0)."""
     sd = sd or {}
     ends, means = [], {p: [] for p in probes}
     t = 0.0
@@ -278,6 +279,8 @@ def relax_all(sim: Simulation, probes: list[str], kT: float, t_min: float = 0.0,
             raise KeyboardInterrupt
         t = res.time - start
         ends.append(t)
+        if on_window is not None:
+            on_window(t)
         for p in probes:
             v = res.probes[p]
             means[p].append(float(np.mean(v[1:] if len(v) > 1 else v)))
@@ -376,11 +379,18 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
                 sd, tau_row = probe_thermal_sd(scene, kT), tau
             t_min = tau_factor * tau_row if state != rest else 0.0
             per = []
+            # within a run the bar moves with the time run over the time it usually takes:
+            # the floor t_min, or MIN_WINDOWS windows (runs relax at the floor as a rule)
+            t_expect = max(t_min, MIN_WINDOWS * window)
             for seed in seed_list:
                 opt = SimOptions(scheme=scheme, kT=kT, seed=seed, dt=dt if dt is not None else DT.get(scheme))
                 sim = Simulation(scene, drives, opt)
                 t_max = max_time if max_time_given else max(MAX_TIME, MAX_TAUS * tau_row)
-                means, t_rel, relaxed = relax_all(sim, names, kT, t_min, window, t_max, sd, tau_row)
+                inner = None
+                if bar.show:
+                    def inner(t, base=done):
+                        bar.update(base + min(t / t_expect, 0.95))
+                means, t_rel, relaxed = relax_all(sim, names, kT, t_min, window, t_max, sd, tau_row, inner)
                 per.append((means, t_rel, relaxed))
                 done += 1
                 bar.update(done)
