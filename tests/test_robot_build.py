@@ -160,3 +160,28 @@ def test_verify_tau_dt_reach_the_robot_run(robot, capsys):
     rep = json.loads(capsys.readouterr().out)
     assert rc == 0 and rep["params"]["tau"] == 2.0 and rep["params"]["dt"] == 0.1
     assert rep["rows"][0]["shape_read"] == "I"
+
+
+def test_dynamic_verify_bar_moves_within_a_fold(robot, monkeypatch):
+    """One row and one seed: the bar and its ETA still move during the fold (the time run over
+    3 tau), not only when the run ends."""
+    import io
+
+    import mlc.io.progress as P
+    from mlc.robot.verify import verify_robot_dynamic
+    seen = []
+
+    class Spy(P.Progress):
+        def __init__(self, label, total=None, expect=None, show=None, delay=2.0, stream=None):
+            super().__init__(label, total, expect, True, 0.0, io.StringIO())
+
+        def update(self, done):
+            super().update(done)
+            seen.append((done, self.line()))
+
+    monkeypatch.setattr(P, "Progress", Spy)
+    verify_robot_dynamic(load_scene(robot / "out" / "robot.yaml"), rows=["1"], seeds=1, max_time=20.0)
+    mids = [(d, t) for d, t in seen if 0 < d < 1]
+    assert len(mids) >= 3 and [d for d, _ in mids] == sorted(d for d, _ in mids)
+    assert all("0/1" in t for _, t in mids) and any("ETA     ? s" not in t for _, t in mids)
+    assert seen[-1][0] == 1

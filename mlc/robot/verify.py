@@ -139,7 +139,7 @@ def angles_relaxed(angles, block: float, tau: float, z: float = 3.0) -> tuple[bo
 
 
 def run_fold(sim, scene: Scene, state: str, kT: float, tau: float, max_time: float, every: float | None = None,
-             min_time: float | None = None):
+             min_time: float | None = None, on_window=None):
     """Advance ``sim`` (inputs already set to row ``state``) in windows of max(0.05, tau/20)
     t0 until relaxed or ``max_time`` t0.  Relaxed: at least ``TAU_FACTOR`` tau (not for the
     rest row), the three block means of every circuit output over the last third within
@@ -148,7 +148,8 @@ def run_fold(sim, scene: Scene, state: str, kT: float, tau: float, max_time: flo
     the skeleton's soft joints fluctuate far more than the circuit's stiff pairs.
     ``min_time`` (t0): run at least this long (default ``TAU_FACTOR`` tau; the rest row 0).
     Returns (probe means over the plateau {name: sigma}, time t0, relaxed, test details,
-    history of turns every ``every`` t0 or [])."""
+    history of turns every ``every`` t0 or []).  ``on_window(t)``, if given, is called after
+    every window with the time run so far (t0)."""
     from mlc.verify.dynamic import MIN_WINDOWS, PLATEAU, TAU_FACTOR, plateau_tol
 
     rm = robot_meta(scene)
@@ -165,6 +166,8 @@ def run_fold(sim, scene: Scene, state: str, kT: float, tau: float, max_time: flo
         res = sim.run(window, record_interval=window / 10, quiet=True)
         t = res.time
         ends.append(t)
+        if on_window is not None:
+            on_window(t)
         angs.append(dof_angles(scene, sim.pos, sim.quat))
         for p in names:
             v = res.probes[p]
@@ -295,6 +298,7 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
     more than 8 min for a 2000-body robot).  Seeds are ``first_seed``, ``first_seed + 1``, ..."""
     from mlc.io.progress import Progress
     from mlc.sim.drive import Drive
+    from mlc.verify.dynamic import TAU_FACTOR
     from mlc.sim.integrator import SimOptions, Simulation
     from mlc.verify.dynamic import relaxation_time
 
@@ -328,7 +332,13 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
             for seed in range(int(first_seed), int(first_seed) + int(seeds)):
                 sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed,
                                                      dt=None if dt is None else float(dt)))
-                means, t_rel, relaxed, _, _ = run_fold(sim, scene, state, kT, tau, t_max)
+                inner = None
+                if bar.show:        # the bar moves within a fold: time run over 3 tau (tau at rest)
+                    t_expect = TAU_FACTOR * tau if state != "0" * len(scene.inputs) else tau
+
+                    def inner(t, base=done, t_expect=t_expect):
+                        bar.update(base + min(t / t_expect, 0.95))
+                means, t_rel, relaxed, _, _ = run_fold(sim, scene, state, kT, tau, t_max, on_window=inner)
                 shape = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy(), means)
                 per.append((means, t_rel, relaxed, shape))
                 poses[(state, seed)] = (sim.pos.copy(), sim.quat.copy())
