@@ -123,3 +123,26 @@ def test_cofactors_off_set_from_care_and_on_set():
         want = (T.cof0(f, n, i), T.cof1(f, n, i), T.cof0(off, n, i), T.cof1(off, n, i),
                 T.cof0(care, n, i), T.cof1(care, n, i))
         assert decomp._cofactors(f, care, 1 << i, pos[i], neg[i], full) == want
+
+
+def test_no_step_matches_the_cofactor_conditions():
+    rng = random.Random(22)
+    seen = set()
+    for _ in range(2000):
+        n = rng.randint(1, 9)
+        full = T.mask(n)
+        pos, neg = T.var_tables(n)
+        i = rng.randrange(n)
+        g = rng.getrandbits(1 << n)
+        if n > 1 and rng.random() < 0.6:
+            # a one-variable step on i: x_i op g with g independent of x_i
+            g = T.cof0(g, n, i)
+            x = pos[i] ^ (full if rng.random() < 0.5 else 0)
+            g = rng.choice([x & g, x | g, x ^ g]) & full
+        on0, on1, of0, of1, _c0, _c1 = decomp._cofactors(g, full, 1 << i, pos[i], neg[i], full)
+        step = (on0 == 0 or on1 == 0 or of1 == 0 or of0 == 0
+                or (on0 & on1 == 0 and of0 & of1 == 0))
+        got = bool(decomp._no_step(g, 1 << i, pos[i], neg[i]))
+        assert got == (not step)
+        seen.add(got)
+    assert seen == {True, False}

@@ -71,6 +71,17 @@ def _cofactors(f: int, care: int, s: int, vi: int, ni: int, full: int):
     return on0, on1, c0 & ~on0, c1 & ~on1, c0, c1
 
 
+def _no_step(f: int, s: int, vi: int, ni: int) -> bool:
+    """For a completely specified ``f``: no one-variable step (``x & g``, ``x | g``,
+    ``x ^ g`` in any polarity) exists on variable ``i`` (``s``, ``vi``, ``ni`` as in
+    :func:`_cofactors`).  Tested on the halves without spreading them: a cofactor is 0
+    or all ones where its half is, and the cofactors are complements where the
+    positive half is the negative half, moved up, complemented."""
+    t0 = f & ni
+    t1 = f & vi
+    return t0 and t1 and t0 != ni and t1 != vi and (t0 << s) != vi ^ t1
+
+
 class _Dec:
     def __init__(self, n: int, effort: int, rng=None):
         self.rng = rng
@@ -137,7 +148,10 @@ class _Dec:
         n = self.n
         best = None
         pos, neg = T.var_tables(n)
+        whole = care == self.full
         for i in sup:
+            if whole and _no_step(f, 1 << i, pos[i], neg[i]):
+                continue
             on0, on1, of0, of1, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i], self.full)
             x = 2 * (i + 1)
             steps = []
@@ -190,7 +204,10 @@ class _Dec:
             return sh
         pos, neg = T.var_tables(n)
         # disjoint-support steps
+        whole = care == full
         for i in sup:
+            if whole and _no_step(f, 1 << i, pos[i], neg[i]):
+                continue
             on0, on1, of0, of1, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i], self.full)
             x = 2 * (i + 1)
             if on0 == 0:                 # f = x & f1
