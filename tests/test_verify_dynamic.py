@@ -243,3 +243,19 @@ def test_fractional_progress_shows_whole_items():
     bar.update(1.5)
     line = bar.line()
     assert "1/2" in line and line.count("#") == 18 and "ETA" in line
+
+
+def test_euler_on_a_stiff_scene_warns_before_the_run(monkeypatch, capsys):
+    """A run of more than SLOW_STEPS Euler steps (a circuit with 100 k0 joints: ~1e8 a row)
+    says so before it starts, with the fix; silent callers (progress=False) get no line."""
+    import mlc.verify.dynamic as D
+    sc = gate_scene("NAND", "expand")
+    monkeypatch.setattr(D, "SLOW_STEPS", 10.0)        # this gate's row takes more than 10 steps
+    check_scene_dynamic_multi(sc, kT=1e-5, seeds=1, rows=["00"], scheme="euler", progress=False)
+    assert capsys.readouterr().err == ""
+    check_scene_dynamic_multi(sc, kT=1e-5, seeds=1, rows=["00", "11"], scheme="euler", progress=None)
+    err = capsys.readouterr().err
+    assert err.count("mlc: warning: --scheme euler") == 1 and "use --scheme stiff" in err
+    monkeypatch.setattr(D, "SLOW_STEPS", 1e8)
+    check_scene_dynamic_multi(sc, kT=1e-5, seeds=1, rows=["00"], scheme="euler", progress=None)
+    assert "warning" not in capsys.readouterr().err

@@ -61,6 +61,7 @@ TAU_FACTOR = 3.0       # the run lasts at least this many slowest relaxation tim
 MAX_TIME = 20.0        # t0: the run stops here (or at MAX_TAUS tau if longer) unrelaxed
 MAX_TAUS = 12.0
 DT = {"stiff": 0.01, "euler": None}      # t0; None: the integrator's own (half the Euler limit)
+SLOW_STEPS = 1e8       # Euler steps a run beyond which the check warns before it starts
 DENSE_MAX = 1800       # degrees of freedom up to which the spectrum is computed densely
 ZERO = 1e-9            # eigenvalues below ZERO * lambda_max count as zero modes
 SIGNAL_MIN = 0.01      # probes answering less than this fraction of the largest answer are left out of signal_time
@@ -358,6 +359,7 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
     show = None if progress is None else (progress if isinstance(progress, bool) else False)
     bar = Progress(f"dynamic check of {scene.name}", total=total, show=show)
     done = 0
+    warned = False
     with bar:
         for state in states:
             want = scene.truth_table.get(state)
@@ -386,6 +388,13 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
                 opt = SimOptions(scheme=scheme, kT=kT, seed=seed, dt=dt if dt is not None else DT.get(scheme))
                 sim = Simulation(scene, drives, opt)
                 t_max = max_time if max_time_given else max(MAX_TIME, MAX_TAUS * tau_row)
+                if scheme == "euler" and not warned and show is not False and t_expect / sim.dt > SLOW_STEPS:
+                    warned = True
+                    import sys
+                    print(f"mlc: warning: --scheme euler: this scene's stiffest bonds allow dt = {sim.dt:.2g} t0, "
+                          f"so row {state} needs about {t_expect / sim.dt:.1e} steps (at least {t_expect:.3g} t0); "
+                          "that can take days: use --scheme stiff (the default), or --rows to check fewer rows",
+                          file=sys.stderr, flush=True)
                 inner = None
                 if bar.show:
                     def inner(t, base=done):
