@@ -279,3 +279,35 @@ def test_refactor_decomposition_kernel_same_network(seed, monkeypatch):
                 opt.KERNELS, opt.KERNEL_MIN_ANDS = old
         assert texts[0] == texts[1]
     assert texts[0] != g.to_text()
+
+
+def test_npn_matches_memo_fits_and_matches_the_transforms():
+    import numpy as np
+    from mlc.logic import npn
+    lo, hi = kern.npn_arrays()[:2]
+    canon = np.full(1 << 16, -1, dtype=np.int64)
+    start = np.zeros(1 << 16, dtype=np.int64)
+    count = np.zeros(1 << 16, dtype=np.int64)
+    pool = np.zeros(kern.NPN_POOL, dtype=np.int32)
+    top = np.zeros(1, dtype=np.int64)
+    rng = random.Random(9)
+    sample = {0, 0xFFFF, 0x8000, 0x6996, 0xCAFE} | {rng.getrandbits(16) for _ in range(200)}
+    for f in range(1 << 16):                   # every function: the pool holds them all
+        R = kern.npn_matches(f, lo, hi, canon, start, count, pool, top)
+        assert kern.npn_matches(f, lo, hi, canon, start, count, pool, top) == R   # memo
+        if f not in sample:
+            continue
+        assert R == npn.canon(f)[0]
+        want = []
+        for idx, (perm, neg, _x) in enumerate(npn._TRANSFORMS):
+            # the transform's table, straight from its definition
+            g = 0
+            for m in range(16):
+                y = sum((((m >> perm[i]) & 1) ^ ((neg >> i) & 1)) << i for i in range(4))
+                g |= ((f >> m) & 1) << y
+            if g == R:
+                want.append(2 * idx)
+            elif g ^ 0xFFFF == R:
+                want.append(2 * idx + 1)
+        assert pool[start[f]:start[f] + count[f]].tolist() == want
+    assert top[0] <= kern.NPN_POOL

@@ -1122,6 +1122,54 @@ def npn_arrays():
 
 _NPN = None
 
+# every 16-bit function's matches (the transforms taking it to its class
+# representative or its complement) over all 65536 functions: 170496 entries
+NPN_POOL = 1 << 18
+
+
+def npn_match_cache():
+    """The memo of :func:`rewrite_node`'s NPN work, filled as functions are met and kept
+    for the process: ``(canon, start, count, pool, top)``: ``canon[f]`` the class
+    representative of 16-bit function ``f`` (-1: not met yet), and its matches
+    ``pool[start[f]:start[f] + count[f]]`` (transform index * 2 + output complement,
+    in increasing index order); ``top[0]`` the pool's fill."""
+    global _MATCH
+    if _MATCH is None:
+        _MATCH = (np.full(1 << 16, -1, dtype=np.int64), np.zeros(1 << 16, dtype=np.int64),
+                  np.zeros(1 << 16, dtype=np.int64), np.zeros(NPN_POOL, dtype=np.int32),
+                  np.zeros(1, dtype=np.int64))
+    return _MATCH
+
+
+_MATCH = None
+
+
+@njit(cache=True)
+def npn_matches(f, lo, hi, canon, start, count, pool, top):
+    """``f``'s class representative, its matches filled into the memo on first use."""
+    R = canon[f]
+    if R >= 0:
+        return R
+    R = npn_canon(f, lo, hi)
+    lo8 = f & 0xFF
+    hi8 = f >> 8
+    t = top[0]
+    if t + lo.shape[0] > pool.shape[0]:
+        raise ValueError("npn_matches: pool too small")
+    start[f] = t
+    for idx in range(lo.shape[0]):
+        g = lo[idx, lo8] | hi[idx, hi8]
+        if g == R:
+            pool[t] = 2 * idx
+            t += 1
+        elif g ^ 0xFFFF == R:
+            pool[t] = 2 * idx + 1
+            t += 1
+    count[f] = t - start[f]
+    top[0] = t
+    canon[f] = R
+    return R
+
 
 @njit(cache=True)
 def cut_table(fa, fb, x, leaves, nl, tv, vis, stack, cstack):
@@ -1181,7 +1229,7 @@ def npn_canon(f, lo, hi):
 @njit(cache=True)
 def rewrite_node(x, fa, fb, n, refs, touched, lev, cl, cn, cc, keys, hvals, M, zero_gain,
                  lo, hi, perms, negs, ands, ngates, gates, out_node, out_c,
-                 mark, tv, vis, buf, res):
+                 mark, tv, vis, buf, res, canon, mstart, mcount, pool, top):
     """The body of :func:`mlc.logic.opt.rewrite` for node ``x``, but building the
     replacement: ``res[0]`` = 1 if a move is to be made (gain, and the zero-gain
     depth rule passed), ``res[1]`` its class ``R``, ``res[2:6]`` the leaf literals,
@@ -1220,20 +1268,16 @@ def rewrite_node(x, fa, fb, n, refs, touched, lev, cl, cn, cc, keys, hvals, M, z
         if skip:
             continue
         f = cut_table(fa, fb, x, leaves, s, tv, vis, stack, buf[4])
-        R = npn_canon(f, lo, hi)
+        R = npn_matches(f, lo, hi, canon, mstart, mcount, pool, top)
         if ands[R] > nc or (ands[R] == nc and not zero_gain):
             continue
         for t in range(nc):
             mark[cone[t]] = 2
         ng = ngates[R]
         nseen = 0
-        lo8 = f & 0xFF
-        hi8 = f >> 8
-        for idx in range(lo.shape[0]):
-            g = lo[idx, lo8] | hi[idx, hi8]
-            if g != R and g ^ 0xFFFF != R:
-                continue
-            out = 1 if g != R else 0
+        for q in range(mstart[f], mstart[f] + mcount[f]):
+            idx = pool[q] >> 1
+            out = pool[q] & 1
             neg = negs[idx]
             for i in range(4):
                 p = perms[idx, i]

@@ -1146,6 +1146,7 @@ def _rewrite_nb(g: AIG, zero_gain: bool, deadline: float | None) -> AIG:
     keys, hvals = kern.strash_table(fa, fb, n, N)
     lev = np.array(g.levels(), dtype=np.int64)
     lo, hi, perms, negs, ands, ngates, gates, out_node, out_c = kern.npn_arrays()
+    canon, mstart, mcount, pool, top = kern.npn_match_cache()
     tick = WIDE_TICK if n > TT_LIMIT else 1.0
     touched = np.zeros(N, dtype=np.uint8)
     mark = np.zeros(N + 1, dtype=np.int8)
@@ -1158,7 +1159,7 @@ def _rewrite_nb(g: AIG, zero_gain: bool, deadline: float | None) -> AIG:
     for x in ps.nodes():
         kern.rewrite_node(x, fa, fb, n, refs, touched, lev, cl, cn, cc, keys, hvals, M,
                           zero_gain, lo, hi, perms, negs, ands, ngates, gates, out_node, out_c,
-                          mark, tv, vis, buf, res)
+                          mark, tv, vis, buf, res, canon, mstart, mcount, pool, top)
         if not res[0]:
             continue
         cone = buf[1, :int(res[7])].tolist()
