@@ -20,7 +20,8 @@ fluct False: the plain stiff scheme for comparison.
 
     python benchmarks/sim_fluct_bias.py [--quick] [--burn N] [--steps N] [--out STEM]
 
-Writes benchmarks/results/sim_fluct_bias.json and .png (~6 min on the shared 2-core machine).
+Writes benchmarks/results/sim_fluct_bias.json and .png (~6 min on the shared 2-core machine;
+session 13's stage rule, ~10 min).
 Units: sigma, k0, gamma, t0 = gamma/(1e-3 k0).
 """
 from __future__ import annotations
@@ -37,6 +38,7 @@ from pathlib import Path
 import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 
+from mlc.io.atomic import atomic_path
 from mlc.sim.integrator import SimOptions, Simulation
 from mlc.sim.testscenes import bond_length_var, bonded_pairs
 
@@ -91,11 +93,19 @@ def main():
                 L, steps, wall, evals = point(sc, kT, dt, fluct, 11, args.cap, args.burn, args.steps)
                 v = L.var(axis=0, ddof=1) / ex
                 m, e = float(np.mean(v)), float(np.std(v, ddof=1) / math.sqrt(len(v)))
+                # the same records over the pairs at each record time (unbiased when records are
+                # correlated over many steps; per pair, averaged over time: pairs are independent)
+                n = L.shape[1]
+                q = ((L - L.mean(axis=1, keepdims=True)) ** 2).mean(axis=0) * n / (n - 1) / ex
                 h = dt * T_UNIT
+                probe = Simulation(sc, None, SimOptions(kT=kT, dt=dt, fluct=fluct))
+                mst, sst, rst = probe.fluct_stages_target() if fluct else (1.0, 0, 0.0)
                 row = {"kT": kT, "dt_t0": dt, "fluct": fluct, "phi2": 4 * kT * h, "noise_step_sigma": math.sqrt(2 * kT * h),
-                       "ratio": m, "ratio_se": e, "steps_measured": steps, "force_evals": evals, "wall_s": wall,
+                       "ratio": m, "ratio_se": e, "ratio_ens": float(q.mean()),
+                       "ratio_ens_se": float(q.std(ddof=1) / math.sqrt(n)), "steps_measured": steps, "force_evals": evals, "wall_s": wall,
                        "exact_var_over_kT": ex / kT,
-                       "stage_factor": Simulation(sc, None, SimOptions(kT=kT, dt=dt, fluct=fluct)).fluct_stage_factor()}
+                       "stage_factor": probe.fluct_stage_factor(), "stages": sst if fluct else None,
+                       "R_stiffest": rst if fluct else None}
                 rows.append(row)
                 print(json.dumps(row), flush=True)
     out = {"benchmark": "fluctuation-mode bond-length variance / exact against dt (bonded pairs, rest 1 sigma, k = 1)",
@@ -104,10 +114,14 @@ def main():
            "pairs": args.pairs, "burn_in_steps": args.burn, "measured_steps": args.steps, "rows": rows,
            "notes": "phi2 = 4 kT h/gamma (h = dt in gamma/k0): the pair's noise turn per step squared (rad^2) for a "
                     "1 sigma bond; ratio = mean over pairs of the per-pair variance over the measured steps / exact; fluct "
-                    "False rows: the plain stiff scheme for comparison; fluctuation mode with its default stage factor "
-                    "(stage_factor: 2 where 2 kT h/gamma > 1 sigma^2, else 1)"}
+                    "False rows: the plain stiff scheme for comparison; fluctuation mode with its default stage rule "
+                    "(session 13, Simulation.fluct_stages_target: stages = s of a full step, R_stiffest = T_s(1 - h "
+                    "rho/s^2) of the pair's mode, stage_factor = the m that gives s); ratio_ens: the same records' "
+                    "variance over the pairs at each record time, averaged over time (unbiased when a pair's "
+                    "records are correlated over many steps)"}
     RESULTS.mkdir(exist_ok=True)
-    (RESULTS / f"{args.out}.json").write_text(json.dumps(out, indent=1) + "\n")
+    with atomic_path(RESULTS / f"{args.out}.json") as tmp:
+        Path(tmp).write_text(json.dumps(out, indent=1) + "\n")
     plot(out, args.out)
 
 
@@ -135,7 +149,8 @@ def plot(out, stem="sim_fluct_bias"):
     axes[0].set_title("fluctuation mode, bonded pairs (rest 1 sigma, k = 1)", fontsize=9)
     axes[1].set_title("the same against the noise turn per step", fontsize=9)
     fig.tight_layout()
-    fig.savefig(RESULTS / f"{stem}.png", dpi=120)
+    with atomic_path(RESULTS / f"{stem}.png") as tmp:
+        fig.savefig(tmp, dpi=120, format="png")
 
 
 if __name__ == "__main__":
