@@ -67,6 +67,8 @@ def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--only", nargs="*", default=list(DEFAULT), help="example file names")
     ap.add_argument("--seeds", type=int, default=3)
+    ap.add_argument("--seed-list", type=int, nargs="*", default=None,
+                    help="run these seeds instead of 0 .. --seeds - 1 (e.g. a second campaign on seed 1)")
     ap.add_argument("--kT", type=float, default=1e-5)
     ap.add_argument("--scheme", default="stiff", choices=("stiff", "euler"))
     ap.add_argument("--joint-k", type=float, default=CircuitOptions().joint_k,
@@ -94,7 +96,7 @@ def main():
                     "joint_k": args.joint_k}
             res["scenes"][key] = info
         done = {(r["scene"], r["state"], r["seed"]) for r in res["runs"] + main_runs if "tau" in r or args.reuse_tau}
-        for seed in range(args.seeds):
+        for seed in (args.seed_list if args.seed_list is not None else range(args.seeds)):
             for state in sc.states():
                 if (key, state, seed) in done or (args.rows and state not in args.rows):
                     continue
