@@ -298,9 +298,8 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
     more than 8 min for a 2000-body robot).  Seeds are ``first_seed``, ``first_seed + 1``, ..."""
     from mlc.io.progress import Progress
     from mlc.sim.drive import Drive
-    from mlc.verify.dynamic import TAU_FACTOR
     from mlc.sim.integrator import SimOptions, Simulation
-    from mlc.verify.dynamic import relaxation_time
+    from mlc.verify.dynamic import TAU_FACTOR, relaxation_time
 
     rm = robot_meta(scene)
     states = select_rows(scene, rows)

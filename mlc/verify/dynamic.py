@@ -47,6 +47,7 @@ times t0 = gamma / (1e-3 k0), energies k0 sigma^2.
 from __future__ import annotations
 
 import math
+import sys
 
 import numpy as np
 
@@ -390,7 +391,6 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
                 t_max = max_time if max_time_given else max(MAX_TIME, MAX_TAUS * tau_row)
                 if scheme == "euler" and not warned and show is not False and t_expect / sim.dt > SLOW_STEPS:
                     warned = True
-                    import sys
                     print(f"mlc: warning: --scheme euler: this scene's stiffest bonds allow dt = {sim.dt:.2g} t0, "
                           f"so row {state} needs about {t_expect / sim.dt:.1e} steps (at least {t_expect:.3g} t0); "
                           "that can take days: use --scheme stiff (the default), or --rows to check fewer rows",
