@@ -146,3 +146,31 @@ def test_no_step_matches_the_cofactor_conditions():
         assert got == (not step)
         seen.add(got)
     assert seen == {True, False}
+
+
+def _random_network(seed: int, n_in: int = 14, n_and: int = 250, n_out: int = 8):
+    from mlc.logic.aig import AIG
+    rng = random.Random(seed)
+    g = AIG([f"i{i}" for i in range(n_in)])
+    lits = [g.input_lit(i) for i in range(n_in)]
+    while g.num_ands() < n_and:
+        a = rng.choice(lits[-30:]) if rng.random() < 0.7 else rng.choice(lits)
+        b = rng.choice(lits[-30:]) if rng.random() < 0.7 else rng.choice(lits)
+        r = g.and_(a ^ rng.randint(0, 1), b ^ rng.randint(0, 1))
+        if r > 1 and (r >> 1) > n_in and r not in lits:
+            lits.append(r & ~1)
+    for k in range(n_out):
+        g.add_output(f"o{k}", lits[-1 - 3 * k] ^ (k & 1))
+    return g.cleanup()
+
+
+def test_refactor_constant_cones_of_several_cut_sizes():
+    # the constant plans are one object for the decompositions of every cut size:
+    # refactor's scratch AIG of a constant met at 10 leaves was taken for a constant
+    # cone over fewer leaves (IndexError) before the scratch AIGs were keyed by size
+    from mlc.logic import opt
+    for seed in (3, 4):
+        g = _random_network(seed)
+        h = opt.refactor(g, max_leaves=10, zero_gain=True)
+        assert h.truth_tables() == g.truth_tables()
+        assert h.num_ands() < g.num_ands()

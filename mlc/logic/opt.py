@@ -1305,8 +1305,9 @@ def refactor(g: AIG, max_leaves: int = 8, zero_gain: bool = False,
     decs: dict[int, _Dec] = {}
     # scratch AIG of each plan built in this pass (a plan is the memoised answer of
     # _Dec.rec for one function; building it again gives the same AIG and adds nothing
-    # to the _Dec's available functions)
-    scratch: dict[int, AIG] = {}
+    # to the _Dec's available functions), by cut size and plan: the constant plans are
+    # one object shared by the _Decs of all cut sizes
+    scratch: dict[tuple[int, int], AIG] = {}
     lev = None
     kernels = _use_kernels(g) and max_leaves <= 14
     if kernels:
@@ -1330,11 +1331,11 @@ def refactor(g: AIG, max_leaves: int = 8, zero_gain: bool = False,
         if d is None:
             d = decs[k] = _Dec(k, 2)
         _, plan = d.rec(f, T.mask(k))
-        s = scratch.get(id(plan))
+        s = scratch.get((k, id(plan)))
         if s is None:
             s = AIG([f"l{i}" for i in range(k)])
             s.add_output("f", d.build(s, plan))
-            s = scratch[id(plan)] = s.cleanup()
+            s = scratch[k, id(plan)] = s.cleanup()
         e, new = _dag_expr(g, s, [2 * y for y in leaves], set(cone), touched, refs)
         if new > len(cone) or (new == len(cone) and not zero_gain):
             continue
