@@ -60,6 +60,18 @@ class Progress:
         if self.show:
             self._draw()
 
+    def within(self, base: float, expect: float):
+        """A callback ``f(t)`` for one long item after ``base`` finished ones: it moves the bar
+        by ``t / expect`` of the item, at most 0.95 of it (``expect``, in the caller's units of
+        ``t``, is an estimate; the item's own ``update(base + 1)`` completes it).  None when the
+        bar is not shown, so a caller passes it on without a test."""
+        if not self.show or not expect > 0:
+            return None
+
+        def f(t: float) -> None:
+            self.update(base + min(t / expect, 0.95))
+        return f
+
     def line(self) -> str:
         """The text of the progress line now (also used by the tests)."""
         el = time.perf_counter() - self.t0

@@ -331,12 +331,8 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
             for seed in range(int(first_seed), int(first_seed) + int(seeds)):
                 sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed,
                                                      dt=None if dt is None else float(dt)))
-                inner = None
-                if bar.show:        # the bar moves within a fold: time run over 3 tau (tau at rest)
-                    t_expect = TAU_FACTOR * tau if state != "0" * len(scene.inputs) else tau
-
-                    def inner(t, base=done, t_expect=t_expect):
-                        bar.update(base + min(t / t_expect, 0.95))
+                # the bar moves within a fold: time run over 3 tau (tau at rest)
+                inner = bar.within(done, TAU_FACTOR * tau if state != "0" * len(scene.inputs) else tau)
                 means, t_rel, relaxed, _, _ = run_fold(sim, scene, state, kT, tau, t_max, on_window=inner)
                 shape = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy(), means)
                 per.append((means, t_rel, relaxed, shape))

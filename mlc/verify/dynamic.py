@@ -395,10 +395,7 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
                           f"so row {state} needs about {t_expect / sim.dt:.1e} steps (at least {t_expect:.3g} t0); "
                           "that can take days: use --scheme stiff (the default), or --rows to check fewer rows",
                           file=sys.stderr, flush=True)
-                inner = None
-                if bar.show:
-                    def inner(t, base=done):
-                        bar.update(base + min(t / t_expect, 0.95))
+                inner = bar.within(done, t_expect)
                 means, t_rel, relaxed = relax_all(sim, names, kT, t_min, window, t_max, sd, tau_row, inner)
                 per.append((means, t_rel, relaxed))
                 done += 1
