@@ -174,3 +174,75 @@ def test_refactor_constant_cones_of_several_cut_sizes():
         h = opt.refactor(g, max_leaves=10, zero_gain=True)
         assert h.truth_tables() == g.truth_tables()
         assert h.num_ands() < g.num_ands()
+
+
+def _random_tables(rng, n: int, n_out: int):
+    """Outputs sharing remainders (g, x & g, !x | g, x ^ g, ...), so that the
+    decomposition's shared steps find plans of earlier outputs; some don't cares."""
+    from mlc.spec import TableSpec
+    full = T.mask(n)
+    pos, _ = T.var_tables(n)
+    g = rng.getrandbits(1 << n) & full
+    on, dc = [], []
+    for _ in range(n_out):
+        x = pos[rng.randrange(n)] ^ (full if rng.random() < 0.5 else 0)
+        f = rng.choice([g, x & g, x | g, x ^ g, full ^ g, rng.getrandbits(1 << n) & full])
+        d = 0 if rng.random() < 0.6 else rng.getrandbits(1 << n) & rng.getrandbits(1 << n) & full
+        on.append(f & ~d & full)
+        dc.append(d)
+        if rng.random() < 0.5:
+            g = f
+    return TableSpec([f"x{i}" for i in range(n)], [f"o{k}" for k in range(n_out)], on, dc)
+
+
+def _clear_caches():
+    for c in (decomp._support_cache, decomp._sop_cache, decomp._exact_cache,
+              decomp._analysis_cache):
+        c.clear()
+
+
+def test_analysis_memo_same_networks_as_plain_recursion(monkeypatch):
+    # _Dec._rec reads its analysis of an interval from decomp._analysis_cache (the
+    # memo path) or works it out afresh (ANALYSIS_MEMO False): same plans, same AIGs,
+    # with the memo cold and warm (refactoring's later passes meet the same cones)
+    from mlc.logic import opt
+    analysed = []
+    real = decomp._Dec._analyse
+    monkeypatch.setattr(decomp._Dec, "_analyse",
+                        lambda self, f, care: analysed.append(1) or real(self, f, care))
+    rng = random.Random(31)
+    jobs = []
+    for _ in range(80):
+        n = rng.randint(3, 7)
+        spec = _random_tables(rng, n, rng.randint(1, 6))
+        jobs.append(lambda spec=spec: decomp.from_table(spec).to_text())
+    for seed in (3, 4):
+        g = _random_network(seed)
+        jobs.append(lambda g=g: opt.refactor(g).to_text())
+        jobs.append(lambda g=g: opt.refactor(g, max_leaves=10, zero_gain=True).to_text())
+    for job in jobs:
+        _clear_caches()
+        monkeypatch.setattr(decomp, "ANALYSIS_MEMO", False)
+        want = job()
+        assert not analysed
+        monkeypatch.setattr(decomp, "ANALYSIS_MEMO", True)
+        _clear_caches()
+        assert job() == want                   # cold memo
+        k = len(analysed)
+        assert k > 0
+        assert job() == want                   # warm memo: nothing analysed again
+        assert len(analysed) == k
+        analysed.clear()
+
+
+def test_analysis_memo_leaves_random_shannon_choices_to_the_plain_path(monkeypatch):
+    monkeypatch.setattr(decomp, "ANALYSIS_MEMO", True)
+    rng = random.Random(32)
+    for _ in range(20):
+        spec = _random_tables(rng, rng.randint(5, 8), 3)
+        texts = []
+        for memo in (False, True):
+            monkeypatch.setattr(decomp, "ANALYSIS_MEMO", memo)
+            _clear_caches()
+            texts.append(decomp.from_table(spec, rng=random.Random(7)).to_text())
+        assert texts[0] == texts[1]

@@ -267,7 +267,8 @@ def test_refactor_decomposition_kernel_same_network(seed, monkeypatch):
     for kw in ({}, {"max_leaves": 10, "zero_gain": True}):
         texts = []
         for on in (False, True):
-            for c in (decomp._support_cache, decomp._sop_cache, decomp._exact_cache):
+            for c in (decomp._support_cache, decomp._sop_cache, decomp._exact_cache,
+                      decomp._analysis_cache):
                 c.clear()
             old = opt.KERNELS, opt.KERNEL_MIN_ANDS
             opt.KERNELS, opt.KERNEL_MIN_ANDS = on, 0

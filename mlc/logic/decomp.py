@@ -30,6 +30,16 @@ _CACHE_MAX = 200_000
 _support_cache: dict = {}
 _sop_cache: dict = {}
 _exact_cache: dict = {}
+# _Dec._rec's analysis of an interval (see _Dec._analyse), by (n, effort, f, care):
+# everything _rec works out before it looks at the plans already built or recurses
+_analysis_cache: dict = {}
+# False: _Dec._rec analyses every interval afresh (the plain path, kept for the tests)
+ANALYSIS_MEMO = True
+
+# the constant plans (one object each, as _rec's constants always were: build's
+# self._key is keyed by a plan's id)
+_CONST0 = ("const", 0)
+_CONST1 = ("const", 1)
 
 
 def _kernels(n: int):
@@ -145,31 +155,11 @@ class _Dec:
         complement) an earlier output has already built: (cost, plan) or None."""
         if not self.avail:
             return None
-        n = self.n
         best = None
-        pos, neg = T.var_tables(n)
-        whole = care == self.full
-        for i in sup:
-            if whole and _no_step(f, 1 << i, pos[i], neg[i]):
-                continue
-            on0, on1, of0, of1, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i], self.full)
-            x = 2 * (i + 1)
-            steps = []
-            if on0 == 0:
-                steps.append((1, "and", x, on1, c1))
-            if on1 == 0:
-                steps.append((1, "and", x ^ 1, on0, c0))
-            if of1 == 0:
-                steps.append((1, "or", x, on0, c0))
-            if of0 == 0:
-                steps.append((1, "or", x ^ 1, on1, c1))
-            if on0 & on1 == 0 and of0 & of1 == 0:
-                steps.append((3, "xor", x, on0 | of1, c0 | c1))
-            for cost, kind, lit, g, gc in steps:
-                g &= gc
-                p = self._find_avail(g, gc)
-                if p is not None and (best is None or cost < best[0]):
-                    best = (cost, (kind, lit, p))
+        for cost, kind, lit, g, gc in self._steps(f, care, sup):
+            p = self._find_avail(g, gc)
+            if p is not None and (best is None or cost < best[0]):
+                best = (cost, (kind, lit, p))
         return best
 
     def _find_avail(self, g: int, gc: int):
@@ -184,11 +174,123 @@ class _Dec:
         return None
 
     def _rec(self, f: int, care: int):
-        n, full = self.n, self.full
+        if self.rng is not None or not ANALYSIS_MEMO:
+            return self._rec_plain(f, care)
+        key = (self.n, self.effort, f, care)
+        a = _analysis_cache.get(key)
+        if a is None:
+            a = self._analyse(f, care)
+            _cache_put(_analysis_cache, key, a)
+        tag = a[0]
+        if tag == 0:
+            return 0, _CONST0
+        if tag == 1:
+            return 0, _CONST1
+        if tag == 2:
+            return 0, ("lit", a[1])
+        _, nsup, steps, base, shannon = a
+        sh = None
+        if steps and self.avail:                 # shared_step
+            find = self._find_avail
+            for cost, kind, lit, g, gc in steps:
+                p = find(g, gc)
+                if p is not None and (sh is None or cost < sh[0]):
+                    sh = (cost, (kind, lit, p))
+        if nsup <= 4:
+            ex = (base[0], (base[1][0], base[1][1], base[1][2]))
+            return sh if sh is not None and sh[0] < ex[0] else ex
+        if sh is not None:
+            return sh
+        if steps:                                # the first disjoint-support step
+            cost, kind, lit, g, gc = steps[0]
+            c, p = self.rec(g, gc)
+            return c + cost, (kind, lit, p)
+        best = (base[0], (base[1][0], base[1][1], base[1][2]))
+        for i, on0, on1, c0, c1 in shannon:
+            ca, pa = self.rec(on1, c1)
+            cb, pb = self.rec(on0, c0)
+            c = ca + cb + 3
+            if c < best[0]:
+                best = (c, ("mux", 2 * (i + 1), pa, pb))
+        return best
+
+    def _analyse(self, f: int, care: int):
+        """What :meth:`_rec_plain` works out for the interval (``f`` on ``care``)
+        before it looks at ``self.avail`` or recurses; it depends only on the
+        interval, ``n`` and the effort (not on a random Shannon choice).  One of
+        (0,) constant 0, (1,) constant 1, (2, lit) a literal, or
+        (3, |support|, steps, base, shannon): ``steps`` the one-variable steps
+        (cost, kind, literal, g, g's care) in shared_step's order (the first is the
+        disjoint-support step), ``base`` the exact plan (support <= 4) or the
+        factored SOP's (cost, plan), ``shannon`` the (i, on0, on1, c0, c1) that the
+        Shannon expansion tries, in order."""
+        full = self.full
         if f == 0:
-            return 0, ("const", 0)
+            return (0,)
         if (f | ~care) & full == full:
-            return 0, ("const", 1)
+            return (1,)
+        f, care, sup = self.reduce_support(f, care)
+        for i in sup:
+            v = self.vars[i] & care
+            if v == f:
+                return (2, 2 * (i + 1))
+            if (~self.vars[i]) & care == f:
+                return (2, 2 * (i + 1) + 1)
+        steps = tuple(self._steps(f, care, sup))
+        if len(sup) <= 4:
+            return (3, len(sup), steps, self.exact(f, care, sup), ())
+        if steps:
+            return (3, len(sup), steps, None, ())
+        base = self.sop_plan(f, care)
+        shannon = ()
+        if len(sup) <= self.shannon_limit:
+            shannon = tuple(t[1:] for t in self._shannon_scored(f, care, sup))
+        return (3, len(sup), steps, base, shannon)
+
+    def _steps(self, f: int, care: int, sup: list[int]):
+        """The one-variable steps ``x op g`` of the interval, as shared_step tries
+        them: (cost, kind, literal of x, g & g's care, g's care)."""
+        pos, neg = T.var_tables(self.n)
+        whole = care == self.full
+        for i in sup:
+            if whole and _no_step(f, 1 << i, pos[i], neg[i]):
+                continue
+            on0, on1, of0, of1, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i], self.full)
+            x = 2 * (i + 1)
+            if on0 == 0:
+                yield 1, "and", x, on1 & c1, c1
+            if on1 == 0:
+                yield 1, "and", x ^ 1, on0 & c0, c0
+            if of1 == 0:
+                yield 1, "or", x, on0 & c0, c0
+            if of0 == 0:
+                yield 1, "or", x ^ 1, on1 & c1, c1
+            if on0 & on1 == 0 and of0 & of1 == 0:
+                gc = c0 | c1
+                yield 3, "xor", x, (on0 | of1) & gc, gc
+
+    def _shannon_scored(self, f: int, care: int, sup: list[int]):
+        """The Shannon candidates (score, i, on0, on1, c0, c1), best first, that
+        _rec tries: at most ``width`` of them; with ``self.rng``, each variable's
+        score gets a noise in [0, 3) (one draw a variable, in support order)."""
+        pos, neg = T.var_tables(self.n)
+        scored = []
+        for i in sup:
+            on0, on1, _, _, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i], self.full)
+            s0 = len(self.reduce_support(on0, c0)[2])
+            s1 = len(self.reduce_support(on1, c1)[2])
+            noise = self.rng.random() * 3 if self.rng is not None else 0.0
+            scored.append((s0 + s1 + noise, i, on0, on1, c0, c1))
+        scored.sort()
+        width = (len(sup) if len(sup) <= 6 else 2) if self.effort >= 2 else 1
+        return scored[:width]
+
+    def _rec_plain(self, f: int, care: int):
+        full = self.full
+        if f == 0:
+            return 0, _CONST0
+        if (f | ~care) & full == full:
+            return 0, _CONST1
         f, care, sup = self.reduce_support(f, care)
         for i in sup:
             v = self.vars[i] & care
@@ -202,45 +304,15 @@ class _Dec:
             return sh if sh is not None and sh[0] < ex[0] else ex
         if sh is not None:
             return sh
-        pos, neg = T.var_tables(n)
-        # disjoint-support steps
-        whole = care == full
-        for i in sup:
-            if whole and _no_step(f, 1 << i, pos[i], neg[i]):
-                continue
-            on0, on1, of0, of1, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i], self.full)
-            x = 2 * (i + 1)
-            if on0 == 0:                 # f = x & f1
-                c, p = self.rec(on1, c1)
-                return c + 1, ("and", x, p)
-            if on1 == 0:                 # f = !x & f0
-                c, p = self.rec(on0, c0)
-                return c + 1, ("and", x ^ 1, p)
-            if of1 == 0:                 # f = x | f0
-                c, p = self.rec(on0, c0)
-                return c + 1, ("or", x, p)
-            if of0 == 0:                 # f = !x | f1
-                c, p = self.rec(on1, c1)
-                return c + 1, ("or", x ^ 1, p)
-            if on0 & on1 == 0 and of0 & of1 == 0:   # f = x ^ g, g = f0 = !f1
-                g_on = on0 | of1
-                g_care = c0 | c1
-                c, p = self.rec(g_on, g_care)
-                return c + 3, ("xor", x, p)
+        # disjoint-support steps: the first one-variable step
+        for cost, kind, lit, g, gc in self._steps(f, care, sup):
+            c, p = self.rec(g, gc)
+            return c + cost, (kind, lit, p)
         # factored SOP, both phases
         best = self.sop_plan(f, care)
         if len(sup) <= self.shannon_limit:
             # Shannon on the variables whose cofactors are simplest
-            scored = []
-            for i in sup:
-                on0, on1, _, _, c0, c1 = _cofactors(f, care, 1 << i, pos[i], neg[i], self.full)
-                s0 = len(self.reduce_support(on0, c0)[2])
-                s1 = len(self.reduce_support(on1, c1)[2])
-                noise = self.rng.random() * 3 if self.rng is not None else 0.0
-                scored.append((s0 + s1 + noise, i, on0, on1, c0, c1))
-            scored.sort()
-            width = (len(sup) if len(sup) <= 6 else 2) if self.effort >= 2 else 1
-            for _, i, on0, on1, c0, c1 in scored[:width]:
+            for _, i, on0, on1, c0, c1 in self._shannon_scored(f, care, sup):
                 ca, pa = self.rec(on1, c1)
                 cb, pb = self.rec(on0, c0)
                 c = ca + cb + 3
