@@ -312,3 +312,46 @@ def test_npn_matches_memo_fits_and_matches_the_transforms():
                 want.append(2 * idx + 1)
         assert pool[start[f]:start[f] + count[f]].tolist() == want
     assert top[0] <= kern.NPN_POOL
+
+
+def test_analyse_full_same_records_as_python_analysis(monkeypatch):
+    # decomp._Dec._analyse of completely specified functions: kern.analyse_full's
+    # support, steps, Shannon scores and 4-variable table give the Python path's record
+    from mlc.logic import decomp
+    from mlc.logic import tt as T
+    monkeypatch.setattr(kern, "READY", True)
+    rng = random.Random(41)
+    cases = []
+    for n in range(1, kern.SOP_MAX_VARS + 1):
+        full = T.mask(n)
+        pos, _ = T.var_tables(n)
+        for _ in range(30):
+            f = rng.getrandbits(1 << n) & full
+            for i in range(n):                          # drop some variables
+                if rng.random() < 0.4:
+                    f = T.cof0(f, n, i) if rng.random() < 0.5 else T.cof1(f, n, i)
+            if n > 1 and rng.random() < 0.5:            # one-variable steps on top
+                i = rng.randrange(n)
+                g = T.cof0(f, n, i)
+                x = pos[i] ^ (full if rng.random() < 0.5 else 0)
+                f = rng.choice([x & g, x | g, x ^ g]) & full
+            cases.append((n, f))
+        cases += [(n, pos[0]), (n, full ^ pos[n - 1])]
+    kinds = set()
+    for n, f in cases:
+        full = T.mask(n)
+        recs = []
+        for on in (False, True):
+            monkeypatch.setattr(opt, "KERNELS", on)
+            for c in (decomp._support_cache, decomp._sop_cache, decomp._exact_cache):
+                c.clear()
+            for effort in (1, 2, 3):
+                recs.append(decomp._Dec(n, effort)._analyse(f, full))
+        assert recs[:3] == recs[3:], (n, f)
+        for r in recs:
+            kinds.add((r[0], r[0] == 3 and r[1] <= 4, r[0] == 3 and bool(r[2]),
+                       r[0] == 3 and bool(r[4])))
+    # constants, literals, exact, steps, SOP + Shannon and SOP alone all met
+    assert {(0, False, False, False), (2, False, False, False), (3, True, False, False),
+            (3, True, True, False), (3, False, True, False), (3, False, False, True),
+            (3, False, False, False)} <= kinds

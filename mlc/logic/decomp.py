@@ -229,6 +229,10 @@ class _Dec:
             return (0,)
         if (f | ~care) & full == full:
             return (1,)
+        if care == full:
+            kern = _kernels(self.n)
+            if kern is not None:
+                return self._analyse_full_nb(f, kern)
         f, care, sup = self.reduce_support(f, care)
         for i in sup:
             v = self.vars[i] & care
@@ -245,6 +249,59 @@ class _Dec:
         shannon = ()
         if len(sup) <= self.shannon_limit:
             shannon = tuple(t[1:] for t in self._shannon_scored(f, care, sup))
+        return (3, len(sup), steps, base, shannon)
+
+    def _analyse_full_nb(self, f: int, kern):
+        """:meth:`_analyse` of a completely specified, non-constant ``f``, its table
+        work (support, steps, Shannon scores, the table over a support of at most 4)
+        done by :func:`mlc.logic.kern.analyse_full`."""
+        n, full = self.n, self.full
+        dep, stepbits, score, t16 = kern.analyse_full(f, n)
+        sup = [i for i in range(n) if dep[i]]
+        if len(sup) == 1:               # a completely specified function of one variable
+            i = sup[0]
+            return (2, 2 * (i + 1) + (f != self.vars[i]))
+        pos, neg = T.var_tables(n)
+        steps = []
+        for i in sup:
+            b = int(stepbits[i])
+            if not b:
+                continue
+            s = 1 << i
+            t = f & neg[i]
+            on0 = t | (t << s)
+            t = f & pos[i]
+            on1 = t | (t >> s)
+            x = 2 * (i + 1)
+            if b & 1:
+                steps.append((1, "and", x, on1, full))
+            if b & 2:
+                steps.append((1, "and", x ^ 1, on0, full))
+            if b & 4:
+                steps.append((1, "or", x, on0, full))
+            if b & 8:
+                steps.append((1, "or", x ^ 1, on1, full))
+            if b & 16:
+                steps.append((3, "xor", x, on0, full))
+        steps = tuple(steps)
+        if len(sup) <= 4:
+            t16 = int(t16)
+            return (3, len(sup), steps, (npn.cost4(t16), ("exact", t16, tuple(sup))), ())
+        if steps:
+            return (3, len(sup), steps, None, ())
+        base = self.sop_plan(f, full)
+        shannon = ()
+        if len(sup) <= self.shannon_limit:
+            width = (len(sup) if len(sup) <= 6 else 2) if self.effort >= 2 else 1
+            sh = []
+            for _, i in sorted((int(score[i]), i) for i in sup)[:width]:
+                s = 1 << i
+                t = f & neg[i]
+                on0 = t | (t << s)
+                t = f & pos[i]
+                on1 = t | (t >> s)
+                sh.append((i, on0, on1, full, full))
+            shannon = tuple(sh)
         return (3, len(sup), steps, base, shannon)
 
     def _steps(self, f: int, care: int, sup: list[int]):

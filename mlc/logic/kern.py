@@ -1403,6 +1403,8 @@ def warm() -> float:
     finally:
         opt.KERNELS, opt.KERNEL_MIN_ANDS = old
     npn_arrays()
+    sop_costs(0b0110, 0b1111, 2)              # the decomposition's kernels
+    analyse_full(0b0110, 2)
     return time.perf_counter() - t0
 
 
@@ -1833,3 +1835,91 @@ def _sop_phase(L, U, n, W, full):
     st = np.full(1, n + 1, dtype=np.int64)
     _fx_factor(P[:m].copy(), Q[:m].copy(), n, keys, vals, 2 * N + 2, st)
     return st[0] - (n + 1), P, Q, m
+
+
+# ----------------------------------------------------------------------------- decomposition analysis
+
+_FULLW: dict = {}
+
+
+def analyse_full(f: int, n: int):
+    """The table work of :meth:`mlc.logic.decomp._Dec._analyse` for a completely
+    specified ``f`` (Python int over ``n <= SOP_MAX_VARS`` variables, neither
+    constant): ``(dep, steps, score, t16)``, arrays over the variables --
+    ``dep[i]`` whether ``f`` depends on variable ``i``; ``steps[i]`` the one-variable
+    steps on ``i`` as bits (1: cofactor 0 is 0, 2: cofactor 1 is 0, 4: cofactor 1 is
+    all ones, 8: cofactor 0 is all ones, 16: the cofactors are complements); ``score[i]``
+    the number of variables each cofactor depends on, summed -- and ``t16`` the table
+    over the support (its variables in increasing order) repeated to 16 bits, where the
+    support has at most 4 variables (else 0)."""
+    W = max(1, (1 << n) >> 6)
+    fullw = _FULLW.get(n)
+    if fullw is None:
+        full = (1 << (1 << n)) - 1
+        fullw = _FULLW[n] = np.frombuffer(full.to_bytes(8 * W, "little"),
+                                          dtype="<u8").astype(np.uint64)
+    t = np.frombuffer(f.to_bytes(8 * W, "little"), dtype="<u8").astype(np.uint64)
+    return _analyse_full(t, n, W, fullw)
+
+
+@njit(cache=True)
+def _analyse_full(t, n, W, full):
+    dep = np.zeros(n, dtype=np.int64)
+    steps = np.zeros(n, dtype=np.int64)
+    score = np.zeros(n, dtype=np.int64)
+    nsup = 0
+    for i in range(n):
+        if _tw_depends(t, i, W):
+            dep[i] = 1
+            nsup += 1
+    for i in range(n):
+        if dep[i] == 0:
+            continue
+        c0 = _tw_cof(t, i, W, False)
+        c1 = _tw_cof(t, i, W, True)
+        z0 = True
+        z1 = True
+        o0 = True
+        o1 = True
+        cp = True
+        for w in range(W):
+            if c0[w] != 0:
+                z0 = False
+            if c1[w] != 0:
+                z1 = False
+            if c0[w] != full[w]:
+                o0 = False
+            if c1[w] != full[w]:
+                o1 = False
+            if c0[w] != (c1[w] ^ full[w]):
+                cp = False
+        steps[i] = (1 if z0 else 0) | (2 if z1 else 0) | (4 if o1 else 0) \
+            | (8 if o0 else 0) | (16 if cp else 0)
+        s = 0
+        for j in range(n):
+            if j != i:
+                if _tw_depends(c0, j, W):
+                    s += 1
+                if _tw_depends(c1, j, W):
+                    s += 1
+        score[i] = s
+    t16 = 0
+    if nsup <= 4:
+        sup = np.zeros(4, dtype=np.int64)
+        k = 0
+        for i in range(n):
+            if dep[i]:
+                sup[k] = i
+                k += 1
+        for lm in range(1 << k):
+            m = 0
+            for i in range(k):
+                if (lm >> i) & 1:
+                    m |= 1 << sup[i]
+            if (t[m >> 6] >> np.uint64(m & 63)) & np.uint64(1):
+                t16 |= 1 << lm
+        w = 1 << k
+        while w < 16:
+            t16 |= t16 << w
+            w *= 2
+    return dep, steps, score, t16
