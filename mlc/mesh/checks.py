@@ -40,6 +40,7 @@ GAP_EPS = 1e-6    # mm
 BED_CONTACT_MIN = 0.20     # first-layer area / footprint
 SUPPORT_MAX = 0.10         # support volume / part volume
 OVERHANG_DEG = 45.0        # faces steeper than this from vertical need support (FDM rule of thumb)
+APART = True               # states check of large assemblies: prove posed pairs apart first (mlc.mesh.apart)
 
 
 @dataclass
@@ -204,6 +205,14 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
             Fr = np.asarray(frames, float)
             corners = np.einsum("nij,nkj->nki", Fr[:, :3, :3], loc) + Fr[:, None, :3, 3]
         skipped = 0
+        meshes: dict = {}
+
+        def mesh_of(k):
+            if k not in meshes:
+                m = parts[k].solid.to_mesh64()
+                meshes[k] = (np.asarray(m.vert_properties, float)[:, :3], np.asarray(m.tri_verts, np.int64))
+            return meshes[k]
+        from mlc.mesh.apart import surfaces_apart
         for st, (pos, quat) in poses.items():
             T = asm.part_transforms(pos, quat)
             Tp = [T[p.name] for p in parts]
@@ -224,6 +233,7 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
                 skipped += int((~keep).sum())
                 cand = [pr for pr, k in zip(cand, keep) if k]
             posed = {}
+            posed_v = {}
 
             def vol(i, j):
                 for k in (i, j):
@@ -231,13 +241,24 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
                         posed[k] = transform_solid(parts[k].solid, Tp[k])
                 return float((posed[i] ^ posed[j]).volume())
 
+            def vol_or_apart(i, j):
+                # large assemblies: most posed pairs share no volume, and the triangles prove it
+                # (mlc.mesh.apart, exact and one-sided) in a third of a boolean's time
+                for k in (i, j):
+                    if k not in posed_v:
+                        V, F = mesh_of(k)
+                        posed_v[k] = (V @ Tp[k][:3, :3].T + Tp[k][:3, 3], F)
+                if surfaces_apart(*posed_v[i], *posed_v[j]):
+                    return 0.0
+                return vol(i, j)
+
             rels = cong.rel_many(cand, Tp) if cong is not None else None
             for k, (i, j) in enumerate(cand):
                 if cong is None:
                     v = vol(i, j)
                 else:
                     v = cong.lookup(("volume", cong.key(i, parts[i].solid), cong.key(j, parts[j].solid),
-                                     rels[k]), lambda: vol(i, j))
+                                     rels[k]), lambda: (vol_or_apart if APART else vol)(i, j))
                 worst = max(worst, v)
                 if v > VOL_EPS:
                     fails.append(f"state {st}: {parts[i].name} intersects {parts[j].name} ({v:.4g} mm^3)")
