@@ -258,6 +258,16 @@ def _body_cells(b, prof: Profile) -> float:
 _WALL_CELLS = 6e6       # mlc.mesh.walls.MAX_CELLS
 
 
+#: bytes a body for the bed check (mlc.mesh.printability.bed_stats rasterises every triangle of
+#: the print at once: the Tetris circuit went from 1.68 to 2.94 GB there, 2.82 M triangles, 1631
+#: bodies, about 0.77 MB a body); fitted with a margin on the compiled circuits (session 14)
+BED_BYTES_PER_BODY = 1.0e6
+
+#: measured peak resident memory (bytes) of ``mlc stl`` at mjp: (case, bodies, peak); the test of
+#: :func:`estimate_memory` checks the estimate stays above each (tests/test_mesh_profiles.py)
+MEASURED_PEAKS = (("gate a & b", 8, 0.229e9), ("(a & b) | c", 144, 0.492e9), ("examples/tetris.tt", 1631, 3.086e9))
+
+
 def estimate_memory(prof: Profile, scene) -> dict:
     """Rough peak memory (bytes) of an export of ``scene`` at ``prof``, from the sizes in mm.
 
@@ -266,9 +276,14 @@ def estimate_memory(prof: Profile, scene) -> dict:
     the voxel grid of the wall check (one part at a time, at most 6e6 cells, about 40 bytes a
     cell), the support-column grid of the bed check over the whole print (spacing
     ``max(0.05, min(min_wall, size/150))`` mm, about 300 bytes a column), 0.8 MB of meshes per
-    body and a fixed 250 MB.  Measured peaks (NAND at sigma 20 mm: 0.50 GB, estimate 0.51; grids of
-    9 and 36 NAND at mjp: 0.24 and 0.41 GB, estimates 0.33 and 0.52; a grid of 900 NAND is
-    estimated at 6.7 GB and refused)."""
+    body, :data:`BED_BYTES_PER_BODY` for the bed check's raster of every triangle of the print at
+    once, and a fixed 250 MB.  Measured peaks (NAND at sigma 20 mm: 0.50 GB, estimate 0.51; grids of
+    9 and 36 NAND at mjp: 0.24 and 0.41 GB, estimates 0.40 and 0.81; a grid of 900 NAND is
+    estimated at 13.9 GB and refused).  Compiled circuits at mjp, ``mlc stl`` (``/usr/bin/time -v``,
+    session 14): ``a & b`` (8 bodies) 0.23 GB, estimate 0.30; ``(a & b) | c`` (144 bodies) 0.49 GB
+    (0.39 before the states check loaded numba), estimate 0.54; the Tetris circuit (1631 bodies)
+    3.09 GB, its peak in the bed check (1.68 GB resident before it), estimate 3.33 (1.70 before
+    the bed term).  :data:`MEASURED_PEAKS` lists them for the test."""
     import numpy as np
     s = prof.sigma_mm
     t = prof.slab_thickness
@@ -287,7 +302,7 @@ def estimate_memory(prof: Profile, scene) -> dict:
     size = np.sort(np.asarray(ext, float) * s)
     hb = max(0.05, min(prof.min_wall, float(size[-1]) / 150))
     cols = (size[-1] / hb + 2) * (size[-2] / hb + 2)
-    total = 100.0 * n + 40.0 * cells + 300.0 * cols + 0.8e6 * len(scene.bodies) + 250e6
+    total = 100.0 * n + 40.0 * cells + 300.0 * cols + (0.8e6 + BED_BYTES_PER_BODY) * len(scene.bodies) + 250e6
     return {"bytes": total, "samples": n, "sample_step_mm": h, "columns": cols, "column_step_mm": hb}
 
 
