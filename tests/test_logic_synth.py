@@ -155,3 +155,37 @@ def test_random_networks_equivalent(rnd, n, effort):
                        nodes, outs)
     g = synthesize(spec, effort)
     assert check_equivalent(g, spec)["equivalent"]
+
+
+def test_optimize_holds_off_full_garbage_collections(monkeypatch):
+    # full collections (generation 2) wait until the optimisation ends, the young
+    # generations are still collected, and the thresholds come back, also on an error
+    import gc
+    from mlc.logic import opt
+    spec = TableSpec([f"x{i}" for i in range(7)], ["y"], [0x96696996_69969669_12345678_9ABCDEF0],
+                     [0])
+    gens = []
+
+    def seen(phase, info):
+        if phase == "start":
+            gens.append(info["generation"])
+
+    old = gc.get_threshold()
+    gc.set_threshold(10, 1, 1)              # a full collection every 100 allocations
+    gc.callbacks.append(seen)
+    try:
+        g = opt.optimize(spec, 2)
+        during = list(gens)
+        assert gc.get_threshold() == (10, 1, 1)
+
+        def boom(*a):
+            raise RuntimeError("boom")
+        monkeypatch.setattr(opt, "_optimize_spec", boom)
+        with pytest.raises(RuntimeError):
+            opt.optimize(spec, 2)
+        assert gc.get_threshold() == (10, 1, 1)
+    finally:
+        gc.callbacks.remove(seen)
+        gc.set_threshold(*old)
+    assert g.truth_tables() == spec.on
+    assert 0 in during and 2 not in during
