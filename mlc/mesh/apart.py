@@ -245,4 +245,29 @@ def surfaces_apart(VA, FA, VB, FB, margin: float = MARGIN) -> bool:
                        np.ascontiguousarray(VB, np.float64), np.ascontiguousarray(FB, np.int64), float(margin)))
 
 
-__all__ = ["MARGIN", "surfaces_apart"]
+def mesh_arrays(solid, cache: dict | None = None):
+    """Vertices (n, 3, float64, mm) and triangles (m, 3, int64) of a manifold3d solid; ``cache``
+    (a dict) keeps them per solid object for the caller's lifetime of that dict."""
+    if cache is not None:
+        got = cache.get(id(solid))
+        if got is not None and got[0] is solid:
+            return got[1]
+    m = solid.to_mesh64()
+    out = (np.asarray(m.vert_properties, float)[:, :3], np.asarray(m.tri_verts, np.int64))
+    if cache is not None:
+        cache[id(solid)] = (solid, out)
+    return out
+
+
+def min_gap(a, b, search: float, cache: dict | None = None) -> float:
+    """``a.min_gap(b, search)`` of manifold3d (mm): the gap up to ``search``, and ``search`` itself
+    when nothing comes closer.  Answered ``search`` without manifold3d when the triangles prove the
+    surfaces more than ``search`` apart and neither box holds the other (nested solids have gap 0
+    in manifold3d; they go to manifold3d): a third of a millisecond against two (``(a & b) | c``:
+    571 of the 572 box-near pairs at least 2 x clearance apart proven, none wrongly)."""
+    if search > 0 and surfaces_apart(*mesh_arrays(a, cache), *mesh_arrays(b, cache), margin=search):
+        return float(search)
+    return float(a.min_gap(b, search))
+
+
+__all__ = ["MARGIN", "mesh_arrays", "min_gap", "surfaces_apart"]

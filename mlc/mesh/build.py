@@ -66,6 +66,7 @@ from mlc.scene.model import Scene
 _TOL = 1e-3  # sigma: tolerance for "same point / same line"
 #: assemblies with at least this many parts reuse results across congruent parts by default
 REUSE_MIN_PARTS = 64
+APART_GAP = True      # large assemblies: min_gap of pairs proven farther apart than the search skips manifold3d
 GUARD_PAD = 0.005  # mm: protected material grown by this much for the final trims of large assemblies
 
 
@@ -253,6 +254,7 @@ class Assembly:
     # large assemblies: each part's joint material (knuckles less their holes, pins, rings): a
     # subset of the finished part (no trim takes from it), for the retention check's first test
     cores: dict = field(default_factory=dict)
+    cone_conflicts: list = field(default_factory=list)   # pin: cone: [(part, part, state or None)]
     axis_cores: dict = field(default_factory=dict)   # compound junction's joint part: its stack knuckle and pin
 
     def part(self, name: str) -> Part:
@@ -366,11 +368,15 @@ def _build_assembly(scene, profile, poses, resolve, reuse) -> Assembly:
     R = max(R, t / 2 + prof.min_wall / 2)
     kmin = max(prof.min_feature, 0.0)
     cones = prof.pin == "cone"
-    r_cone = 0.0
+    r_cone = h_cone = 0.0
     if cones:
         # 45 degree cone pins: a cone on one knuckle in a conical recess of the next; the
         # recess is the cone offset by the clearance (its apex moves by c*sqrt(2))
         r_cone = max(prof.min_feature / 2 + g + c, r_pin)
+        # truncated where its diameter is min_feature (the tip beyond is thinner than the
+        # printer's smallest feature): a flat top h_cone above the face, still 45 degrees; the
+        # recess is short by as much, and so are the knuckles that hold it (issue 14)
+        h_cone = r_cone - prof.min_feature / 2
         R = max(R, r_cone + c * np.sqrt(2) + prof.min_wall)
         features.append(("cone pin diameter", 2 * r_cone, prof.min_feature))
         features.append(("knuckle wall around a cone recess", R - r_cone - c * np.sqrt(2), prof.min_wall))
@@ -431,8 +437,9 @@ def _build_assembly(scene, profile, poses, resolve, reuse) -> Assembly:
         k = (S - (nk - 1) * g) / nk
         layout = [blist[0]] + blist[1:] + [blist[0]]
         if cones:
-            # the recess of a cone must leave a wall at the far end of its knuckle
-            k_need = r_cone + c * np.sqrt(2) - g + prof.min_wall
+            # the recess of a cone (h_cone + c deep from the face below) must leave a wall at
+            # the far end of its knuckle
+            k_need = h_cone + c - g + prof.min_wall
             if k < k_need:
                 S = nk * k_need + (nk - 1) * g
                 k = k_need
@@ -632,6 +639,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse) -> Assembly:
     protected: dict[str, mf.Manifold] = {}
     soft: dict[str, mf.Manifold] = {}
     fat_guard: dict[str, tuple] = {}     # reuse only: (hard, soft or None) guards grown by GUARD_PAD
+    cone_cores: dict[str, mf.Manifold] = {}  # pin: cone: what the trims never touch (knuckles, cones, rings)
     for b in scene.bodies:
         bn = b.name
         # large assemblies: every primitive and boolean of the body in its own frame (its first
@@ -695,10 +703,11 @@ def _build_assembly(scene, profile, poses, resolve, reuse) -> Assembly:
                 for (iv0, b0), (iv1, b1) in zip(seq, seq[1:]):
                     face = iv0[1]          # the cone grows from the end face of the lower knuckle
                     if b0 == bn:
-                        male.append(cone(ax.origin, ax.direction, face - 1e-3, face + r_cone, r_cone + 1e-3, 0.0, n))
-                    if b1 == bn:
-                        recess.append(cone(ax.origin, ax.direction, face - 1e-3, face + cr, cr + 1e-3, 0.0, n,
-                                           cutter=True))
+                        male.append(cone(ax.origin, ax.direction, face - 1e-3, face + h_cone, r_cone + 1e-3,
+                                         r_cone - h_cone, n))
+                    if b1 == bn:      # the truncated cone offset by c: flat top c higher, side c out
+                        recess.append(cone(ax.origin, ax.direction, face - 1e-3, face + h_cone + c, cr + 1e-3,
+                                           cr - h_cone - c, n, cutter=True))
         keep += male
         solid = union([solid] + keep + rings)
         # 3. holes: non-owner knuckles, yoke knuckles, attachment holes
@@ -724,6 +733,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse) -> Assembly:
         protected[bn] = union(keep + pins + rings)
         if reuse:
             cores[bn] = union([subtract(union(keep + rings), holes)] + pins)
+        if cones:
+            cone_cores[bn] = subtract(union(keep + rings), holes)
         solid = _drop_scraps(solid, protected[bn], bn, notes)
         # the spot where the attachment hole would go (0.85 mm in from the site), kept if possible
         spots = [cylinder(_spot(x[4], x[0], lug_out), x[1], -t, t, lug_out + c, n) for x in lugs[bn] if not x[2]]
@@ -747,7 +758,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse) -> Assembly:
         _LOCAL[0] = None
         if Fb is not None:
             solid = transform_solid(solid, Fb)
-            for tab in (protected, soft, cores):
+            for tab in (protected, soft, cores, cone_cores):
                 if bn in tab:
                     tab[bn] = transform_solid(tab[bn], Fb)
             if bn in fat_guard:
@@ -797,6 +808,11 @@ def _build_assembly(scene, profile, poses, resolve, reuse) -> Assembly:
     if reuse:
         asm.congruence = Congruence(_congruence_frames(asm, slabs))
     _log(f"{len(parts)} parts built ({sum(p.solid.num_vert() for p in parts)} vertices)")
+    if cones:
+        cone_cores.update({uj.part: protected[uj.part] for uj in ujoints if uj.primary})
+        asm.cone_conflicts = _cone_conflicts(asm, cone_cores)
+        if asm.cone_conflicts and resolve and not _CONE_PROBE[0]:
+            _cone_refuse(asm, scene, prof, poses, r_cone, h_cone)
     if resolve:
         _resolve(asm, protected, soft, state_T, asm.congruence, fat_guard)
     _log("final trims done; drilling")
@@ -807,6 +823,73 @@ def _build_assembly(scene, profile, poses, resolve, reuse) -> Assembly:
 
 
 # --------------------------------------------------------------------------- helpers
+_CONE_PROBE = [False]      # building to find the smallest sigma at which cones fit: never refuse
+
+
+def _cone_conflicts(asm: "Assembly", cores: dict) -> list:
+    """Pairs of parts whose untrimmable material (knuckles, cones, attachment rings, joint
+    parts) comes closer than the clearance as printed, or meets in a logic state:
+    ``[(part, part, state or None)]``.  The final trims never cut that material, so such
+    a pair could never settle (pin: cone, issue 14)."""
+    c, g = asm.profile.clearance, asm.profile.knuckle_gap
+    names = [p.name for p in asm.parts if p.name in cores]
+    sol = [cores[x] for x in names]
+    shared = {frozenset((a, b)) for ax in asm.axes for a in ax.bodies for b in ax.bodies if a != b}
+    lo, hi = solid_boxes(sol)
+    out = []
+    for i, j in box_pairs(lo, hi, c):
+        thr = min(c, g) if frozenset((names[i], names[j])) in shared else c
+        if float(sol[i].min_gap(sol[j], thr)) < thr - 1e-6:
+            out.append((names[i], names[j], None))
+    for st, (pos, quat) in (asm.poses or {}).items():
+        T = asm.part_transforms(pos, quat)
+        posed = [transform_solid(x, T[nm]) for x, nm in zip(sol, names)]
+        plo, phi = solid_boxes(posed)
+        for i, j in box_pairs(plo, phi, 0.0):
+            if (names[i], names[j], None) not in out and (posed[i] ^ posed[j]).volume() > 1e-6:
+                out.append((names[i], names[j], st))
+    return out
+
+
+def _cone_refuse(asm: "Assembly", scene, prof, poses, r_cone, h_cone) -> None:
+    """Raise the one message for cone pins that cannot fit (before the final trims): the
+    pairs, the knuckle sizes, and the smallest sigma (whole mm, up to 4 x) at which they do."""
+    import dataclasses
+    fit = None
+    _CONE_PROBE[0] = True
+    try:
+        for s2 in range(int(np.floor(prof.sigma_mm)) + 1, int(np.ceil(4 * prof.sigma_mm)) + 1):
+            p2 = dataclasses.replace(prof, sigma_mm=float(s2))
+            if not build_assembly(scene, p2, poses, resolve=False).cone_conflicts:
+                fit = s2
+                break
+    finally:
+        _CONE_PROBE[0] = False
+    pairs = ", ".join(f"{a}/{b}" + (" as printed" if st is None else f" in state {st}")
+                      for a, b, st in asm.cone_conflicts[:6])
+    more = f" and {len(asm.cone_conflicts) - 6} more" if len(asm.cone_conflicts) > 6 else ""
+    c, n = prof.clearance, prof.circular_segments
+
+    def stack(ax, bn):
+        return union([cylinder(ax.origin, ax.direction, a0, a1, ax.R, n) for a0, a1 in ax.intervals[bn]])
+    # the hinges whose knuckles (as cylinders) meet: a's knuckles on one, b's on another
+    met = sorted({f"{a}'s on {A.name} and {b}'s on {B.name}" for a, b, _ in asm.cone_conflicts
+                  for A in asm.axes if a in A.bodies for B in asm.axes if b in B.bodies and B is not A
+                  and float(stack(A, a).min_gap(stack(B, b), c)) < c - 1e-6})
+    used = {x for a, b, _ in asm.cone_conflicts for x in (a, b)}
+    Rk = sorted({(round(ax.R, 3), round(ax.knuckle, 3), round(ax.span, 3)) for ax in asm.axes
+                 if used & set(ax.bodies)})
+    sizes = "; ".join(f"knuckle radius {R:g} mm, length {k:g} mm, stack {S:g} mm" for R, k, S in Rk)
+    hinges = "; ".join(met) if met else "the universal joint"
+    fix = "use --pin pin" + (f", or --sigma-mm >= {fit}" if fit is not None else
+                             f" (no sigma up to {4 * prof.sigma_mm:g} mm fits the cones)")
+    raise MlcError(
+        f"pin: cone does not fit at sigma {prof.sigma_mm:g} mm: the knuckles or cones of {pairs}{more} come "
+        f"closer than the clearance {prof.clearance:g} mm (or meet in a logic state), and the trims never cut "
+        f"them (knuckles: {hinges}; {sizes or 'no hinge'}; cone diameter {2 * r_cone:g} mm, "
+        f"{h_cone:g} mm high; the hinge spacing grows with sigma, these sizes do not)", "--pin", fix)
+
+
 def _complement(own, lo, hi):
     """Intervals of ``[lo, hi]`` not covered by a body's own knuckles (gaps included): the
     cut reaches exactly to the faces of its own knuckles."""
@@ -1598,6 +1681,8 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
             return all(i in f or j in f for f in filters)
 
         out: dict = {}
+        gap_meshes: dict = {}
+        from mlc.mesh.apart import min_gap as _apart_gap
         lo, hi = solid_boxes([p.solid for p in parts])
         for i, j in box_pairs(lo, hi, 2 * c):
             if not wanted(i, j):
@@ -1608,10 +1693,12 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
                 # the gap itself, searched as far as the report's min_gap check searches and
                 # cached under its key: the check finds every pair the trims left alone cached
                 # (a gap under the clearance is the same number searched to c or to 2 c)
+                # (pairs whose triangles prove them farther apart than the search: mlc.mesh.apart)
                 search = max(2 * c, 1e-3)
                 near = cong.lookup(("min_gap", search, cong.key(i, parts[i].solid), cong.key(j, parts[j].solid),
                                     cong.rel(i, j)),
-                                   lambda: float(parts[i].solid.min_gap(parts[j].solid, search))) < c - 1e-6
+                                   lambda: (_apart_gap(parts[i].solid, parts[j].solid, search, gap_meshes) if APART_GAP
+                                            else float(parts[i].solid.min_gap(parts[j].solid, search)))) < c - 1e-6
             if near:
                 out.setdefault((i, j), []).append(None)
         llo, lhi = local_boxes([p.solid for p in parts], frames)
