@@ -1481,6 +1481,13 @@ def _tw_depends(t, v, W):
 def _tw_cof(t, v, W, pos):
     """The cofactor of ``t`` for variable ``v`` = ``pos``, spread over both halves."""
     r = np.empty(W, dtype=np.uint64)
+    _tw_cof_to(t, v, W, pos, r)
+    return r
+
+
+@njit(cache=True)
+def _tw_cof_to(t, v, W, pos, r):
+    """:func:`_tw_cof` written into ``r`` (no new array)."""
     if v < 6:
         s = np.uint64(1 << v)
         x = _VARW[v]
@@ -1495,7 +1502,6 @@ def _tw_cof(t, v, W, pos):
         st = 1 << (v - 6)
         for w in range(W):
             r[w] = t[w | st] if pos else t[w & ~st]
-    return r
 
 
 @njit(cache=True)
@@ -1559,10 +1565,10 @@ def _isop(L, U, n, W, full, outp, outq):
                     break
                 v -= 1
             sv[d] = v
-            L0[d] = _tw_cof(SL[d], v, W, False)
-            L1[d] = _tw_cof(SL[d], v, W, True)
-            U0[d] = _tw_cof(SU[d], v, W, False)
-            U1[d] = _tw_cof(SU[d], v, W, True)
+            _tw_cof_to(SL[d], v, W, False, L0[d])
+            _tw_cof_to(SL[d], v, W, True, L1[d])
+            _tw_cof_to(SU[d], v, W, False, U0[d])
+            _tw_cof_to(SU[d], v, W, True, U1[d])
             for w in range(W):
                 SL[d + 1, w] = L0[d, w] & ~U1[d, w] & full[w]
                 SU[d + 1, w] = U0[d, w]
@@ -1872,11 +1878,13 @@ def _analyse_full(t, n, W, full):
         if _tw_depends(t, i, W):
             dep[i] = 1
             nsup += 1
+    c0 = np.empty(W, dtype=np.uint64)
+    c1 = np.empty(W, dtype=np.uint64)
     for i in range(n):
         if dep[i] == 0:
             continue
-        c0 = _tw_cof(t, i, W, False)
-        c1 = _tw_cof(t, i, W, True)
+        _tw_cof_to(t, i, W, False, c0)
+        _tw_cof_to(t, i, W, True, c1)
         z0 = True
         z1 = True
         o0 = True
