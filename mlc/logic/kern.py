@@ -1438,6 +1438,21 @@ def canon_index(f, lo, hi):
 SOP_MAX_VARS = 10
 
 
+_FULLW: dict = {}
+
+
+def _full_words(n: int):
+    """``(W, full, fullw)`` for tables over ``n`` variables: the number of 64-bit words,
+    the all-ones table as a Python int and as words (kept per ``n``)."""
+    r = _FULLW.get(n)
+    if r is None:
+        W = max(1, (1 << n) >> 6)
+        full = (1 << (1 << n)) - 1
+        r = _FULLW[n] = (W, full, np.frombuffer(full.to_bytes(8 * W, "little"),
+                                                dtype="<u8").astype(np.uint64))
+    return r
+
+
 def sop_costs(f: int, care: int, n: int):
     """:meth:`mlc.logic.decomp._Dec._sop_plan`'s work for the interval (on-set ``f``,
     care set ``care``; Python ints over ``n <= SOP_MAX_VARS`` variables): the irredundant
@@ -1445,19 +1460,29 @@ def sop_costs(f: int, care: int, n: int):
     of its factored form (:func:`mlc.logic.lower.factor_sop` into an empty AIG of ``n``
     inputs).  Returns ``((ands, cubes) of the on-set, (ands, cubes) of the off-set)``,
     cubes as lists of ``(pos_mask, neg_mask)``."""
-    W = max(1, (1 << n) >> 6)
-    full = (1 << (1 << n)) - 1
+    W, full, fullw = _full_words(n)
     off = care & ~f
-    dc = full & ~care
     nb = 8 * W
-    words = [np.frombuffer(t.to_bytes(nb, "little"), dtype="<u8").astype(np.uint64)
-             for t in (f, f | dc, off, off | dc)]
-    fullw = np.frombuffer(full.to_bytes(nb, "little"), dtype="<u8").astype(np.uint64)
-    out = []
-    for L, U in ((words[0], words[1]), (words[2], words[3])):
-        k, P, Q, m = _sop_phase(L, U, n, W, fullw)
-        out.append((int(k), list(zip(P[:m].tolist(), Q[:m].tolist()))))
-    return out[0], out[1]
+    if care == full:                 # no don't cares: each phase's interval is one table
+        t = np.frombuffer(f.to_bytes(nb, "little") + off.to_bytes(nb, "little"),
+                          dtype="<u8").astype(np.uint64).reshape(2, W)
+        words = (t[0], t[0], t[1], t[1])
+    else:
+        dc = full & ~care
+        words = np.frombuffer(b"".join(x.to_bytes(nb, "little") for x in (f, f | dc, off, off | dc)),
+                              dtype="<u8").astype(np.uint64).reshape(4, W)
+    k0, P0, Q0, k1, P1, Q1 = _sop_phases(words[0], words[1], words[2], words[3], n, W, fullw)
+    return ((k0, list(zip(P0.tolist(), Q0.tolist()))),
+            (k1, list(zip(P1.tolist(), Q1.tolist()))))
+
+
+@njit(cache=True)
+def _sop_phases(L0, U0, L1, U1, n, W, full):
+    """:func:`_sop_phase` of the on-set's interval [L0, U0] and the off-set's [L1, U1]
+    in one call: ``(ANDs, P, Q)`` of each, the masks cut to the cube count."""
+    k0, P0, Q0, m0 = _sop_phase(L0, U0, n, W, full)
+    k1, P1, Q1, m1 = _sop_phase(L1, U1, n, W, full)
+    return k0, P0[:m0], Q0[:m0], k1, P1[:m1], Q1[:m1]
 
 
 @njit(cache=True)
@@ -1845,8 +1870,6 @@ def _sop_phase(L, U, n, W, full):
 
 # ----------------------------------------------------------------------------- decomposition analysis
 
-_FULLW: dict = {}
-
 
 def analyse_full(f: int, n: int):
     """The table work of :meth:`mlc.logic.decomp._Dec._analyse` for a completely
@@ -1858,12 +1881,7 @@ def analyse_full(f: int, n: int):
     the number of variables each cofactor depends on, summed -- and ``t16`` the table
     over the support (its variables in increasing order) repeated to 16 bits, where the
     support has at most 4 variables (else 0)."""
-    W = max(1, (1 << n) >> 6)
-    fullw = _FULLW.get(n)
-    if fullw is None:
-        full = (1 << (1 << n)) - 1
-        fullw = _FULLW[n] = np.frombuffer(full.to_bytes(8 * W, "little"),
-                                          dtype="<u8").astype(np.uint64)
+    W, _full, fullw = _full_words(n)
     t = np.frombuffer(f.to_bytes(8 * W, "little"), dtype="<u8").astype(np.uint64)
     return _analyse_full(t, n, W, fullw)
 
