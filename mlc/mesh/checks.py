@@ -190,6 +190,7 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
               else f"no two parts within {2 * c:g} mm")
     checks.append(Check("min_gap", not fails, gval, c, detail, fails))
 
+    gap_meshes.clear()      # each part's float64 arrays: ~0.1 GB on the Tetris circuit, not kept to the bed check
     _log("check min_gap done")
     # -- logic states --------------------------------------------------------------------
     if poses:
@@ -268,6 +269,7 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
                 worst = max(worst, v)
                 if v > VOL_EPS:
                     fails.append(f"state {st}: {parts[i].name} intersects {parts[j].name} ({v:.4g} mm^3)")
+        meshes.clear()      # as gap_meshes above
         n_path = sum("@" in str(k) for k in poses)
         what = f"{len(poses) - n_path} logic states"
         if n_path:
