@@ -9,7 +9,7 @@ k0 sigma^2 by default, the stiff scheme) and record each output's read length, b
 margin, the relaxation time (t0) and the wall time.
 
     python benchmarks/circuit_dynamic.py [--only full_adder.expr ...] [--seeds 3] [--kT 1e-5]
-                                         [--joint-k 100] [--rows 000 101]
+                                         [--joint-k 100] [--rows 000 101] [--dt 0.2]
 
 ``--joint-k K`` builds the circuit as ``mlc compile --joint-k K`` does (connector joints K
 times stiffer; default: mlc compile's default, 100 k0 since 2026-11-25; runs before that
@@ -39,7 +39,7 @@ from mlc.circuit.build import CircuitOptions
 from mlc.io.atomic import atomic_path
 from mlc.pipeline import build, compile_spec, load
 from mlc.scene.io import dump_scene
-from mlc.verify.dynamic import check_scene_dynamic_multi
+from mlc.verify.dynamic import DT, check_scene_dynamic_multi
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results" / "circuit_dynamic.json"
@@ -71,6 +71,9 @@ def main():
                     help="run these seeds instead of 0 .. --seeds - 1 (e.g. a second campaign on seed 1)")
     ap.add_argument("--kT", type=float, default=1e-5)
     ap.add_argument("--scheme", default="stiff", choices=("stiff", "euler"))
+    ap.add_argument("--dt", type=float, default=None,
+                    help="t0: the step (default the verifier's, mlc.verify.dynamic.DT: 0.01 for stiff); each run "
+                         "records it; a row already verified at another dt counts as done")
     ap.add_argument("--joint-k", type=float, default=CircuitOptions().joint_k,
                     help="connector joint stiffness (k0), as mlc compile (default: its default)")
     ap.add_argument("--out", type=Path, default=OUT,
@@ -100,16 +103,17 @@ def main():
             for state in sc.states():
                 if (key, state, seed) in done or (args.rows and state not in args.rows):
                     continue
-                t0 = time.perf_counter()
+                t0, c0 = time.perf_counter(), time.process_time()
                 # tau: the one computed for this scene in an earlier session (the eigensolver), or
                 # None: the verifier's own per-row signal_time, as `mlc verify --dynamic` does
                 entries = check_scene_dynamic_multi(sc, kT=args.kT, seeds=[seed], scheme=args.scheme, rows=[state],
-                                                    progress=False, tau=info["tau"] if args.reuse_tau else None)
-                wall = time.perf_counter() - t0
+                                                    progress=False, dt=args.dt, tau=info["tau"] if args.reuse_tau else None)
+                wall, cpu = time.perf_counter() - t0, time.process_time() - c0
                 run = {"scene": key, "example": name, "joint_k": args.joint_k, "state": state, "seed": seed, "kT": args.kT,
-                       "scheme": args.scheme, "ok": all(e["ok"] for e in entries),
+                       "scheme": args.scheme, "dt": args.dt if args.dt is not None else DT.get(args.scheme),
+                       "ok": all(e["ok"] for e in entries),
                        "relax_time": max((e["relax_time"] or float("nan")) for e in entries), "wall_s": wall,
-                       "tau": max(e["tau"] for e in entries),
+                       "cpu_s": cpu, "tau": max(e["tau"] for e in entries),
                        "outputs": {e["output"]: {"measured": e["measured"], "expected": e["expected"],
                                                  "margin": e["margin"], "ok": e["ok"]} for e in entries},
                        "commit": commit, "load": list(os.getloadavg())}
