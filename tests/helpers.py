@@ -26,3 +26,23 @@ def assert_parse_error(parse, text: str, filename: str, where: str, words: str) 
     msg = str(e.value)
     assert msg.startswith(f"{filename}:{where}:") or msg.startswith(f"{filename}:{where} "), msg
     assert words in msg, msg
+
+
+def random_aig(seed: int, n_in: int = 20, n_and: int = 400, n_out: int = 12, window: int = 40):
+    """A seeded random AIG: mostly local fanins (the last ``window`` nodes: reconvergence), some
+    far ones, outputs on every third of the last nodes."""
+    import random
+
+    from mlc.logic.aig import AIG
+    rng = random.Random(seed)
+    g = AIG([f"i{i}" for i in range(n_in)])
+    lits = [g.input_lit(i) for i in range(n_in)]
+    while g.num_ands() < n_and:
+        a = rng.choice(lits[-window:]) if rng.random() < 0.7 else rng.choice(lits)
+        b = rng.choice(lits[-window:]) if rng.random() < 0.7 else rng.choice(lits)
+        r = g.and_(a ^ rng.randint(0, 1), b ^ rng.randint(0, 1))
+        if r > 1 and (r >> 1) > n_in and r not in lits:
+            lits.append(r & ~1)
+    for k in range(n_out):
+        g.add_output(f"o{k}", lits[-1 - 3 * k] ^ (k & 1))
+    return g.cleanup()

@@ -3,6 +3,7 @@ their fast paths give the same answers, in the same order, as the plain algorith
 (refactoring's networks depend on both)."""
 import random
 
+from helpers import random_aig
 from mlc.logic import decomp
 from mlc.logic import tt as T
 
@@ -149,19 +150,7 @@ def test_no_step_matches_the_cofactor_conditions():
 
 
 def _random_network(seed: int, n_in: int = 14, n_and: int = 250, n_out: int = 8):
-    from mlc.logic.aig import AIG
-    rng = random.Random(seed)
-    g = AIG([f"i{i}" for i in range(n_in)])
-    lits = [g.input_lit(i) for i in range(n_in)]
-    while g.num_ands() < n_and:
-        a = rng.choice(lits[-30:]) if rng.random() < 0.7 else rng.choice(lits)
-        b = rng.choice(lits[-30:]) if rng.random() < 0.7 else rng.choice(lits)
-        r = g.and_(a ^ rng.randint(0, 1), b ^ rng.randint(0, 1))
-        if r > 1 and (r >> 1) > n_in and r not in lits:
-            lits.append(r & ~1)
-    for k in range(n_out):
-        g.add_output(f"o{k}", lits[-1 - 3 * k] ^ (k & 1))
-    return g.cleanup()
+    return random_aig(seed, n_in, n_and, n_out, window=30)
 
 
 def test_refactor_constant_cones_of_several_cut_sizes():

@@ -5,23 +5,12 @@ import random
 import pytest
 
 from mlc.logic import kern, opt
+from helpers import random_aig
 from mlc.logic.aig import AIG
 
 
 def _random_aig(seed: int, n_in: int = 20, n_and: int = 400, n_out: int = 12) -> AIG:
-    rng = random.Random(seed)
-    g = AIG([f"i{i}" for i in range(n_in)])
-    lits = [g.input_lit(i) for i in range(n_in)]
-    while g.num_ands() < n_and:
-        # mostly local fanins (reconvergence), some far ones
-        a = rng.choice(lits[-40:]) if rng.random() < 0.7 else rng.choice(lits)
-        b = rng.choice(lits[-40:]) if rng.random() < 0.7 else rng.choice(lits)
-        r = g.and_(a ^ rng.randint(0, 1), b ^ rng.randint(0, 1))
-        if r > 1 and (r >> 1) > n_in and r not in lits:
-            lits.append(r & ~1)
-    for k in range(n_out):
-        g.add_output(f"o{k}", lits[-1 - 3 * k] ^ (k & 1))
-    return g.cleanup()
+    return random_aig(seed, n_in, n_and, n_out, window=40)
 
 
 def _both(fn, g, **kw):

@@ -205,8 +205,12 @@ class _Dec:
             cost, kind, lit, g, gc = steps[0]
             c, p = self.rec(g, gc)
             return c + cost, (kind, lit, p)
-        best = (base[0], (base[1][0], base[1][1], base[1][2]))
-        for i, on0, on1, c0, c1 in shannon:
+        return self._mux_best((base[0], (base[1][0], base[1][1], base[1][2])), shannon)
+
+    def _mux_best(self, best, cands):
+        """The cheaper of ``best`` (cost, plan) and a 2:1 mux on each Shannon candidate
+        ``(i, on0, on1, c0, c1)`` in turn (cofactors built by :meth:`rec`, on1 first)."""
+        for i, on0, on1, c0, c1 in cands:
             ca, pa = self.rec(on1, c1)
             cb, pb = self.rec(on0, c0)
             c = ca + cb + 3
@@ -369,12 +373,7 @@ class _Dec:
         best = self.sop_plan(f, care)
         if len(sup) <= self.shannon_limit:
             # Shannon on the variables whose cofactors are simplest
-            for _, i, on0, on1, c0, c1 in self._shannon_scored(f, care, sup):
-                ca, pa = self.rec(on1, c1)
-                cb, pb = self.rec(on0, c0)
-                c = ca + cb + 3
-                if c < best[0]:
-                    best = (c, ("mux", 2 * (i + 1), pa, pb))
+            best = self._mux_best(best, (t[1:] for t in self._shannon_scored(f, care, sup)))
         return best
 
     def sop_plan(self, f: int, care: int):
