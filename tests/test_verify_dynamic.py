@@ -193,6 +193,11 @@ def test_a_large_scene_uses_the_signal_time(monkeypatch):
     assert only_rest["ok"] and only_rest["tau"] == rest["tau"]
     given = dyn.check_scene_dynamic_multi(sc, 1e-5, [0], rows=["1"], progress=False, tau=0.5, dt=0.02)[0]
     assert given["ok"] and given["tau"] == 0.5
+    # the step: a circuit's default (DT_LARGE), or the one given; a small scene keeps DT
+    assert row["dt"] == rest["dt"] == dyn.DT_LARGE["stiff"] != dyn.DT["stiff"] and given["dt"] == 0.02
+    monkeypatch.setattr(dyn, "DENSE_MAX", 1800)
+    small = dyn.check_scene_dynamic_multi(sc, 1e-5, [0], rows=["1"], progress=False, tau=0.5)[0]
+    assert small["dt"] == dyn.DT["stiff"]
 
 
 def test_circuit_verify_takes_tau_and_dt():

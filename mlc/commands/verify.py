@@ -27,7 +27,8 @@ def register(sub):
                         "(docs/robot.md section 3); for a circuit, computed per row (mlc.verify.dynamic.signal_time)")
     p.add_argument("--dt", type=float, metavar="DT",
                    help="--dynamic: the integrator's step (t0). Default for a robot: mlc.robot.verify.ROBOT_DT; "
-                        "for a circuit, mlc.verify.dynamic.DT (0.01 t0 with the stiff scheme)")
+                        "for a circuit of more than 300 bodies, mlc.verify.dynamic.DT_LARGE (0.2 t0 with the stiff scheme), "
+                        "else mlc.verify.dynamic.DT (0.01 t0)")
     p.add_argument("--rows", metavar="BITS", nargs="+", help="verify only these rows (bit strings in input order)")
     p.add_argument("--require-clearance", action="store_true",
                    help="static: also fail a row whose slabs interpenetrate (reported as a warning otherwise)")

@@ -140,7 +140,8 @@ def verify_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int = 3, sc
     """Brownian-dynamics check of every row in ``rows`` (default all) over ``seeds`` seeds at
     ``kT`` (k0 sigma^2): :func:`mlc.verify.dynamic.check_scene_dynamic_multi`.  ``tau`` (t0):
     the relaxation time a run lasts at least 3 times (default computed per row, see there);
-    ``dt`` (t0): the integrator's step (default the scheme's, mlc.verify.dynamic.DT)."""
+    ``dt`` (t0): the integrator's step (default mlc.verify.dynamic.DT_LARGE for a circuit of
+    more than DENSE_MAX / 6 bodies, else the scheme's own, mlc.verify.dynamic.DT)."""
     from mlc.verify.dynamic import check_scene_dynamic_multi
 
     states = select_rows(scene, rows)
@@ -150,7 +151,7 @@ def verify_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int = 3, sc
     entries = check_scene_dynamic_multi(scene, kT=kT, seeds=int(seeds), scheme=scheme, rows=states,
                                         progress=progress, tau=tau, dt=dt)
     rep = Report(scene.name, "dynamic", params={"kT": kT, "seeds": int(seeds), "scheme": scheme,
-                                                "tau": tau, "dt": dt})
+                                                "tau": tau, "dt": entries[0]["dt"] if entries else dt})
     for e in entries:
         rep.entries.append({"state": e["state"], "output": e["output"], "expected": e["expected"],
                             "measured": e["measured"], "bit": e.get("bit"), "margin": e["margin"],

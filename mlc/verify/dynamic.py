@@ -62,6 +62,8 @@ TAU_FACTOR = 3.0       # the run lasts at least this many slowest relaxation tim
 MAX_TIME = 20.0        # t0: the run stops here (or at MAX_TAUS tau if longer) unrelaxed
 MAX_TAUS = 12.0
 DT = {"stiff": 0.01, "euler": None}      # t0; None: the integrator's own (half the Euler limit)
+DT_LARGE = {"stiff": 0.2}  # t0: circuits (more than DENSE_MAX / 6 bodies); measured against the static
+                           # equilibrium at 0.01-0.2 t0 (benchmarks/circuit_dt.py, docs/circuits.md)
 SLOW_STEPS = 1e8       # Euler steps a run beyond which the check warns before it starts
 DENSE_MAX = 1800       # degrees of freedom up to which the spectrum is computed densely
 ZERO = 1e-9            # eigenvalues below ZERO * lambda_max count as zero modes
@@ -342,6 +344,8 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
     opt0 = SimOptions(scheme=scheme)
     tau_given = tau is not None
     large = 6 * len(scene.bodies) > DENSE_MAX      # a circuit: signal_time, not the spectrum
+    if dt is None:     # the step: 0.2 t0 for a circuit with the stiff scheme, else the scheme's own
+        dt = (DT_LARGE if large else DT).get(scheme)
     if tau_given:
         tau = float(tau)
     elif large:   # the rest row has no switch of its own: its floor is the slowest of all rows
@@ -386,7 +390,7 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
             # the floor t_min, or MIN_WINDOWS windows (runs relax at the floor as a rule)
             t_expect = max(t_min, MIN_WINDOWS * window)
             for seed in seed_list:
-                opt = SimOptions(scheme=scheme, kT=kT, seed=seed, dt=dt if dt is not None else DT.get(scheme))
+                opt = SimOptions(scheme=scheme, kT=kT, seed=seed, dt=dt)
                 sim = Simulation(scene, drives, opt)
                 t_max = max_time if max_time_given else max(MAX_TIME, MAX_TAUS * tau_row)
                 if scheme == "euler" and not warned and show is not False and t_expect / sim.dt > SLOW_STEPS:
@@ -416,7 +420,7 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
                             "relaxed": relaxed,
                             "relax_time": max(t for _, t, _ in per) if relaxed else None,
                             "per_seed": vals, "seeds": seed_list, "tau": tau_row, "thermal_sd": sd[pr.name],
-                            "scheme": scheme, "kT": kT})
+                            "scheme": scheme, "kT": kT, "dt": dt})
     return out
 
 
