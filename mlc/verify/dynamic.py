@@ -318,10 +318,12 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
     output, probe, expected (0/1, or None for a don't-care), measured (sigma, mean over
     seeds), bit, margin (sigma, smallest over seeds; None for a don't-care), ok,
     relaxed, relax_time (t0, largest over seeds; None if a seed did not relax),
-    per_seed (the measured value of each seed), seeds, tau (t0), scheme, kT.
+    per_seed (the measured value of each seed), seeds, tau (t0), scheme, kT, dt (t0: the
+    step asked of the integrator, None for its own; a run's steps are at most one averaging window).
 
     ``progress``: None (a bar on a terminal for long runs), False (silent), True (a
-    bar) or a callable ``f(done, total)`` called after each (row, seed) run.  ``tau``
+    bar) or a callable ``f(done, total)`` called after each (row, seed) run.  ``dt`` (t0):
+    default ``DT_LARGE`` for a scene of more than ``DENSE_MAX`` / 6 bodies, else ``DT``.  ``tau``
     (t0): the slowest relaxation time, if already known, used for every row (default
     :func:`relaxation_time` at the starting pose and at each row's static equilibrium,
     the larger of the two; for a scene of more than ``DENSE_MAX`` / 6 bodies, a circuit,
