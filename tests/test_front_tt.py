@@ -36,6 +36,8 @@ def test_unlisted_directive():
     assert s.on == [0b1000] and s.dc == [0]
     s = parse(".inputs a b\n.outputs f\n.unlisted 1\n00 | 0\n", "x.tt")
     assert s.on == [0b1110] and s.dc == [0]
+    s = parse(".inputs a b\n.outputs f g\n.unlisted 1\n", "x.tt")        # no rows: a constant, on purpose
+    assert s.on == [0b1111, 0b1111] and s.dc == [0, 0]
 
 
 def test_overlapping_rows_that_agree_are_fine():
@@ -71,6 +73,10 @@ BAD = [
     (".inputs a b\n.outputs f g\n01 | 1 0\n-1 | 1 1\n", "4:8", "line 4 sets g=1 but line 3 sets g=0"),
     ("# nothing\n", "1", "no .inputs line"),
     (".inputs a\n", "1", "no .outputs line"),
+    # issue 14: a table that gives an output no value used to compile to a silent constant 0
+    (".inputs a b\n.outputs f g\n", "2:10", "output f is a don't care on every input combination (the table has no rows)"),
+    (".inputs a b\n.outputs f g\n00 | 1 -\n1- | 0 -\n", "2:12", "output g is a don't care on every input combination (every row gives it -)"),
+    (".inputs a b\n.outputs f\n.unlisted dc\n", "2:10", "the table has no rows"),
 ]
 
 

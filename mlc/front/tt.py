@@ -21,7 +21,9 @@ values; with ``|`` each side is checked separately.
 Input combinations that no row lists take the ``.unlisted`` value: don't care by
 default, or an error when ``strict=True`` (``mlc compile --strict``) and the file has
 no ``.unlisted`` line.  Two rows that give the same output opposite values on a common
-input combination are an error that names both lines.
+input combination are an error that names both lines.  So is an output that no row sets
+to 0 or 1 while unlisted rows are don't cares (a table with no rows, say): any constant
+would match it, which is never what was meant.
 
 Minterm numbering is that of :class:`mlc.spec.TableSpec`: the first input is the
 least significant bit.
@@ -198,6 +200,13 @@ def parse(text: str, filename: str = "<input>", strict: bool = False) -> TableSp
         raise MlcError(f"{count} input combination(s) are not listed, the first is {minterm_str(inputs, mt)} (--strict)",
                        Loc(filename, in_line, 1),
                        "add the missing rows, add '.unlisted dc' (or 0 or 1), or drop --strict")
+    if unlisted in (None, "dc"):
+        for o in range(m):
+            if not (on[o] | off[o]):            # no row gives it a value: any constant would do
+                raise MlcError(f"output {outputs[o]} is a don't care on every input combination "
+                               f"({'the table has no rows' if not listed else 'every row gives it -'})",
+                               Loc(filename, out_line, out_cols[o]),
+                               "add rows that set it to 0 or 1, or '.unlisted 0' (or 1) for a constant output")
     dc = []
     for o in range(m):
         if unlisted == "1":
