@@ -63,6 +63,18 @@ def scene_key(sc, res: dict) -> str:
     return legacy
 
 
+def build_host() -> dict:
+    """What a build depends on beyond the code (docs/circuits.md, "Reproducibility"): the CPU,
+    numpy's SIMD dispatch in use and OpenBLAS's kernel choice."""
+    import numpy as np
+    from numpy._core._multiarray_umath import __cpu_dispatch__, __cpu_features__
+    cpu = next((ln.split(":", 1)[1].strip() for ln in open("/proc/cpuinfo") if ln.startswith("model name")),
+               platform.processor()) if Path("/proc/cpuinfo").exists() else platform.processor()
+    return {"cpu": cpu, "numpy": np.__version__,
+            "numpy_dispatch": [f for f in __cpu_dispatch__ if __cpu_features__.get(f)],
+            "openblas_coretype": os.environ.get("OPENBLAS_CORETYPE")}
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--only", nargs="*", default=list(DEFAULT), help="example file names")
@@ -97,7 +109,7 @@ def main():
         info = res["scenes"].get(key)
         if info is None:
             info = {"example": name, "bodies": len(sc.bodies), "tau": None, "commit": commit,
-                    "joint_k": args.joint_k}
+                    "joint_k": args.joint_k, "host": build_host()}
             res["scenes"][key] = info
         done = {(r["scene"], r["state"], r["seed"]) for r in res["runs"] + main_runs if "tau" in r or args.reuse_tau}
         for seed in (args.seed_list if args.seed_list is not None else range(args.seeds)):
