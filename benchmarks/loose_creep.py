@@ -20,15 +20,18 @@ Parts (units: sigma, k0, gamma, t0 = gamma/(1e-3 k0); kT in k0 sigma^2):
   rest (a = 0), input a switched to 1 at t = 0; the signal after each unit at 1, 2, 5,
   10, 20, 30 t0 (mean over seeds and 0.5 t0 around each time), for kT = 0, 1e-5 and
   1e-4 with the stiff scheme (dt 0.01 t0), kT = 1e-5 with Euler-Maruyama at its default
-  dt (half its stability limit) and at a third of it (first 10 t0): is the creep thermal
+  dt (half its stability limit) and at a third of it (first 10 t0); ``half_time_out``: when
+  the far end's mean over seeds (smoothed over 0.5 t0) first reaches 1.25 sigma.  Is the creep thermal
   (none at kT = 0; ten times faster at ten times kT: diffusion over a flat bottom, time
   ~ W^2 gamma_eff / kT) or the integrator's (it would change with the scheme and dt)?
 * ``gate``: the same for the AND gate (tolerance 0.05 sigma, inputs 00 -> 11 and
   00 -> 01): the gate's output after 1, 2, 5, 10, 20 t0.
 * ``kscale``: the creep of the 5-unit chain (tolerance 0.025 sigma) with hard walls (every
   joint 100 k0, so the wall's thermal give sqrt(kT/k) is 0.0003-0.001 sigma, not 0.003-0.01)
-  at kT = 1e-5 and 1e-4, stiff scheme, to 60 t0: diffusion over a flat bottom takes a
-  time proportional to 1/kT, so the two curves should be one curve with time scaled 10x.
+  at kT = 1e-5 and 1e-4, stiff scheme at dt = 0.01 and 0.001 t0 (at 1e-4 a body's thermal
+  step in 0.01 t0, sqrt(2 kT dt/gamma) = 0.045 sigma, exceeds the tolerance), to 60 t0:
+  diffusion over a flat bottom takes a time proportional to 1/kT, so the two curves
+  should be one curve with time scaled 10x.
 * ``pair``: the integrator inside a tolerance, against exact theory: two free slabs joined
   by one flat-bottomed bond (tolerance 0.025 sigma, k0 outside), kT = 1e-5, 20 t0 (the
   first 1 t0 dropped), sampled every 0.001 t0.  The separation d of the two sites has the
@@ -52,6 +55,7 @@ HERE = os.path.dirname(os.path.abspath(__file__))
 sys.path.insert(0, os.path.dirname(HERE))
 
 TIMES = (1.0, 2.0, 5.0, 10.0, 20.0, 30.0)
+HALF = 1.25         # sigma: half-way between the states (1.0 and 1.5 sigma)
 
 
 def slack_ranges(scene, pos, quat, delta: float, probes: list[str]):
@@ -123,7 +127,15 @@ def _run(scene, drives, scheme: str, dt, kT: float, seed: int, T: float, probes:
     for p in probes:
         x = np.asarray(res.probes[p])
         at[p] = [float(np.mean(x[(tt >= s - 0.25) & (tt <= s + 0.25)])) for s in TIMES if s <= T]
-    return at, wall, float(res.dt)
+    return at, wall, float(res.dt), tt, np.asarray(res.probes[probes[-1]])
+
+
+def half_time(t, x, level: float = HALF) -> float:
+    """First time (t0) at which ``x``, smoothed over 0.5 t0, reaches ``level``; NaN if never."""
+    w = max(1, int(round(0.5 / (t[1] - t[0]))))
+    xs = np.convolve(x, np.ones(w) / w, mode="same")
+    i = np.flatnonzero(xs[w:-w] >= level)
+    return float(t[w + i[0]]) if len(i) else float("nan")
 
 
 def _cases(scene, drives, probes, cases, seeds, T):
@@ -131,12 +143,15 @@ def _cases(scene, drives, probes, cases, seeds, T):
     for scheme, dt, kT, TT in cases:
         per = []
         walls = []
+        last = []
         n = 1 if kT == 0 else seeds
         for s in range(n):
-            at, wall, dt_used = _run(scene, drives, scheme, dt, kT, s, TT or T, probes)
+            at, wall, dt_used, tt, x = _run(scene, drives, scheme, dt, kT, s, TT or T, probes)
             per.append(at)
             walls.append(wall)
+            last.append(x)
         row = {"scheme": scheme, "dt": dt_used, "kT": kT, "seeds": n, "times": [x for x in TIMES if x <= (TT or T)],
+               f"half_time_{probes[-1]}": half_time(tt, np.mean(last, axis=0)),
                "mean": {p: np.mean([a[p] for a in per], axis=0).round(4).tolist() for p in probes},
                "se": {p: (np.std([a[p] for a in per], axis=0, ddof=1) / math.sqrt(n)).round(4).tolist()
                       if n > 1 else None for p in probes},
@@ -184,7 +199,8 @@ def part_kscale(seeds: int):
         for b in sc.bonds:
             b.k *= 100.0
         probes = [p.name for p in sc.probes]
-        cases = [("stiff", 0.01, 1e-5, None), ("stiff", 0.01, 1e-4, None), ("stiff", 0.01, 0.0, None)]
+        cases = [("stiff", 0.01, 1e-5, None), ("stiff", 0.01, 1e-4, None), ("stiff", 0.01, 0.0, None),
+                 ("stiff", 0.001, 1e-5, None), ("stiff", 0.001, 1e-4, None)]
         return {"scene": "chain 5 units, tolerance 0.025, joints 100 k0", "probes": probes,
                 "rows": _cases(sc, {"a": Drive.constant(1)}, probes, cases, seeds, 60.0)}
     finally:
