@@ -974,3 +974,115 @@ def test_stl_refuses_a_mechanism_too_large_to_mesh(tmp_path, capsys, monkeypatch
     code, stdout, err = run(capsys, "stl", str(path), "-o", str(out / "x.stl"))
     assert_clean_failure(code, err, {}, out, f"{len(sc.bodies)} bodies", f"at most {MAX_MECHANISM_BODIES}",
                          "mlc stl NAND")
+
+
+def test_compile_refuses_a_table_too_large_for_memory(tmp_path, capsys, monkeypatch):
+    """A 24-input truth table (the format's maximum) peaked at 5.8 GB in synthesis, silently:
+    the estimate is checked before any work, against the budget (lowered here to 1 GiB)."""
+    from mlc.commands import compile as cc
+    from mlc.mesh import profiles
+    rng = random.Random(14)
+    n = 22
+    rows = sorted({"".join(rng.choice("01") for _ in range(n)) for _ in range(50)})
+    src = tmp_path / "wide.tt"
+    src.write_text(f".inputs {' '.join(f'x{i}' for i in range(n))}\n.outputs f g\n"
+                   + "".join(f"{r} | {rng.choice('01')}{rng.choice('01')}\n" for r in rows))
+    monkeypatch.setattr(profiles, "memory_budget", lambda: 2.0 ** 30)
+    before = listing(tmp_path)
+    code, stdout, err = run(capsys, "compile", src, "-o", tmp_path / "o", "--no-circuit")
+    assert_clean_failure(code, err, before, tmp_path, f"{src}: ", "22-input truth table", "GiB of memory",
+                         "the limit is 1 GiB")
+    assert stdout == ""
+    # a network of as many inputs is not tabulated: no estimate, it compiles
+    from mlc.front.load import load
+    assert cc.table_memory(load(expr="f = " + " & ".join(f"x{i}" for i in range(n)))) == 0
+
+
+def test_table_memory_estimate_covers_the_measured_peaks():
+    """The estimate stays above each measured peak (mlc.commands.compile.TABLE_MEASURED_PEAKS),
+    and within 1.5 times it."""
+    from mlc.commands import compile as cc
+    from mlc.spec import TableSpec
+    for (n, m), peak in cc.TABLE_MEASURED_PEAKS.items():
+        spec = TableSpec([f"x{i}" for i in range(n)], [f"f{j}" for j in range(m)], [0] * m, [0] * m)
+        assert peak <= cc.table_memory(spec) <= 1.5 * peak, (n, m)
+
+
+def _wires_through_boxes(dot_text: str) -> list:
+    """Graphviz's own layout (``dot -Tplain``) of a netlist graph: the (wire, box) pairs where a wire's
+    spline passes inside a gate box that is not one of its two ends (boxes shrunk by 0.02 in)."""
+    import shlex
+    plain = subprocess.run(["dot", "-Tplain"], input=dot_text, capture_output=True, text=True, timeout=120,
+                           check=True).stdout
+    boxes, edges = {}, []
+    for line in plain.splitlines():
+        f = shlex.split(line)
+        if f[0] == "node" and f[-3] == "box":
+            x, y, w, h = map(float, f[2:6])
+            boxes[f[1]] = (x - w / 2 + 0.02, x + w / 2 - 0.02, y - h / 2 + 0.02, y + h / 2 - 0.02)
+        elif f[0] == "edge":
+            n = int(f[3])
+            pts = [(float(f[4 + 2 * i]), float(f[5 + 2 * i])) for i in range(n)]
+            edges.append((f[1], f[2], pts))
+    bad = []
+    for tail, head, pts in edges:
+        curve = []
+        for k in range(0, len(pts) - 3, 3):                 # cubic Bezier pieces
+            p0, p1, p2, p3 = pts[k:k + 4]
+            for i in range(21):
+                t = i / 20
+                c = [(1 - t) ** 3, 3 * t * (1 - t) ** 2, 3 * t * t * (1 - t), t ** 3]
+                curve.append((sum(w * p[0] for w, p in zip(c, (p0, p1, p2, p3))),
+                              sum(w * p[1] for w, p in zip(c, (p0, p1, p2, p3)))))
+        for name, (x0, x1, y0, y1) in boxes.items():
+            if name not in (tail, head) and any(x0 < x < x1 and y0 < y < y1 for x, y in curve):
+                bad.append((tail, head, name))
+    return bad
+
+
+@pytest.mark.skipif(not __import__("shutil").which("dot"), reason="Graphviz's dot is not installed")
+@pytest.mark.parametrize("example", ["tetris.tt", "mux4.blif", "full_adder.tt", "random"])
+def test_compile_draw_wires_go_around_gate_boxes(example, tmp_path, capsys):
+    """compile --draw is Graphviz's drawing of OUTDIR/netlist.dot, and in Graphviz's layout of that
+    graph no wire passes through a gate box (mlc's own layered drawing ran examples/tetris.tt's
+    y -> u3_up wire behind two gate boxes; straight wires in the seeded random netlist of 88 gates
+    cross 51 boxes)."""
+    src = ROOT / "examples" / example
+    if example == "random":
+        from helpers import random_aig
+        from mlc.logic.aigio import write_aiger
+        src = tmp_path / "random.aag"
+        src.write_text(write_aiger(random_aig(1, n_in=16, n_and=150, n_out=8, window=60)))
+    png = tmp_path / "c.png"
+    code, _, err = run(capsys, "compile", src, "-O0", "-o", tmp_path / "o", "--no-circuit", "--draw", png)
+    assert code == 0 and err == "", err
+    dot_text = (tmp_path / "o" / "netlist.dot").read_text()
+    assert png.read_bytes() == subprocess.run(["dot", "-Tpng"], input=dot_text.encode(), capture_output=True,
+                                              timeout=120, check=True).stdout
+    assert dot_text.count("shape=box") >= 3 and _wires_through_boxes(dot_text) == []
+
+
+def test_compile_draw_says_when_a_circuit_is_too_large(tmp_path, capsys, monkeypatch):
+    from mlc.commands import compile as cc
+    monkeypatch.setattr(cc, "DRAW_LEGIBLE_GATES", 2)
+    png = tmp_path / "c.png"
+    code, _, err = run(capsys, "compile", ROOT / "examples" / "tetris.tt", "-o", tmp_path / "o", "--no-circuit",
+                       "--draw", png)
+    assert code == 0 and err.startswith("mlc: warning: --draw: 3 gates are too many to read") and \
+        err.count("\n") == 1, err
+    assert png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_draw_shows_progress(tmp_path, capsys, monkeypatch):
+    """mlc draw of a compiled circuit solves each input state for minutes (1328 bodies: ~3 min):
+    a bar counts the states, then the picture (shown here as on a terminal)."""
+    from mlc.io import progress
+
+    class Shown(progress.Progress):
+        def __init__(self, label, total=None, expect=None, show=None, delay=2.0, stream=None):
+            super().__init__(label, total, expect, True, 0.0, stream)
+
+    monkeypatch.setattr(progress, "Progress", Shown)
+    code, out, err = run(capsys, "draw", "NAND", "-o", tmp_path / "n.png")
+    assert code == 0 and out == f"wrote {tmp_path / 'n.png'}\n"
+    assert "mlc draw: solving and drawing NAND_expand [" in err and "4/5" in err and err.endswith("5/5  ETA     0 s  \n")

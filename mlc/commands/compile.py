@@ -18,6 +18,35 @@ from mlc.errors import MlcError
 
 MAX_JOINT_K = 1e4          # --joint-k upper bound (k0); the stiff scheme's stages grow as sqrt(k)
 
+# Peak memory of synthesizing a truth table grows with its 2**n input combinations (bit sets of
+# 2**n bits, many alive at once): bytes = TABLE_BASE + 2**n (TABLE_PER_MINTERM + TABLE_PER_OUTPUT m).
+# TABLE_MEASURED_PEAKS: (n, m) -> bytes, ru_maxrss of load + synthesize + map + prove in one
+# process, 200 seeded random rows, the larger of -O0 and -O2 (-O0 peaks higher from 22 inputs).
+TABLE_BASE = 0.2e9
+TABLE_PER_MINTERM = 300
+TABLE_PER_OUTPUT = 50
+TABLE_MEASURED_PEAKS = {(18, 2): 0.260e9, (20, 2): 0.448e9, (22, 2): 1.611e9, (22, 6): 2.373e9, (24, 2): 5.815e9}
+
+
+def table_memory(spec) -> float:
+    """Estimated peak bytes of compiling ``spec`` if it is a truth table (0 for a network)."""
+    from mlc.spec import TableSpec
+    if not isinstance(spec, TableSpec):
+        return 0.0
+    return TABLE_BASE + 2.0 ** spec.n * (TABLE_PER_MINTERM + TABLE_PER_OUTPUT * len(spec.outputs))
+
+
+def check_table_memory(spec) -> None:
+    """Refuse a truth table whose synthesis would need more than the memory budget (half the
+    memory available, at least 2 GiB: :func:`mlc.mesh.profiles.memory_budget`)."""
+    from mlc.mesh.profiles import memory_budget
+    need, budget = table_memory(spec), memory_budget()
+    if need > budget:
+        raise MlcError(f"synthesizing this {spec.n}-input truth table would need about {need / 2 ** 30:.3g} GiB "
+                       f"of memory ({len(spec.outputs)} outputs over 2^{spec.n} input combinations); the limit is "
+                       f"{budget / 2 ** 30:.3g} GiB (half the memory available, at least 2 GiB)", spec.source,
+                       "describe the function with fewer inputs, or as BLIF, AIGER or expressions (not tabulated)")
+
 
 def register(sub):
     p = sub.add_parser("compile", help="compile Boolean logic (.tt .pla .expr .blif .aag or -e) into mechanical gates",
@@ -76,8 +105,43 @@ def render(c, draw: bool = False) -> dict[str, bytes]:
         "netlist.dot": nl.to_dot().encode(),
     }
     if draw:
-        files["<draw>"] = nl.render_png()
+        files["<draw>"] = schematic_png(nl)
     return files
+
+
+# A schematic of more gates than this is not legible at any size (a warning says so); it is
+# also where Graphviz's layout stops being quick (measured, dot -Tpng of random netlists: 88 gates
+# 0.7 s, 172 gates 1.7 s, 360 gates 12 s CPU; 2002 gates did not finish in 5 min).
+DRAW_LEGIBLE_GATES = 150
+DOT_TIMEOUT = 60.0           # seconds for Graphviz's layout; then the plain layered drawing
+
+
+def schematic_png(nl, stream=None) -> bytes:
+    """The gate schematic (--draw) as PNG bytes: Graphviz's ``dot`` layout of OUTDIR/netlist.dot
+    when ``dot`` is installed and the circuit is legible (its splines go around the gate boxes),
+    else mlc's own layered drawing (:meth:`mlc.netlist.ir.Netlist.render_png`, whose straight
+    wires may pass behind boxes), with a warning on ``stream`` (standard error) that says why."""
+    import shutil
+    import subprocess
+    stream = stream or sys.stderr
+    n = len(nl.gates)
+    if n > DRAW_LEGIBLE_GATES:
+        stream.write(f"mlc: warning: --draw: {n} gates are too many to read in one drawing (about "
+                     f"{DRAW_LEGIBLE_GATES} at most); a plain layered drawing is written, whose wires may pass "
+                     f"behind gate boxes (OUTDIR/netlist.dot holds the graph)\n")
+        return nl.render_png()
+    dot = shutil.which("dot")
+    if dot is None:
+        return nl.render_png()
+    try:
+        r = subprocess.run([dot, "-Tpng"], input=nl.to_dot().encode(), capture_output=True, timeout=DOT_TIMEOUT)
+        if r.returncode == 0 and r.stdout.startswith(b"\x89PNG"):
+            return r.stdout
+    except (OSError, subprocess.TimeoutExpired):
+        pass
+    stream.write("mlc: warning: --draw: Graphviz's dot failed; a plain layered drawing is written, whose wires "
+                 "may pass behind gate boxes\n")
+    return nl.render_png()
 
 
 def summary(c, written: list[str], level: int) -> dict:
@@ -178,7 +242,9 @@ def run(args) -> int:
     outs.check()                                    # every output location, before the work
 
     spec = load(args.input, args.expr, strict=args.strict)
-    c = compile_spec(spec, args.level, args.signal)
+    check_table_memory(spec)
+    with Progress(f"synthesizing and proving {spec.source}"):      # a timer: 24-input tables take ~1 min
+        c = compile_spec(spec, args.level, args.signal)
     files = render(c, draw=bool(args.draw))
     report = None
     if want_circuit:
