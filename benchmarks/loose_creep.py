@@ -122,7 +122,9 @@ def _run(scene, drives, scheme: str, dt, kT: float, seed: int, T: float, probes:
     t = time.perf_counter()
     res = sim.run(T, record_interval=0.05, quiet=True)
     wall = time.perf_counter() - t
-    tt = np.asarray(res.times)
+    # record times carry round-off that depends on the integrator's chunking (1e-13 t0 with
+    # Euler): rounded, so that a sample on a window's edge is in or out whatever the chunks
+    tt = np.round(np.asarray(res.times), 9)
     at = {}
     for p in probes:
         x = np.asarray(res.probes[p])
