@@ -733,6 +733,11 @@ def test_kernel_compile_notice_once(monkeypatch):
     (["simulate", "", "--time", "1"], ["empty scene file name"]),
     (["verify", ""], ["empty scene file name"]),
     (["gate", "NAND", "-o", "/dev/full"], ["-o", "/dev/full"]),
+    # a step over 1e9 averaging windows made no step: the rest pose was reported as a wrong bit (exit 1)
+    (["verify", "{scene}", "--dynamic", "--seeds", "1", "--dt", "1e308"], ["--dt", "longer than any run needs"]),
+    (["verify", "{scene}", "--dynamic", "--seeds", "1", "--tau", "1", "--dt", "5"], ["--dt", "longer than --tau"]),
+    # the last of two drives of one input won, silently
+    (["simulate", "{scene}", "--time", "0.1", "--set", "a=1", "--set", "a=0"], ["--set a is given twice"]),
 ])
 def test_refused_at_once(argv, words, scene_text, tmp_path, capsys):
     src = tmp_path / "s.yaml"
@@ -1086,3 +1091,18 @@ def test_draw_shows_progress(tmp_path, capsys, monkeypatch):
     code, out, err = run(capsys, "draw", "NAND", "-o", tmp_path / "n.png")
     assert code == 0 and out == f"wrote {tmp_path / 'n.png'}\n"
     assert "mlc draw: solving and drawing NAND_expand [" in err and "4/5" in err and err.endswith("5/5  ETA     0 s  \n")
+
+
+def test_compile_checks_the_mesh_profile_before_the_work(tmp_path, capsys, monkeypatch):
+    """compile --stl with a bad --profile failed only after synthesis and place and route."""
+    from mlc.commands import compile as cc
+
+    def no_work(*a, **k):
+        raise AssertionError("synthesis started before the profile was checked")
+
+    monkeypatch.setattr(cc, "compile_spec", no_work)
+    before = listing(tmp_path)
+    for opt in ("--stl", "--3mf"):
+        code, _, err = run(capsys, "compile", "-e", "f = a & b", "-o", tmp_path / "o", opt,
+                           tmp_path / f"x{opt.replace('--', '.')}", "--profile", tmp_path / "missing.yaml")
+        assert_clean_failure(code, err, before, tmp_path, "--profile", "unknown printer profile")

@@ -234,6 +234,9 @@ def run(args) -> int:
             raise MlcError("--robot needs the circuit", "--no-circuit", "drop --no-circuit")
         from mlc.robot.spec import load_robot
         load_robot(args.robot)                      # the file alone, before the work
+    if args.stl or args.threemf:
+        from mlc.mesh.profiles import load_profile
+        load_profile(args.profile)                  # a bad profile fails now, not after the circuit is built
     outs = Outputs(inputs=[args.input, getattr(args, "robot", None)])
     outdir = outs.directory(args.outdir, "-o")
     draw = outs.file(args.draw, "--draw", suffixes=(".png",), parents=True)

@@ -28,8 +28,9 @@ def register(sub):
                         "probe errors come out about a tenth of it")
     p.add_argument("--fluct", action="store_true",
                    help="stiff scheme, fluctuation mode: SK-ROCK without damping and post-processed records, "
-                        "so bond fluctuations have their exact variance (linear theory) at any dt; "
-                        "same cost and trajectories as --scheme stiff")
+                        "so bond fluctuations have their exact variance (linear theory) at any dt, and random "
+                        "substep levels so that no stiff mode stays on a Chebyshev extremum; about twice the "
+                        "force evaluations of --scheme stiff at small noise (docs/simulation.md)")
     p.add_argument("--rot-noise", action="store_true", help="add rotational noise (off in the paper)")
     p.add_argument("--threads", type=int, default=1, help="numba threads for scenes of 20000 bodies or more (default 1)")
     p.add_argument("--out", default=None, metavar="traj.gsd", help="write a GSD trajectory")
@@ -56,6 +57,8 @@ def parse_sets(items, scene) -> dict:
         if name not in scene.inputs:
             raise MlcError(f"no input named {name!r} in scene {scene.name}", "--set",
                            f"inputs are {', '.join(scene.inputs) or 'none'}")
+        if name in drives:
+            raise MlcError(f"--set {name} is given twice", "--set", "drive each input once")
         drives[name] = Drive.parse(val, f"--set {name}")
     return drives
 

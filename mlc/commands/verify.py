@@ -6,6 +6,7 @@ import json
 
 
 MAX_SEEDS = 1000            # seeds per row for --dynamic
+MAX_DT = 1e3          # --dt upper bound (t0): the slowest rows relax in about 100 t0 (the Tetris robot)
 
 
 def register(sub):
@@ -73,6 +74,12 @@ def run(args) -> int:
         if not (v > 0 and v < float("inf")):
             raise MlcError(f"{opt} must be a finite time > 0 (t0), got {v}", opt,
                            "e.g. --tau 100 --dt 0.2 for the Tetris robot (docs/robot.md section 3)")
+    if args.dt is not None and args.dt > min(args.tau or MAX_DT, MAX_DT):
+        # a run advances one averaging window (0.05 t0 to tau/20) at a time, so a longer step is cut to
+        # it; a step over 1e9 windows made no step at all, and the rest pose was read as a wrong bit
+        raise MlcError(f"--dt {args.dt:g} t0 is longer than {'--tau' if args.tau else 'any run needs'} "
+                       f"({min(args.tau or MAX_DT, MAX_DT):g} t0)", "--dt",
+                       "e.g. --dt 0.2 (circuits' default); steps longer than the averaging window are cut to it")
     scene = load_scene(args.scene)
     if args.dynamic:
         from mlc.io.warmup import notice
