@@ -25,10 +25,12 @@ grid:
 runs:
   - {}
   - {scheme: euler, dt: 0.002}
+  - {scheme: euler, dt: 9.0e-5}
 seeds: 2
 """
-# (the Euler runs are far beyond Euler's stability limit, about 1.5e-4 t0: they must become
-#  failed rows; the spec expands to 2 grid points x 2 entries x 2 seeds)
+# (the Euler runs at dt = 0.002 t0 are far beyond Euler's stability limit, about 1.5e-4 t0:
+#  they must become failed rows; the Euler runs at 9e-5 t0 (its default here, half its limit) are the
+#  scheme of the shipped Fig. 5D spec; the spec expands to 2 grid points x 3 entries x 2 seeds)
 
 
 def _write(tmp_path, text, name="s.yaml"):
@@ -69,20 +71,21 @@ def tiny_runs(tmp_path_factory):
 def test_spec_expands_grid_runs_and_seeds(tmp_path):
     p = _write(tmp_path, TINY)
     s = load_spec(str(p))
-    assert len(s.runs) == 2 * 2 * 2
-    assert len({r.run_id for r in s.runs}) == 8
+    assert len(s.runs) == 2 * 3 * 2
+    assert len({r.run_id for r in s.runs}) == 12
     assert sorted({r.params["scheme"] for r in s.runs}) == ["euler", "stiff"]
     assert {r.seed for r in s.runs} == {0, 1}
     # the id depends on the parameters and seed only, not on the order of the spec
     p2 = _write(tmp_path, TINY.replace("frequency: [2, 1]", "frequency: [1, 2]").replace(
-        "runs:\n  - {}\n  - {scheme: euler, dt: 0.002}\n", "runs:\n  - {scheme: euler, dt: 0.002}\n  - {}\n"),
+        "runs:\n  - {}\n  - {scheme: euler, dt: 0.002}\n  - {scheme: euler, dt: 9.0e-5}\n",
+        "runs:\n  - {scheme: euler, dt: 9.0e-5}\n  - {scheme: euler, dt: 0.002}\n  - {}\n"),
         "s2.yaml")
     assert {r.run_id for r in load_spec(str(p2)).runs} == {r.run_id for r in s.runs}
 
 
 def test_sweep_two_workers_resume_and_reproducible(tiny_runs):
     spec, tmp, a, b = tiny_runs
-    assert a["ran"] == 8 and a["skipped"] == 0 and b["ran"] == 8
+    assert a["ran"] == 12 and a["skipped"] == 0 and b["ran"] == 12
     two, one = _table(tmp / "two"), _table(tmp / "one")
     assert [r["run_id"] for r in two] == [r.run_id for r in spec.runs]        # rows in the spec's order
     ok = [r for r in two if r["status"] == "ok"]
@@ -90,23 +93,24 @@ def test_sweep_two_workers_resume_and_reproducible(tiny_runs):
     # the Euler runs at 13x its stability limit are failed rows naming the instability, not a crash
     # (messages name every row's status and error: a one-off failure on a loaded machine is then diagnosable)
     rows_msg = [(r["run_id"], r["scheme"], r["status"], r["error"][:200]) for r in two]
-    assert len(ok) == 4 and len(failed) == 4, rows_msg
-    assert all(r["scheme"] == "euler" for r in failed), rows_msg
+    assert len(ok) == 8 and len(failed) == 4, rows_msg
+    assert all(r["scheme"] == "euler" and float(r["dt"]) == 0.002 for r in failed), rows_msg
+    assert sum(r["scheme"] == "euler" for r in ok) == 4, rows_msg
     assert all("unstable" in r["error"] and "--dt" in r["error"] for r in failed), failed[0]["error"]
-    # same spec, 1 or 2 workers: the same numbers, bit for bit
+    # same spec, 1 or 2 workers: the same numbers, bit for bit (both schemes)
     for r1, r2 in zip(one, two):
         assert r1["run_id"] == r2["run_id"] and r1["status"] == r2["status"]
         for k in MEASURED:
             assert r1[k] == r2[k], (r1["run_id"], r1["scheme"], k, r1[k], r2[k])
     # the seeds differ (thermal noise), the drive frequencies too
-    assert len({r["rms_dev"] for r in ok}) == 4
+    assert len({r["rms_dev"] for r in ok}) == 8
     for r in ok:
         assert 0.0 < float(r["rms_dev"]) < 1.0
     # beside the table: the spec and the versions
     assert (tmp / "two" / "spec.yaml").read_text() == spec.text
     meta = json.loads((tmp / "two" / "sweep.json").read_text())
-    assert meta["versions"]["mlc"] and meta["versions"]["dask"] and meta["runs"] == 8
-    assert len(list((tmp / "two" / "traces").glob("*.npz"))) == 4
+    assert meta["versions"]["mlc"] and meta["versions"]["dask"] and meta["runs"] == 12
+    assert len(list((tmp / "two" / "traces").glob("*.npz"))) == 8
 
 
 def test_resume_skips_finished_runs(tiny_runs):
@@ -115,14 +119,14 @@ def test_resume_skips_finished_runs(tiny_runs):
     d = tmp / "one"
     before = _table(d)
     again = run_sweep(spec, d, workers=1, progress=False)
-    assert again["ran"] == 0 and again["skipped"] == 8
+    assert again["ran"] == 0 and again["skipped"] == 12
     assert _table(d) == before
     # drop one finished row: only that run is run again, with the same numbers
     lines = (d / "results.csv").read_text().splitlines(keepends=True)
     dropped = before[1]
     (d / "results.csv").write_text("".join(lines[:2] + lines[3:]))
     third = run_sweep(spec, d, workers=1, progress=False)
-    assert third["ran"] == 1 and third["skipped"] == 7
+    assert third["ran"] == 1 and third["skipped"] == 11
     after = _table(d)
     assert [r["run_id"] for r in after] == [r["run_id"] for r in before]
     assert {k: after[1][k] for k in MEASURED} == {k: dropped[k] for k in MEASURED}
@@ -135,9 +139,10 @@ def test_plot_response_grid(tiny_runs, capsys):
     summary = json.loads(out)
     assert (tmp / "grid.png").stat().st_size > 1000 and (tmp / "grid.json").exists()
     rows = {(r["frequency"], r.get("scheme")): r for r in summary["rows"]}
-    assert set(rows) == {(2.0, "stiff"), (1.0, "stiff")}          # failed runs are not plotted
+    # failed runs are not plotted: the Euler lines are its runs at 9e-5 t0
+    assert set(rows) == {(2.0, "stiff"), (1.0, "stiff"), (2.0, "euler"), (1.0, "euler")}
     t = _table(tmp / "two")
-    mine = [float(r["rms_dev"]) for r in t if r["status"] == "ok" and r["frequency"] == "2"]
+    mine = [float(r["rms_dev"]) for r in t if r["status"] == "ok" and r["frequency"] == "2" and r["scheme"] == "stiff"]
     assert rows[(2.0, "stiff")]["rms_dev_mean"] == pytest.approx(sum(mine) / 2)
     assert rows[(2.0, "stiff")]["seeds"] == 2
 

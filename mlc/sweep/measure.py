@@ -65,6 +65,14 @@ def _options(params: dict, seed: int):
                       disp_acc=float(params["drift_tol"]))
 
 
+def _times(res) -> np.ndarray:
+    """The run's record times (t0), rounded to 1e-9 t0: Euler accumulates its time per compiled
+    chunk, and the chunks follow the machine's load, so the same trajectory's record times
+    can differ by ~1e-13 t0 between runs (1 or 2 workers); rounded, every measurement is
+    the same to the last digit."""
+    return np.round(np.asarray(res.times, dtype=float), 9)
+
+
 def _rms(t, y, drive, mask) -> float:
     """sqrt(time average of (y - u)^2) over the samples in ``mask`` (a contiguous run).
 
@@ -106,7 +114,7 @@ def square_response(scene, params: dict, seed: int):
     res = sim.run(period * cyc, record_interval=rec, quiet=True)
     pr = next(p for p in scene.probes if p.name == params["probe"])
     L0, L1 = pr.rest, pr.actuated
-    t = np.asarray(res.times)
+    t = _times(res)
     u = np.array([drives[params["drive_input"]].value(x) for x in t])
     # a sample at a switching instant belongs to the new state already (drive value at t)
     traces = {}
@@ -145,7 +153,7 @@ def steady(scene, params: dict, seed: int):
     T = float(params["time"])
     rec = params["record"] if params["record"] is not None else T / 2000.0
     res = sim.run(T, record_interval=rec, quiet=True)
-    t = np.asarray(res.times)
+    t = _times(res)
     m = t >= T * (1.0 - float(params["window"])) - 1e-12
     state = "".join(str(int(round(drives[i].value(0.0)))) if i in drives else "0" for i in scene.inputs)
     expected = scene.truth_table.get(state)
