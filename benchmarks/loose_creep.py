@@ -1,7 +1,7 @@
 """Why a loose (toleranced) connector chain creeps, and why a loose gate fares better
 (issue 11, docs/reproduction.md sections 3 and 4).
 
-    python benchmarks/loose_creep.py [--parts slack,creep,gate,kscale,pair] [--seeds 3]
+    python benchmarks/loose_creep.py [--parts slack,creep,gate,kscale,kscan,pair] [--seeds 3]
         # writes benchmarks/results/loose_creep.json
 
 Parts (units: sigma, k0, gamma, t0 = gamma/(1e-3 k0); kT in k0 sigma^2):
@@ -31,7 +31,8 @@ Parts (units: sigma, k0, gamma, t0 = gamma/(1e-3 k0); kT in k0 sigma^2):
   at kT = 1e-5 and 1e-4, stiff scheme at dt = 0.01 and 0.001 t0 (at 1e-4 a body's thermal
   step in 0.01 t0, sqrt(2 kT dt/gamma) = 0.045 sigma, exceeds the tolerance), to 60 t0:
   diffusion over a flat bottom takes a time proportional to 1/kT, so the two curves
-  should be one curve with time scaled 10x.
+  should be one curve with time scaled 10x.  ``kscan``: the same at dt = 0.001 t0 and
+  kT = 3e-5 and 3e-4, to see how the half-way time scales with kT.
 * ``pair``: the integrator inside a tolerance, against exact theory: two free slabs joined
   by one flat-bottomed bond (tolerance 0.025 sigma, k0 outside), kT = 1e-5, 20 t0 (the
   first 1 t0 dropped), sampled every 0.001 t0.  The separation d of the two sites has the
@@ -209,6 +210,25 @@ def part_kscale(seeds: int):
         TIMES = old
 
 
+def part_kscan(seeds: int):
+    """``kscale``'s hard-walled chain at dt = 0.001 t0 and kT = 3e-5, 3e-4 (to put beside its
+    1e-5 and 1e-4): how the half-way time scales with kT."""
+    from mlc.gates.connector import chain_scene
+    from mlc.sim.drive import Drive
+    global TIMES
+    old, TIMES = TIMES, (1.0, 2.0, 5.0, 10.0, 20.0, 30.0, 45.0, 60.0)
+    try:
+        sc = chain_scene(5, "expand", 0.0, tolerance=0.025, probe_every_unit=True)
+        for b in sc.bonds:
+            b.k *= 100.0
+        probes = [p.name for p in sc.probes]
+        cases = [("stiff", 0.001, 3e-5, None), ("stiff", 0.001, 3e-4, 20.0)]
+        return {"scene": "chain 5 units, tolerance 0.025, joints 100 k0", "probes": probes,
+                "rows": _cases(sc, {"a": Drive.constant(1)}, probes, cases, seeds, 60.0)}
+    finally:
+        TIMES = old
+
+
 def pair_scene(delta: float, k: float = 1.0):
     """Two free slabs 0.5 sigma apart whose facing edge sites are joined by one flat-bottomed
     bond (WCA-free: the centres stay ~0.5 sigma apart); probe ``d``: the sites' separation."""
@@ -250,7 +270,7 @@ def part_pair():
 
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--parts", default="slack,creep,gate,kscale,pair")
+    ap.add_argument("--parts", default="slack,creep,gate,kscale,kscan,pair")
     ap.add_argument("--seeds", type=int, default=3)
     ap.add_argument("-o", "--output", default=os.path.join(HERE, "results", "loose_creep.json"))
     a = ap.parse_args(argv)
@@ -261,7 +281,7 @@ def main(argv=None):
     for part in a.parts.split(","):
         t = time.perf_counter()
         fn = {"slack": part_slack, "creep": lambda: part_creep(a.seeds), "gate": lambda: part_gate(a.seeds),
-              "kscale": lambda: part_kscale(a.seeds), "pair": part_pair}[part]
+              "kscale": lambda: part_kscale(a.seeds), "kscan": lambda: part_kscan(a.seeds), "pair": part_pair}[part]
         res[part] = {"result": fn(), "wall_s": time.perf_counter() - t}
         tmp = a.output + ".tmp"
         with open(tmp, "w") as f:
