@@ -62,7 +62,7 @@ def _options(params: dict, seed: int):
     from mlc.sim.integrator import SimOptions
     return SimOptions(dt=params["dt"], scheme=params["scheme"], kT=float(params["kT"]), seed=int(seed),
                       fluct=bool(params["fluct"]), rot_noise=bool(params["rot_noise"]),
-                      disp_acc=float(params["drift_tol"]))
+                      disp_acc=float(params["drift_tol"]), gamma_r=params.get("gamma_r"))
 
 
 def _times(res) -> np.ndarray:
