@@ -1106,3 +1106,38 @@ def test_compile_checks_the_mesh_profile_before_the_work(tmp_path, capsys, monke
         code, _, err = run(capsys, "compile", "-e", "f = a & b", "-o", tmp_path / "o", opt,
                            tmp_path / f"x{opt.replace('--', '.')}", "--profile", tmp_path / "missing.yaml")
         assert_clean_failure(code, err, before, tmp_path, "--profile", "unknown printer profile")
+
+
+def test_robot_fold_interrupted_and_shapes_progress(tmp_path, tiny_robot_yaml, capsys, monkeypatch):
+    """robot fold: a run cut short by Ctrl-C wrote the frames and printed the shape as if folded
+    (exit 0); now exit 130 and nothing written.  robot shapes: a bar over the rows (silent before)."""
+    from mlc.io import progress
+    from mlc.sim.integrator import Simulation
+    (tmp_path / "tiny.robot.yaml").write_text(tiny_robot_yaml)
+    assert main(["compile", "-e", "u1_up = a; u2_dn = a", "--robot", str(tmp_path / "tiny.robot.yaml"),
+                 "-o", str(tmp_path / "out")]) == 0
+    robot = tmp_path / "out" / "robot.yaml"
+    capsys.readouterr()
+    before = listing(tmp_path)
+    run_ = Simulation.run
+
+    def cut_short(self, *a, **k):
+        res = run_(self, *a, **k)
+        res.interrupted = True               # what the Ctrl-C handler sets
+        return res
+
+    monkeypatch.setattr(Simulation, "run", cut_short)
+    code, out, err = run(capsys, "robot", "fold", robot, "--row", "1", "--time", "0.5", "--frames", "3",
+                         "--gif", tmp_path / "f.gif", "--gsd", tmp_path / "f.gsd", "--png-dir", tmp_path / "frames")
+    assert code == 130 and out == "" and err == "mlc: interrupted\n", err
+    assert listing(tmp_path) == before
+    monkeypatch.setattr(Simulation, "run", run_)
+
+    class Shown(progress.Progress):
+        def __init__(self, label, total=None, expect=None, show=None, delay=2.0, stream=None):
+            super().__init__(label, total, expect, True, 0.0, stream)
+
+    monkeypatch.setattr(progress, "Progress", Shown)
+    code, out, err = run(capsys, "robot", "shapes", robot, "-o", tmp_path / "s.png")
+    assert code == 0 and "mlc robot shapes: the equilibrium of each row of" in err and "2/2" in err, err
+    assert (tmp_path / "s.png").read_bytes()[:4] == b"\x89PNG"

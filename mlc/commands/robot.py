@@ -80,7 +80,11 @@ def run_shapes(args) -> int:
         rep = verify_robot_dynamic(scene, kT=args.kT, seeds=1, keep_poses=True, dt=args.dt, first_seed=args.seed)
         poses = {s: v for (s, seed), v in rep.poses.items()}
     else:
-        rep = verify_robot_static(scene, keep_poses=True)
+        from mlc.io.progress import Progress
+        with Progress(f"mlc robot shapes: the equilibrium of each row of {scene.name}",
+                      total=len(scene.states())) as bar:          # minutes on a robot of 2500 bodies
+            rep = verify_robot_static(scene, keep_poses=True,
+                                      progress=lambda done, total: (setattr(bar, "total", total), bar.update(done)))
         poses = rep.poses
     info = {r["state"]: r for r in rep.rows}
     data = render_shapes(scene, poses, info, f"{scene.name}: {rep.mode} ({'all rows fold correctly' if rep.ok else 'WRONG'})")
@@ -121,12 +125,17 @@ def run_fold(args) -> int:
     drives = {n: Drive.constant(int(b)) for n, b in zip(scene.inputs, args.row)}
     sim = Simulation(scene, drives, SimOptions(scheme="stiff", kT=args.kT, seed=args.seed,
                                                dt=ROBOT_DT if args.dt is None else args.dt))
-    res = sim.run(args.time, frames=args.frames, quiet=True)
+    res = sim.run(args.time, frames=args.frames)         # a progress bar on a terminal
+    if res.interrupted:          # Ctrl-C: a fold cut short is not the row's shape; nothing is written
+        raise KeyboardInterrupt
     shape = _shape_row(scene, rm, args.row, res.frame_pos[-1], res.frame_quat[-1])
     title = f"{scene.name} row {args.row}"
     with outs:
         if gif is not None or pdir is not None:
-            pngs = render_frames(scene, res.frame_pos, res.frame_quat, res.frame_times, title, shape["cells_expected"])
+            from mlc.io.progress import Progress
+            with Progress(f"mlc robot fold: drawing {len(res.frame_times)} frames"):
+                pngs = render_frames(scene, res.frame_pos, res.frame_quat, res.frame_times, title,
+                                     shape["cells_expected"])
             if gif is not None:
                 gif.write_bytes(gif_bytes(pngs))
             if pdir is not None:
