@@ -6,6 +6,7 @@ import sys
 import pytest
 
 from mlc.cli import main
+from mlc.errors import MlcError
 from mlc.mesh import examples as ex
 from mlc.mesh.build import build_assembly
 from mlc.mesh.export import part_meshes, read_3mf, read_parts, stl_bytes, threemf_bytes, write_outputs
@@ -51,7 +52,7 @@ def test_write_outputs_all_files(asm, tmp_path):
 
 def test_failed_export_leaves_no_file(asm, tmp_path):
     (tmp_path / "blocker").write_text("a file where the parts directory should go")
-    with pytest.raises(Exception):
+    with pytest.raises(MlcError, match=r"--parts: .*blocker: exists and is not a directory"):
         write_outputs(asm, stl=tmp_path / "x.stl", threemf=tmp_path / "x.3mf", parts_dir=tmp_path / "blocker")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["blocker"]
 

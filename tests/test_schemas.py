@@ -27,7 +27,13 @@ def test_gate_scene_validates_with_jsonschema():
 
 def test_library_files_validate_with_jsonschema():
     import yaml
-    for f in resources.files("mlc.stdlib_gates").iterdir():
-        if f.name.endswith(".yaml"):
-            data = yaml.safe_load(f.read_text("utf-8"))
-            jsonschema.validate(data, load_schema("design" if f.name == "design.yaml" else "gate"))
+    files = [f for f in resources.files("mlc.stdlib_gates").iterdir() if f.name.endswith(".yaml")]
+    assert len(files) == 9, sorted(f.name for f in files)      # the 8 gates and design.yaml
+    for f in files:
+        data = yaml.safe_load(f.read_text("utf-8"))
+        jsonschema.validate(data, load_schema("design" if f.name == "design.yaml" else "gate"))
+
+
+def test_every_schema_is_found():
+    # the parametrized check above passes vacuously when it finds no schema
+    assert _schemas() == ["design", "gate", "netlist", "profile", "robot", "scene", "sweep"]
