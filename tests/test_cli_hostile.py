@@ -1141,3 +1141,15 @@ def test_robot_fold_interrupted_and_shapes_progress(tmp_path, tiny_robot_yaml, c
     code, out, err = run(capsys, "robot", "shapes", robot, "-o", tmp_path / "s.png")
     assert code == 0 and "mlc robot shapes: the equilibrium of each row of" in err and "2/2" in err, err
     assert (tmp_path / "s.png").read_bytes()[:4] == b"\x89PNG"
+
+
+def test_draw_refuses_more_panels_than_a_picture_shows(scene_text, tmp_path, capsys):
+    """A NAND scene declaring 8 inputs (6 without a muscle) drew 256 panels in 3 min, silently."""
+    lines = scene_text.replace("inputs: [a, b]", "inputs: [a, b, c, d, e, f, g]", 1).splitlines(keepends=True)
+    i = lines.index("truth_table:\n")
+    j = next(k for k in range(i + 1, len(lines)) if not lines[k].startswith(" "))
+    src = tmp_path / "wide.yaml"
+    src.write_text("".join(lines[:i] + lines[j:]))
+    before = listing(tmp_path)
+    code, _, err = run(capsys, "draw", src, "-o", tmp_path / "x.png")
+    assert_clean_failure(code, err, before, tmp_path, f"{src}: 7 inputs make 128 input states", "at most 64")

@@ -4,6 +4,9 @@ from __future__ import annotations
 from pathlib import Path
 
 
+MAX_STATES = 64             # panels of one picture (examples/mux4.blif's circuit has 6 inputs)
+
+
 def register(sub):
     p = sub.add_parser("draw", help="render a gate or scene in every input state (PNG), or a mesh with --mesh",
                        description="Draw a library gate (by name) or a scene file in each of its input states, "
@@ -48,6 +51,10 @@ def run(args) -> int:
             from mlc.io.progress import Progress
             from mlc.verify.static import equilibrium
             scene = load_target(args.target, args.signal)
+            if 2 ** len(scene.inputs) > MAX_STATES:         # 8 inputs: 256 panels, 3 min, not legible
+                raise MlcError(f"{len(scene.inputs)} inputs make {2 ** len(scene.inputs)} input states, more panels "
+                               f"than one picture shows (at most {MAX_STATES}: 6 inputs)",
+                               scene.source or scene.name, "mlc verify SCENE prints every row as a table")
             states = scene.states()
             # a compiled circuit takes minutes (1328 bodies: about 3 min); a gate about a second
             with Progress(f"mlc draw: solving and drawing {scene.name}", total=len(states) + 1) as bar:
