@@ -201,3 +201,19 @@ def test_dynamic_check_catches_a_wrong_bit():
         library.gate_scene = orig
     assert not any(r["ok"] for r in rows)
     assert all(r["margin"] < 0 for r in rows)
+
+
+def test_non_finite_stage_is_a_clear_error_not_a_traceback():
+    # NAND contracting at kT = 1 (melted), seed 2, the stiff scheme's default dt: a stage ran to
+    # non-finite positions inside a step and the compiled kernel raised ZeroDivisionError
+    from mlc.gates.library import gate_scene
+
+    sc = gate_scene("NAND", "contract")
+    with pytest.raises(MlcError) as e:
+        simulate(sc, 2.0, {"a": 1, "b": 1}, SimOptions(kT=1.0, seed=2))
+    msg = str(e.value)
+    print("\n" + msg)
+    assert "non-finite" in msg and "unstable between t =" in msg and "--dt" in msg
+    # what it suggests works: a smaller dt runs, and ends with the warning that outputs are not bits
+    res = simulate(sc, 2.0, {"a": 1, "b": 1}, SimOptions(kT=1.0, seed=2, dt=0.01))
+    assert any("not bits" in w for w in res.warnings)

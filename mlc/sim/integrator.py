@@ -62,6 +62,8 @@ class SimOptions:
                                      # (exact stationary variance of linear modes; see docs/simulation.md)
     fluct_stages: float = 0.0        # fluctuation mode with noise: s = ceil(m sqrt(h rho/2)) stages, m this
                                      # factor (0 = auto: the stage rule of Simulation.fluct_stages_target)
+    fluct_levels: int = 4            # fluctuation mode with noise: each step's least substep level random in
+                                     # [0, fluct_levels) (1 = off: every mode's h lambda fixed; see docs/simulation.md)
     max_steps: float = 1e9           # refuse runs of more steps than this
 
 
@@ -111,6 +113,9 @@ class Simulation:
         if not (math.isfinite(o.fluct_stages) and (o.fluct_stages == 0 or o.fluct_stages >= 1)):
             raise MlcError(f"the fluctuation mode's stage factor must be 0 (auto) or >= 1, got {o.fluct_stages}",
                            "fluct_stages", "fewer stages than the stable minimum would be unstable")
+        if not (isinstance(o.fluct_levels, (int, np.integer)) and 1 <= o.fluct_levels <= 8):
+            raise MlcError(f"the fluctuation mode's random substep levels must be an integer from 1 to 8, got "
+                           f"{o.fluct_levels!r}", "fluct_levels", "use 4 (the default) or 1 (off)")
         u = scene.units
         self.gamma = float(u.get("gamma", 1.0))
         self.k0 = float(u.get("k0", 1.0))
@@ -373,18 +378,28 @@ class Simulation:
                       int(rec_every), int(rph), rec, int(frame_every), int(fph), fpos, fquat, self.uval, self.ws,
                       self.arm, self.fsp, self.ratio, self.dmin, self.dpart, self.F, self.T, self.disp, self.mon,
                       self.status)
-            if o.scheme == "euler":
-                done = self._k["euler"](*common)
-                self.stages_out[0] += done
-                self.stages_out[1] = 1
-            else:
-                eta = 0.0 if o.fluct else float(o.eta)
-                m = self.fluct_stage_factor(dt / self.t_unit)
-                done = self._k["skrock"](*common, eta, float(o.rho_safety) * m * m, int(o.rho_every), 60, self.pv,
-                                         self.pw, self.sp_tmp, int(o.stages), self.stages_out, self.K0, self.K1,
-                                         self.K2, self.Qn, self.qn, self.xs, self.qs, float(o.accept),
-                                         float(o.rot_acc), float(o.disp_acc), self.arm_max, self.Bc, self.Bn,
-                                         self.zb, self.ppos, self.pquat, bool(o.fluct), self._lev_min(dt))
+            try:
+                if o.scheme == "euler":
+                    done = self._k["euler"](*common)
+                    self.stages_out[0] += done
+                    self.stages_out[1] = 1
+                else:
+                    eta = 0.0 if o.fluct else float(o.eta)
+                    m = self.fluct_stage_factor(dt / self.t_unit)
+                    done = self._k["skrock"](*common, eta, float(o.rho_safety) * m * m, int(o.rho_every), 60,
+                                             self.pv, self.pw, self.sp_tmp, int(o.stages), self.stages_out, self.K0,
+                                             self.K1, self.K2, self.Qn, self.qn, self.xs, self.qs, float(o.accept),
+                                             float(o.rot_acc), float(o.disp_acc), self.arm_max, self.Bc, self.Bn,
+                                             self.zb, self.ppos, self.pquat, bool(o.fluct), self._lev_min(dt),
+                                             self.fluct_level_span(dt / self.t_unit))
+            except (ZeroDivisionError, OverflowError, FloatingPointError) as e:
+                # a stage inside a step ran to non-finite numbers before the step's checks could
+                # reject it (seen: NAND contracting at kT = 1, seed 2, the stiff scheme's default dt)
+                t0, t1 = self.t / self.t_unit, (self.t + nsteps * dt) / self.t_unit
+                raise MlcError(f"unstable between t = {t0:.6g} and {t1:.6g} t0: the forces or positions became "
+                               f"non-finite inside a step ({type(e).__name__} in the compiled kernel); at "
+                               f"kT = {o.kT:g} the scene may be coming apart", "--dt",
+                               "use a smaller --dt or a lower --kT") from None
             if self.status[0] != K.OVERFLOW:
                 break
             # the neighbour list outgrew its buffer: grow it and redo the call from its start
@@ -410,6 +425,24 @@ class Simulation:
             return float(o.fluct_stages)
         return self.fluct_stages_target(dt)[0]
 
+    def fluct_level_span(self, dt: float | None = None) -> int:
+        """How many random least substep levels the fluctuation mode draws each step from at
+        step ``dt`` (t0; default the run's): ``fluct_levels`` when a full step takes more than
+        ``FLUCT_LEVELS_MIN_STAGES`` stages (:meth:`fluct_stages_target`), else 1 (full-size
+        steps), and 1 without noise.  Measured (benchmarks/sim_fluct_bias.py,
+        benchmarks/sim_fluct_modes.py): at 4 stages (dt = 0.01 t0 for k0 bonds), where the
+        deeper levels fall to 2 and 3 stages, random levels gave the bonded pair 1.150 of exact
+        at kT = 1e-2 (full-size steps 1.007)."""
+        o = self.opt
+        if not (o.fluct and o.kT > 0) or o.fluct_levels <= 1:
+            return 1
+        h = (self.dt if dt is None else dt) * self.t_unit
+        q = math.sqrt(h * self.rho() * float(o.rho_safety) / 2.0)
+        if not (q > 0 and math.isfinite(q)):
+            return 1
+        s0 = max(2, math.ceil(self.fluct_stage_factor(dt) * q))
+        return int(o.fluct_levels) if s0 > FLUCT_LEVELS_MIN_STAGES else 1
+
     def fluct_stages_target(self, dt: float | None = None) -> tuple[float, int, float]:
         """The fluctuation mode's stage rule at step ``dt`` (t0): (m, s, R) with s the stages of a
         full step, m the factor that gives them, R = T_s(1 - h rho/s^2) the one-step factor of
@@ -423,8 +456,10 @@ class Simulation:
         ``FLUCT_M_HI`` (3) when one step's noise variance per axis 2 kT h/gamma exceeds
         ``FLUCT_NOISE_HI`` (0.5 sigma^2; a 1 sigma bond then turns by ~1 rad a step), else 1;
         s0 = ceil(m0 sqrt(h rho 1.2/2)); s = the smallest s in [s0, 1.5 s0] with R in
-        ``FLUCT_R_WINDOW`` ([-0.5, 0.5]), else the one there nearest that window.  Only the
-        estimated stiffest mode is placed: a scene's other modes fall where they fall."""
+        ``FLUCT_R_WINDOW`` ([-0.5, 0.5]), else the one there nearest that window.  This places
+        the estimated stiffest mode of a full-size step; the scene's other modes are kept off
+        the extrema by the random substep levels (``SimOptions.fluct_levels``; the kernel takes
+        s stages at level 0 and m sqrt(h rho/2) rounded up at the deeper levels)."""
         o = self.opt
         h = (self.dt if dt is None else dt) * self.t_unit
         m0 = FLUCT_M_HI if 2.0 * o.kT * h / self.gamma > FLUCT_NOISE_HI else 1.0
@@ -531,8 +566,9 @@ class Simulation:
         :meth:`rho`): Euler 1/(1 - h lambda/2); SK-ROCK (eta > 0) oscillates with h lambda
         (min and max over the modes up to rho); the fluctuation mode is exact (1.0) for every
         mode.  Keys: scheme, h_rho (stiffest mode's h lambda), ratio_min, ratio_max; for the
-        fluctuation mode also stage_factor, stages and R_stiffest (:meth:`fluct_stages_target`)
-        and the measured pair bias (:func:`fluct_pair_bias`)."""
+        fluctuation mode also stage_factor, stages and R_stiffest (:meth:`fluct_stages_target`,
+        a full-size step), substep_levels (:meth:`fluct_level_span`: each step's least substep
+        level is random in [0, substep_levels)) and the measured pair bias (:func:`fluct_pair_bias`)."""
         dt = self.dt if dt is None else dt
         h = dt * self.t_unit
         r = self.rho()
@@ -545,6 +581,8 @@ class Simulation:
             out = {"scheme": "stiff-fluct", "h_rho": hr, "ratio_min": 1.0, "ratio_max": 1.0,
                    "stage_factor": self.fluct_stage_factor(dt),
                    "note": "post-processed SK-ROCK with eta = 0: exact for every linear mode"}
+            if self.opt.kT > 0:
+                out["substep_levels"] = self.fluct_level_span(dt)
             if self.opt.kT > 0 and self.opt.fluct_stages == 0:
                 _, out["stages"], out["R_stiffest"] = self.fluct_stages_target(dt)
             out.update(fluct_pair_bias(self.opt.kT, dt))
@@ -680,6 +718,9 @@ FLUCT_M_HI = 3.0
 FLUCT_NOISE_HI = 0.5
 FLUCT_R_WINDOW = (-0.5, 0.5)
 FLUCT_SPAN = 1.5
+#: ... and random least substep levels (SimOptions.fluct_levels, session 15) only where a full
+#: step takes more than this many stages (Simulation.fluct_level_span)
+FLUCT_LEVELS_MIN_STAGES = 4
 
 
 def _cheb_factor(hr: float, s: int) -> float:
@@ -697,16 +738,17 @@ def _cheb_factor(hr: float, s: int) -> float:
 #: value for 200 bonded pairs (one bond, k = 1 k0, rest 1 sigma, between the bodies'
 #: centres, no rotational noise), per kT (k0 sigma^2): (dt in t0, ratio); 50 steps of
 #: burn-in, 200 measured, sampling error ~0.01; the session-13 stage rule (before it, kT = 1e-3,
-#: dt = 0.2 t0 gave +40 %: 16 stages put the pair's mode on an interior Chebyshev extremum).
+#: dt = 0.2 t0 gave +40 %: 16 stages put the pair's mode on an interior Chebyshev extremum) and
+#: the session-15 random substep levels above 4 stages (SimOptions.fluct_levels).
 FLUCT_PAIR_RATIO = {
-    1e-05: ((0.01, 0.994), (0.05, 1.003), (0.2, 1.014), (0.5, 0.996), (2.0, 0.981), (5.0, 0.999), (20.0, 0.996),
-            (100.0, 1.000)),
-    0.0001: ((0.01, 1.003), (0.05, 0.997), (0.2, 0.996), (0.5, 0.989), (2.0, 0.994), (5.0, 0.997), (20.0, 1.008),
-             (100.0, 1.011)),
-    0.001: ((0.01, 1.005), (0.05, 1.001), (0.2, 1.001), (0.5, 1.005), (2.0, 1.011), (5.0, 0.980), (20.0, 0.994),
-            (100.0, 0.991)),
-    0.01: ((0.01, 1.007), (0.05, 1.028), (0.2, 0.999), (0.5, 1.020), (2.0, 1.018), (5.0, 1.003), (20.0, 1.000),
-           (100.0, 1.023)),
+    1e-05: ((0.01, 0.994), (0.05, 0.999), (0.2, 0.998), (0.5, 1.005), (2.0, 0.990), (5.0, 1.000), (20.0, 0.999),
+            (100.0, 1.014)),
+    0.0001: ((0.01, 1.003), (0.05, 0.997), (0.2, 0.983), (0.5, 0.993), (2.0, 0.998), (5.0, 0.999), (20.0, 1.000),
+             (100.0, 1.004)),
+    0.001: ((0.01, 1.005), (0.05, 0.991), (0.2, 1.026), (0.5, 1.002), (2.0, 1.015), (5.0, 0.992), (20.0, 0.981),
+            (100.0, 1.009)),
+    0.01: ((0.01, 1.007), (0.05, 1.011), (0.2, 1.027), (0.5, 1.029), (2.0, 1.008), (5.0, 1.007), (20.0, 1.019),
+           (100.0, 1.009)),
 }
 
 
@@ -733,10 +775,11 @@ def fluct_pair_bias(kT: float, dt: float) -> dict:
             "pair_note": "measured bond-length variance / exact of a bonded pair (k = 1 k0, rest 1 sigma) at this "
                          "dt and the nearest measured kT (benchmarks/sim_fluct_bias.py): the nonlinearity linear "
                          "theory misses: within 3 % at kT = 1e-5 to 1e-2 and dt = 0.01 to 100 t0 with the "
-                         "stage rule (fluct_stages_target), which keeps the pair's mode off the interior Chebyshev "
-                         "extrema (there the undamped scheme neither relaxes nor damps nonlinear noise: +40 % "
-                         "at kT = 1e-3, dt = 0.2 t0 before)" + ("; outside the measured range: an extrapolation"
-                                                                     if far else "")}
+                         "stage rule (fluct_stages_target) and the random substep levels (fluct_level_span), "
+                         "which keep the modes off the interior Chebyshev extrema (there the undamped scheme "
+                         "neither relaxes nor damps nonlinear noise: +40 % at kT = 1e-3, dt = 0.2 t0 before); "
+                         "one stiffness: a spread of stiff modes is measured in docs/simulation.md ('Many stiff "
+                         "modes')" + ("; outside the measured range: an extrapolation" if far else "")}
 
 
 def _floor1(x: float) -> float:

@@ -614,6 +614,14 @@ def _normals3(seed, key, b, rot, out):
 
 
 @njit(cache=True)
+def _least_level(seed, step, lev_min, lev_span):
+    """The fluctuation mode's random least substep level of macro step ``step``: lev_min + r,
+    r uniform in [0, lev_span), from a counter keyed by (seed, step) (not by the noise's keys)."""
+    r = _mix(np.uint64(seed) * _H + np.uint64(step) * _G + _M2) % np.uint64(lev_span)
+    return min(lev_min + int(r), LMAX)
+
+
+@njit(cache=True)
 def brownian_at(seed, step, k, lev, b, rot, out, z):
     """Standard Brownian path of macro step ``step``, body ``b``, at the dyadic point
     u = k / 2^lev of the step (B(0) = 0, Var B(u) = u), into out[0:6] (3 components, 6 with
@@ -755,7 +763,7 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
                uval, ws, arm, fsp, ratio, dmin, dpart, F, T, disp, mon, status,
                eta, rho_safety, rho_every, rho_iters, pv, pw, sp_tmp, fixed_s, stages_out,
                K0, K1, K2, Qn, qn, xs, qs, accept, rot_acc, disp_acc, arm_max,
-               Bc, Bn, zb, ppos, pquat, post, lev_min):
+               Bc, Bn, zb, ppos, pquat, post, lev_min, lev_span):
     """SK-ROCK (Abdulle, Almuslimani & Vilmart 2018) with damping ``eta``, ``nsteps``
     macro steps of size dt.  The number of stages s is the smallest with
     (2 - 4 eta/3) s^2 >= h rho, rho = power-iteration estimate (times ``rho_safety``,
@@ -771,7 +779,12 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
     drift beyond ``disp_acc`` (+ 3 |noise| for bodies whose noise a bond absorbs) or a
     rotational drift beyond ``rot_acc`` or that over ``arm_max``.  After an easy substep
     the level drops again where the grid allows; never below ``lev_min`` (a level set from
-    the rotational noise variance).  A substep rejected at level LMAX is a genuine
+    the rotational noise variance).  With ``lev_span`` > 1 (the fluctuation mode with noise)
+    each macro step also gets a random least level lev_min + r, r uniform in [0, lev_span),
+    from a counter keyed by (seed, step) and independent of the noise: a mode whose h lambda
+    sits at an interior Chebyshev extremum at one level (|R| = 1 without damping: it neither
+    relaxes nor takes noise) is away from it at the others, so no mode of the spectrum stays
+    frozen.  A substep rejected at level LMAX is a genuine
     instability (status set).  With ``post`` the recorded states are post-processed:
     X + Q'/(2s), Q' a fresh noise increment of the current substep size (exact stationary
     variance of linear modes for eta = 0), (h, s) of the last accepted substep, and the
@@ -818,8 +831,14 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
             stages_out[5] = rho_b
         rho = rho_b + 2.0 * mon[5] / gamma
         stages_out[2] = rho
-        # the macro step starts at twice the last accepted substep
-        lev = max(lev - 1, lev_min)
+        # the macro step starts at twice the last accepted substep, not below its least level;
+        # with random levels, a step that ended at the previous step's least level starts at its own
+        lmin = lev_min
+        if lev_span > 1:
+            lmin = _least_level(seed, step, lev_min, lev_span)
+            if step > 0 and lev <= _least_level(seed, step - 1, lev_min, lev_span):
+                lev = lmin
+        lev = max(lev - 1, lmin)
         if _due(n, rec_every, rec_phase) or _due(n, frame_every, frame_phase):
             if post and noisy:
                 # the stiff modes' variance deficit is that of the last substep taken (h, s)
@@ -935,7 +954,7 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
                 for b in range(N):
                     for c in range(6):
                         Bc[b, c] = Bn[b, c]
-                if dmax < 0.5 * dlim and amax < 0.5 * alim and lev > lev_min and ((u >> (LMAX - lev)) & 1) == 0:
+                if dmax < 0.5 * dlim and amax < 0.5 * alim and lev > lmin and ((u >> (LMAX - lev)) & 1) == 0:
                     lev -= 1
                 stages_out[4] = dt / (1 << lev)         # the level to go on with (kept between calls)
                 continue

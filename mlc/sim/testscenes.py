@@ -95,18 +95,19 @@ def lever_scene(angle: float = 2.0, k: float = 1.0, tol: float = 0.0) -> Scene:
     return Scene("lever", bodies, bonds, muscles, probes, ["a"], ["out"]).check()
 
 
-def bonded_pairs(n: int, rest: float = 1.0, tol: float = 0.0, k: float = 1.0, spacing: float = 4.0) -> Scene:
+def bonded_pairs(n: int, rest: float = 1.0, tol: float = 0.0, k=1.0, spacing: float = 4.0) -> Scene:
     """n pairs of bodies on a square grid ``spacing`` sigma apart, each pair joined by one
-    bond (rest length ``rest``, tolerance ``tol``, sigma; stiffness ``k``, k0) between
-    their centres, so no torque acts."""
+    bond (rest length ``rest``, tolerance ``tol``, sigma; stiffness ``k``, k0, or a sequence
+    of n stiffnesses, one a pair) between their centres, so no torque acts."""
     bodies, bonds = [], []
     side = int(math.ceil(math.sqrt(n)))
+    ks = np.broadcast_to(np.asarray(k, dtype=float), (n,))
     for i in range(n):
         c = spacing * np.array([i % side, i // side, 0.0])
         for tag, dx in (("a", -0.5 * rest), ("b", 0.5 * rest)):
             bodies.append(Body(f"{tag}{i}", c + [dx, 0, 0], np.array([1.0, 0, 0, 0]),
                                [Box(np.array([0.3, 0.3, 0.01]))], {"c": np.zeros(3)}))
-        bonds.append(Bond(f"u{i}", f"a{i}.c", f"b{i}.c", k, rest, tol, "universal", f"u{i}"))
+        bonds.append(Bond(f"u{i}", f"a{i}.c", f"b{i}.c", float(ks[i]), rest, tol, "universal", f"u{i}"))
     return Scene("pairs", bodies, bonds).check()
 
 
