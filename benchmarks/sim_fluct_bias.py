@@ -21,7 +21,7 @@ fluct False: the plain stiff scheme for comparison.
     python benchmarks/sim_fluct_bias.py [--quick] [--burn N] [--steps N] [--out STEM]
 
 Writes benchmarks/results/sim_fluct_bias.json and .png (~6 min on the shared 2-core machine;
-session 13's stage rule, ~10 min).
+session 13's stage rule, ~10 min; session 15's random substep levels, ~11 min at load 5-8).
 Units: sigma, k0, gamma, t0 = gamma/(1e-3 k0).
 """
 from __future__ import annotations
