@@ -1,6 +1,7 @@
 """Synthesis on the EPFL combinational benchmarks: mlc against Berkeley ABC in one run.
 
     python benchmarks/synthesis_epfl.py [--timeout 150] [--circuits ctrl,router] [--no-abc]
+    python benchmarks/synthesis_epfl.py --profile [--circuits ctrl,router]
 
 Reads the binary AIGER circuits of ``../shared/benchmarks/epfl/`` (relative to the
 repository; the script says so and exits 0 where that folder is absent) and, per circuit:
@@ -20,11 +21,17 @@ repository; the script says so and exits 0 where that folder is absent) and, per
 
 A circuit's mlc numbers count only when its proof succeeded (and, with ABC present,
 ABC's ``cec`` agrees).  Writes ``benchmarks/results/synthesis_epfl.json``, ``.md`` and
-``.png``.  Times in seconds, memory in MiB.
+``.png``.  Times in seconds, memory in MiB.  numba's kernels are loaded (compiled, on a
+fresh clone) once before the run, outside every limit and time (``numba_cache_s``); each
+row records the md5 of mlc's AIG (``to_text()``), to compare networks across runs.
+
+``--profile`` instead measures where mlc's synthesis CPU time goes, by pass and by numba
+kernel (:func:`profile`), into ``benchmarks/results/synthesis_epfl_profile.json``.
 """
 from __future__ import annotations
 
 import argparse
+import hashlib
 import json
 import os
 import platform
@@ -110,6 +117,7 @@ def worker(path: str, outdir: str) -> dict:
         "compile_cpu_s": c2 - c1,
         "ands": c.aig.num_ands(),
         "depth": c.aig.depth(),
+        "aig_md5": hashlib.md5(c.aig.to_text().encode()).hexdigest(),   # to compare networks across runs
         "gates": c.netlist.stats["gates"],
         "gate_depth": c.netlist.stats["depth"],
         "equivalence": st["equivalence"].get("method"),
@@ -275,6 +283,144 @@ def plot(res: dict, path: Path) -> None:
     fig.savefig(path, dpi=110)
 
 
+# ----------------------------------------------------------------------------- profile
+
+PASSES = {
+    "opt": ["sweep", "fraig", "resub", "resub_odc", "resub_window", "resub_dc", "rewrite", "refactor",
+            "balance", "balance_xor", "extract_and", "reorder", "initial_candidates", "improve", "_restarts"],
+    "decomp": ["from_table"],
+    "canon": ["canonical", "restore", "to_canonical", "permuted"],
+    "equiv": ["spec_tables"],
+}
+
+
+class Meter:
+    """CPU seconds charged to the innermost open call (self) and to all open calls (incl)."""
+
+    def __init__(self):
+        self.self_s, self.incl_s, self.calls, self.min_s = {}, {}, {}, {}
+        self.stack = []                 # [name, start, child seconds]
+
+    def wrap(self, name, fn):
+        clock = time.process_time
+        st = self
+
+        def wrapped(*a, **k):
+            st.stack.append([name, clock(), 0.0])
+            try:
+                return fn(*a, **k)
+            finally:
+                nm, t0, child = st.stack.pop()
+                dt = clock() - t0
+                st.incl_s[nm] = st.incl_s.get(nm, 0.0) + dt
+                st.self_s[nm] = st.self_s.get(nm, 0.0) + dt - child
+                st.calls[nm] = st.calls.get(nm, 0) + 1
+                if dt < st.min_s.get(nm, 1e9):
+                    st.min_s[nm] = dt
+                if st.stack:
+                    st.stack[-1][2] += dt
+        return wrapped
+
+
+def profile_worker(path: str) -> dict:
+    """One run of ``opt.optimize(spec, 2)`` with every pass and kernel under a :class:`Meter`."""
+    sys.path.insert(0, str(ROOT))
+    from numba.core.registry import CPUDispatcher
+
+    from mlc.front.load import load
+    from mlc.logic import canon, cofexact, decomp, equiv, exactsat, kern, npn, opt  # noqa: F401
+
+    kern.warm()
+    spec = load(path)
+    m = Meter()
+    for mod_name, names in PASSES.items():
+        mod = {"opt": opt, "decomp": decomp, "canon": canon, "equiv": equiv}[mod_name]
+        for nm in names:
+            setattr(mod, nm, m.wrap(nm if mod_name == "opt" else f"{mod_name}.{nm}", getattr(mod, nm)))
+    kernels = [nm for nm, v in vars(kern).items() if isinstance(v, CPUDispatcher)]
+    for nm in kernels:
+        setattr(kern, nm, m.wrap(f"kern.{nm}", getattr(kern, nm)))
+    c0 = time.process_time()
+    g = opt.optimize(spec, 2)
+    total = time.process_time() - c0
+    other = total - sum(m.self_s.values())
+    return {"cpu_s": total, "ands": g.num_ands(), "depth": g.depth(), "other_s": other,
+            "aig_md5": hashlib.md5(g.to_text().encode()).hexdigest(),
+            "self_s": m.self_s, "incl_s": m.incl_s, "calls": m.calls, "min_s": m.min_s,
+            "kernel_calls": sum(v for k, v in m.calls.items() if k.startswith("kern.")),
+            "kernel_s": sum(v for k, v in m.self_s.items() if k.startswith("kern."))}
+
+
+def dispatch_cost() -> dict:
+    """numba's fixed cost of a call: a kernel that does nothing, with 0 and with 12 array
+    arguments (rewrite_node takes 20 arguments), CPU seconds a call over 2e5 calls."""
+    import numpy as np
+    from numba import njit
+
+    @njit(cache=False)
+    def nop0():
+        return 0
+
+    @njit(cache=False)
+    def nop12(a, b, c, d, e, f, g, h, i, j, k, l):
+        return a[0]
+
+    arrs = [np.zeros(8, np.int64) for _ in range(12)]
+    nop0(), nop12(*arrs)
+    out = {}
+    for name, call in (("0 args", lambda: nop0()), ("12 arrays", lambda: nop12(*arrs))):
+        n = 200_000
+        c0 = time.process_time()
+        for _ in range(n):
+            call()
+        out[name] = (time.process_time() - c0) / n
+    n = 200_000
+    c0 = time.process_time()
+    for _ in range(n):
+        (lambda: None)()
+    out["python call"] = (time.process_time() - c0) / n
+    return out
+
+
+def profile(names: list[str]) -> int:
+    """``--profile``: where mlc's synthesis time goes, one run per circuit in its own process.
+
+    The passes of :mod:`mlc.logic.opt` (with the decomposition, the canonical ordering and
+    the restarts) and every numba kernel of :mod:`mlc.logic.kern` are wrapped by a timer
+    (``time.process_time``, after ``kern.warm`` as above) that charges each CPU second to
+    the innermost wrapped call running (``self_s``) and to every wrapped call open
+    (``incl_s``); per wrapped function also its calls and its shortest call.  The wrappers
+    cost about 1 us a call (part of ``cpu_s``).  ``dispatch_s``: the fixed CPU cost of a
+    call to a numba kernel that does nothing (no arguments, 12 arrays) and of a Python
+    call, for comparison.  Writes ``benchmarks/results/synthesis_epfl_profile.json``."""
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    me = str(Path(__file__).resolve())
+    res = {"benchmark": "synthesis_epfl --profile", "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
+           "machine": f"{platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}",
+           "load_before": [round(x, 1) for x in os.getloadavg()], "circuits": {}}
+    p = subprocess.run([sys.executable, me, "--dispatch"], capture_output=True, text=True, env=env, check=True)
+    res["dispatch_s"] = json.loads(p.stdout.strip().splitlines()[-1])
+    print("fixed CPU s a call:", res["dispatch_s"], flush=True)
+    for name in names:
+        p = subprocess.run([sys.executable, me, "--profile-worker", str(EPFL / f"{name}.aig")],
+                           capture_output=True, text=True, env=env)
+        if p.returncode != 0:
+            print(f"{name}: error {(p.stderr.strip().splitlines() or ['?'])[-1]}", flush=True)
+            continue
+        d = json.loads(p.stdout.strip().splitlines()[-1])
+        res["circuits"][name] = d
+        top = sorted(d["self_s"].items(), key=lambda kv: -kv[1])[:5]
+        print(f"{name:10s} {d['cpu_s']:6.2f} s CPU, {d['ands']} ANDs, kernels {d['kernel_s']:.2f} s in "
+              f"{d['kernel_calls']} calls; " + ", ".join(f"{k} {v:.2f}" for k, v in top), flush=True)
+    res["load_after"] = [round(x, 1) for x in os.getloadavg()]
+    res["git_head"] = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                                     text=True).stdout.strip()
+    RESULTS.mkdir(parents=True, exist_ok=True)
+    stem = "synthesis_epfl_profile" if len(names) == len(CIRCUITS) else "synthesis_epfl_profile_subset"
+    (RESULTS / f"{stem}.json").write_text(json.dumps(res, indent=1) + "\n")
+    return 0
+
+
 # ----------------------------------------------------------------------------- main
 
 def main(argv=None) -> int:
@@ -286,14 +432,31 @@ def main(argv=None) -> int:
     ap.add_argument("--circuits", help="comma-separated subset (default: all eleven)")
     ap.add_argument("--no-abc", action="store_true", help="do not run ABC even if installed")
     ap.add_argument("--note", default="", help="free text stored in the JSON (e.g. which tree was measured)")
+    ap.add_argument("--profile", action="store_true",
+                    help="instead of the comparison: where mlc's synthesis CPU time goes, by pass and numba "
+                         "kernel (writes benchmarks/results/synthesis_epfl_profile.json)")
     ap.add_argument("--worker", nargs=2, metavar=("AIG", "OUTDIR"), help=argparse.SUPPRESS)
+    ap.add_argument("--profile-worker", metavar="AIG", help=argparse.SUPPRESS)
+    ap.add_argument("--dispatch", action="store_true", help=argparse.SUPPRESS)
     args = ap.parse_args(argv)
     if args.worker:
         print(json.dumps(worker(*args.worker)))
         return 0
+    if args.profile_worker:
+        print(json.dumps(profile_worker(args.profile_worker)))
+        return 0
+    if args.dispatch:
+        print(json.dumps(dispatch_cost()))
+        return 0
     if not EPFL.is_dir():
         print(f"skipped: {EPFL} is absent (the EPFL circuits live in ../shared/benchmarks/epfl/)")
         return 0
+    if args.circuits and set(args.circuits.split(",")) - set(CIRCUITS):
+        bad = sorted(set(args.circuits.split(",")) - set(CIRCUITS))
+        print(f"--circuits: unknown {', '.join(bad)}; choose from {', '.join(CIRCUITS)}", file=sys.stderr)
+        return 2
+    if args.profile:
+        return profile(args.circuits.split(",") if args.circuits else CIRCUITS)
     sys.path.insert(0, str(ROOT))
     from mlc.front.aiger import read
 
@@ -307,6 +470,17 @@ def main(argv=None) -> int:
         abc_version = f"{Path(abc).name}: {m.group(1) if m else '?'}"
     else:
         print("ABC not found (apt-get install berkeley-abc): mlc only")
+    # numba compiles the kernels on first use and caches them beside the sources; on a
+    # fresh clone that takes minutes (more on a loaded machine), which would count
+    # against the first circuit's time limit: load (or compile) them once here, untimed
+    t0 = time.perf_counter()
+    p = subprocess.run([sys.executable, "-c", "from mlc.logic import kern; print(kern.warm())"],
+                       capture_output=True, text=True, env={**os.environ, "PYTHONPATH": str(ROOT)})
+    if p.returncode != 0:
+        print(f"numba kernels failed to load: {(p.stderr.strip().splitlines() or ['?'])[-1]}", file=sys.stderr)
+        return 1
+    cache_s = time.perf_counter() - t0
+    print(f"numba kernels loaded (compiled if not cached) in {cache_s:.1f} s wall", flush=True)
     out = []
     start = time.perf_counter()
     load_before = [round(x, 1) for x in os.getloadavg()]
@@ -367,6 +541,7 @@ def main(argv=None) -> int:
         "timeout_s": args.timeout,
         "budget_s": args.budget,
         "wall_s": time.perf_counter() - start,
+        "numba_cache_s": cache_s,                   # kernels loaded or compiled before the run, wall
         "load_before": load_before,
         "load_after": [round(x, 1) for x in os.getloadavg()],
         "units": {"time": "s", "memory": "MiB"},
