@@ -94,6 +94,32 @@ def _decode_error(e: UnicodeDecodeError) -> str:
     return f"{where}: {byte} is not UTF-8 text (save the file as UTF-8)"
 
 
+class _Unraisable:
+    """``sys.unraisablehook`` while a command runs: a Ctrl-C that lands in a callback (Numba's
+    compiler calls back from LLVM) is noted, not printed as a traceback; the compiler then fails
+    with an error of its own, which :func:`_main` reports as the interruption it is."""
+
+    def __init__(self, inner):
+        self.inner, self.hit = inner, False
+
+    def __call__(self, u):
+        if isinstance(u.exc_value, KeyboardInterrupt):
+            self.hit = True
+        else:
+            self.inner(u)
+
+
+def _interrupted(e: BaseException, hook) -> bool:
+    """Whether ``e`` comes of a Ctrl-C: one in its chain of causes, or one noted by ``hook``."""
+    seen = set()
+    while e is not None and id(e) not in seen:
+        if isinstance(e, KeyboardInterrupt):
+            return True
+        seen.add(id(e))
+        e = e.__cause__ or e.__context__
+    return hook.hit
+
+
 def main(argv=None) -> int:
     if sys.stdout is None:       # started as `mlc ... >&-`
         if sys.stderr is not None:
@@ -124,6 +150,8 @@ def _main(argv) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    hook = _Unraisable(sys.unraisablehook)
+    sys.unraisablehook = hook
     try:
         code = int(args.func(args) or 0)
         sys.stdout.flush()
@@ -148,6 +176,9 @@ def _main(argv) -> int:
     except Exception as e:
         if os.environ.get("MLC_TRACEBACK"):
             raise
+        if _interrupted(e, hook):            # e.g. Numba's "no compiled object yet" after a Ctrl-C in a compile
+            sys.stderr.write("mlc: interrupted\n")
+            return 130
         where = ""
         tb = e.__traceback__
         while tb is not None and tb.tb_next is not None:
@@ -157,6 +188,8 @@ def _main(argv) -> int:
         sys.stderr.write(f"mlc: internal error: {type(e).__name__}: {e}{where} (this is a bug in mlc; please "
                          f"report it; MLC_TRACEBACK=1 shows the traceback)\n")
         return 3
+    finally:
+        sys.unraisablehook = hook.inner
 
 
 if __name__ == "__main__":  # pragma: no cover

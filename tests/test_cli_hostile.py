@@ -848,6 +848,8 @@ NUMERIC_OPTIONS = {
             {"--sigma-mm": None, "--clearance": None, "--knuckle-gap": None, "--slab-thickness": None,
              "--min-wall": None, "--min-feature": None, "--pin-diameter": None, "--segments": None}),
     "check-gate": (["check-gate", "NAND", "--signal", "expand", "--dynamic"], {"--seeds": "1", "--kT": None}),
+    "verify": (["verify", "{scene}", "--dynamic", "--rows", "11"],
+               {"--seeds": "1", "--kT": None, "--tau": None, "--dt": None}),
 }
 
 
@@ -903,7 +905,12 @@ OUTPUT_OPTIONS = {
     "stl -o": (["stl", "{hinge}"], "-o", ".stl"),
     "stl --3mf": (["stl", "{hinge}"], "--3mf", ".3mf"),
     "stl --report": (["stl", "{hinge}"], "--report", ".json"),
+    "compile --draw": (["compile", "-e", "f = a & b", "--no-circuit", "-o", "{d}/o"], "--draw", ".png"),
+    "robot shapes -o": (["robot", "shapes", "{scene}"], "-o", ".png"),
+    "robot fold --gif": (["robot", "fold", "{scene}", "--row", "1"], "--gif", ".gif"),
+    "robot fold --gsd": (["robot", "fold", "{scene}", "--row", "1"], "--gsd", ".gsd"),
 }
+MAKES_PARENTS = {"compile --draw", "robot shapes -o", "robot fold --gif", "robot fold --gsd"}   # parents=True
 BAD_LOCATIONS = {
     # name: (path maker given the output directory and the suffix, words)
     "directory": (lambda d, sfx: d, ["is a directory"]),
@@ -923,13 +930,15 @@ def test_generated_bad_output_locations(what, where, scene_text, hinge_scene, tm
     """Refused before the work (fast), naming the option; nothing written anywhere."""
     pre, option, sfx = OUTPUT_OPTIONS[what]
     make, words = BAD_LOCATIONS[where]
+    if where == "missing_directory" and what in MAKES_PARENTS:
+        pytest.skip("this option creates a missing directory")
     src = tmp_path / f"s{sfx}"                 # an input named like the output, for "the_input"
     src.write_text(scene_text)
     d = tmp_path / "out"
     d.mkdir()
     (d / "f.txt").write_text("keep")
     before, before_top = listing(d), listing(tmp_path)
-    inp = {"simulate": src, "stl": hinge_scene}.get(pre[0])
+    inp = {"simulate": src, "stl": hinge_scene, "robot": src}.get(pre[0])
     if where == "the_input":
         if inp is None:
             pytest.skip("this command reads no input file")
@@ -940,7 +949,7 @@ def test_generated_bad_output_locations(what, where, scene_text, hinge_scene, tm
         out = inp
     else:
         out = make(d, sfx)
-    argv = [a.format(scene=src, hinge=inp or hinge_scene) for a in pre] + [option, out]
+    argv = [a.format(scene=src, hinge=inp or hinge_scene, d=d) for a in pre] + [option, out]
     code, stdout, err = run(capsys, *argv)
     assert_clean_failure(code, err, before, d, f"mlc: error: {option}", *[w.format(sfx=sfx) for w in words])
     assert listing(tmp_path) == before_top or where == "the_input" and pre[0] == "stl"
@@ -1153,3 +1162,41 @@ def test_draw_refuses_more_panels_than_a_picture_shows(scene_text, tmp_path, cap
     before = listing(tmp_path)
     code, _, err = run(capsys, "draw", src, "-o", tmp_path / "x.png")
     assert_clean_failure(code, err, before, tmp_path, f"{src}: 7 inputs make 128 input states", "at most 64")
+
+
+def test_ctrl_c_inside_a_compiler_callback_is_an_interruption(monkeypatch, capsys):
+    """Ctrl-C while Numba compiles lands in an LLVM callback: Python printed it as an ignored
+    traceback, then Numba failed with "RuntimeError: no compiled object yet", reported as an mlc
+    bug (exit 3; seen on a cold cache, simulate interrupted 17 s after its start)."""
+    import types
+    import mlc.commands.version as version
+
+    def compile_interrupted(args):
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as ki:
+            sys.unraisablehook(types.SimpleNamespace(exc_type=KeyboardInterrupt, exc_value=ki,
+                                                     exc_traceback=ki.__traceback__, err_msg=None, object=None))
+        raise RuntimeError("no compiled object yet for <Library 'eval_s'>")
+
+    def chained(args):
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt:
+            raise RuntimeError("cleanup failed")
+
+    for fn in (compile_interrupted, chained):
+        monkeypatch.setattr(version, "run", fn)
+        code, _, err = run(capsys, "info")
+        assert code == 130 and err == "mlc: interrupted\n", (fn.__name__, err)
+    seen = []
+    monkeypatch.setattr(sys, "unraisablehook", lambda u: seen.append(u.exc_type))
+
+    def other(args):                 # any other unraisable still reaches the hook; a bug is still a bug
+        sys.unraisablehook(types.SimpleNamespace(exc_type=ValueError, exc_value=ValueError("x"),
+                                                 exc_traceback=None, err_msg=None, object=None))
+        raise RuntimeError("an mlc bug")
+
+    monkeypatch.setattr(version, "run", other)
+    code, _, err = run(capsys, "info")
+    assert code == 3 and "internal error: RuntimeError: an mlc bug" in err and seen == [ValueError]

@@ -7,6 +7,8 @@ import json
 
 MAX_SEEDS = 1000            # seeds per row for --dynamic
 MAX_DT = 1e3          # --dt upper bound (t0): the slowest rows relax in about 100 t0 (the Tetris robot)
+MIN_DT = 1e-6         # --dt lower bound (t0): a run of 20 t0 is then 2e7 steps
+MAX_TAU = 1e4         # --tau upper bound (t0): a run lasts several tau; the Tetris robot's is 100 t0
 
 
 def register(sub):
@@ -74,6 +76,12 @@ def run(args) -> int:
         if not (v > 0 and v < float("inf")):
             raise MlcError(f"{opt} must be a finite time > 0 (t0), got {v}", opt,
                            "e.g. --tau 100 --dt 0.2 for the Tetris robot (docs/robot.md section 3)")
+    if args.tau is not None and args.tau > MAX_TAU:         # 1e308 overflowed the step count (an internal error)
+        raise MlcError(f"--tau {args.tau:g} t0 is longer than any relaxation mlc checks (at most {MAX_TAU:g} t0)",
+                       "--tau", "e.g. --tau 100 for the Tetris robot (docs/robot.md section 3)")
+    if args.dt is not None and args.dt < MIN_DT:
+        raise MlcError(f"--dt {args.dt:g} t0 is below {MIN_DT:g} t0 (a run of 20 t0 would be over 2e7 steps)", "--dt",
+                       "e.g. --dt 0.2 (circuits' default); the stiff scheme takes any step")
     if args.dt is not None and args.dt > min(args.tau or MAX_DT, MAX_DT):
         # a run advances one averaging window (0.05 t0 to tau/20) at a time, so a longer step is cut to
         # it; a step over 1e9 windows made no step at all, and the rest pose was read as a wrong bit
