@@ -784,6 +784,34 @@ def test_sigterm_leaves_nothing(tmp_path):
     assert list(tmp_path.iterdir()) == []
 
 
+def test_ctrl_c_during_the_first_kernel_compile(scene_text, tmp_path):
+    """A real Ctrl-C to `mlc simulate --out` while Numba compiles the stepping kernel (an
+    empty NUMBA_CACHE_DIR forces the compile, ~20 s of it after the trigger): exit 130
+    within a few seconds, nothing written (the handler that defers Ctrl-C to the end of a
+    chunk held it until the compile and the first chunk were done: 26 s, files written)."""
+    import signal
+    import time as _time
+    src, out, nc = tmp_path / "s.yaml", tmp_path / "out", tmp_path / "nc"
+    src.write_text(scene_text)
+    out.mkdir()
+    code = ("import sys; from mlc.cli import main; sys.exit(main(['simulate', %r, '--time', '1', '--out', %r, "
+            "'--probes', %r, '--quiet']))" % (str(src), str(out / "t.gsd"), str(out / "p.csv")))
+    p = subprocess.Popen([sys.executable, "-P", "-c", code], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                         text=True, env=dict(os.environ, NUMBA_CACHE_DIR=str(nc)))
+    # a helper of the stepping kernel (skrock_s) is cached: its own compile has begun (measured 12 s in, of 32)
+    deadline = _time.time() + 120
+    while not list(nc.glob("*/kernels._site_world-*.nbi")) and p.poll() is None and _time.time() < deadline:
+        _time.sleep(0.05)
+    assert p.poll() is None and not list(nc.glob("*/kernels.skrock_s-*.nbi")), "not caught inside the compile"
+    sent = _time.time()
+    p.send_signal(signal.SIGINT)
+    err = p.communicate(timeout=120)[1]
+    back = _time.time() - sent
+    assert p.returncode == 130 and err == "mlc: interrupted\n", err
+    assert back < 5.0, f"exit {back:.1f} s after Ctrl-C"         # measured 0.65-1.1 s
+    assert list(out.iterdir()) == []
+
+
 def test_stl_time_estimate():
     from mlc.gates.library import gate_scene
     from mlc.mesh.profiles import PROFILES, estimate_seconds, load_profile

@@ -629,7 +629,9 @@ class Simulation:
         exactly at ``time``: the run's step is time / ceil(time / dt)); record probes every
         ``record_interval`` t0 (default: about 2000 records) and ``frames`` snapshots.  Shows
         a progress bar on a TTY for long runs.  Ctrl-C stops within about a second and
-        returns what was computed (``interrupted`` set)."""
+        returns what was computed (``interrupted`` set); during the first chunk, which
+        compiles the kernels on a cold cache (up to a minute), it raises KeyboardInterrupt
+        at once: nothing has been computed yet."""
         if not (math.isfinite(time) and time >= 0):
             raise MlcError(f"time must be a finite number >= 0 of t0, got {time}", "--time")
         if record_interval is not None and not (math.isfinite(record_interval) and record_interval > 0):
@@ -672,6 +674,7 @@ class Simulation:
                     g = g[g % frame_every == 0]
                     ftimes.extend((t_start + g * dt * self.t_unit) / self.t_unit)
                 done_total += done
+                stop.arm()
                 bar.update(done_total)
                 # aim at ~0.25 s per chunk (Ctrl-C is seen between chunks)
                 per = el / max(done, 1)
@@ -824,12 +827,18 @@ def skrock_variance_range(h_rho: float, eta: float, h_rho_max: float | None = No
 
 
 class _Interrupt:
-    """Within ``with``: Ctrl-C (SIGINT) sets ``hit`` instead of raising, so a run stops
-    cleanly between two compiled chunks (each ~0.25 s).  Outside the main thread: no-op."""
+    """Within ``with``, once :meth:`arm` is called: Ctrl-C (SIGINT) sets ``hit`` instead of
+    raising, so a run stops cleanly between two compiled chunks (each ~0.25 s).  Before
+    ``arm`` (the first chunk, while Numba compiles the kernels) Ctrl-C raises
+    KeyboardInterrupt at once, as without the handler.  Outside the main thread: no-op."""
 
     def __init__(self):
         self.hit = False
+        self.armed = False
         self._old = None
+
+    def arm(self):
+        self.armed = True
 
     def __enter__(self):
         import signal
@@ -839,6 +848,8 @@ class _Interrupt:
         return self
 
     def _handler(self, signum, frame):
+        if not self.armed:
+            raise KeyboardInterrupt
         self.hit = True
 
     def __exit__(self, *exc):
