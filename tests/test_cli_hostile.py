@@ -738,6 +738,11 @@ def test_kernel_compile_notice_once(monkeypatch):
     (["verify", "{scene}", "--dynamic", "--seeds", "1", "--tau", "1", "--dt", "5"], ["--dt", "longer than --tau"]),
     # the last of two drives of one input won, silently
     (["simulate", "{scene}", "--time", "0.1", "--set", "a=1", "--set", "a=0"], ["--set a is given twice"]),
+    # non-finite drive numbers ran (step:nan and square:inf exit 0, nan a dt instability, inf a stretched muscle)
+    *[(["simulate", "{scene}", "--time", "0.1", "--out", "{d}/t.gsd", "--set", f"a={v}"],
+       ["--set a: ", "drive", "finite", "give times in t0"])
+      for v in ("nan", "inf", "-inf", "step:nan", "step:1:nan:1", "step:1:0:inf", "square:inf", "square:1:nan",
+                "square:1:0.5:nan", "table:0=0,1=nan", "table:0=0,inf=1")],
 ])
 def test_refused_at_once(argv, words, scene_text, tmp_path, capsys):
     src = tmp_path / "s.yaml"

@@ -23,6 +23,15 @@ from mlc.errors import MlcError
 KINDS = {"constant": 0, "step": 1, "square": 2, "table": 3}
 
 
+def _finite(kind: str, *nums: float) -> tuple:
+    """``nums`` as floats, or an error if one is nan or infinite (a drive must say when and what)."""
+    nums = tuple(float(x) for x in nums)
+    if not all(np.isfinite(nums)):
+        raise MlcError(f"{kind} drive: every time and value must be a finite number, got "
+                       f"{':'.join(f'{x:g}' for x in nums)}", "drive", "give times in t0 and values such as 0 or 1")
+    return nums
+
+
 @dataclass(frozen=True)
 class Drive:
     kind: str
@@ -33,14 +42,15 @@ class Drive:
     # -- constructors -------------------------------------------------------
     @staticmethod
     def constant(v: float) -> "Drive":
-        return Drive("constant", (float(v),))
+        return Drive("constant", _finite("constant", float(v)))
 
     @staticmethod
     def step(at: float, before: float = 0.0, after: float = 1.0) -> "Drive":
-        return Drive("step", (float(at), float(before), float(after)))
+        return Drive("step", _finite("step", float(at), float(before), float(after)))
 
     @staticmethod
     def square(period: float, duty: float = 0.5, start: float = 0.0, low: float = 0.0, high: float = 1.0) -> "Drive":
+        _finite("square", period, duty, start, low, high)
         if not period > 0:
             raise MlcError(f"square drive: period must be > 0, got {period}", "drive", "give a positive period in t0")
         if not 0.0 <= duty <= 1.0:
@@ -56,7 +66,8 @@ class Drive:
         if any(b <= a for a, b in zip(t, t[1:])):
             raise MlcError(f"table drive: times must increase strictly, got {t}", "drive")
         if not np.all(np.isfinite(t + v)):
-            raise MlcError("table drive: times and values must be finite", "drive")
+            raise MlcError("table drive: times and values must be finite", "drive",
+                           "give times in t0 and values such as 0 or 1")
         return Drive("table", (), tuple(t), tuple(v))
 
     @staticmethod
@@ -80,8 +91,8 @@ class Drive:
                 pairs = [x.split("=") for x in rest.split(",") if x]
                 return Drive.table([float(a) for a, _ in pairs], [float(b) for _, b in pairs])
             raise ValueError
-        except MlcError:
-            raise
+        except MlcError as e:          # a constructor's complaint, about this option
+            raise MlcError(e.message, where, e.fix) from None
         except (ValueError, TypeError):
             raise MlcError(f"cannot read drive {text!r}", where,
                            "use 0, 1, step:T[:BEFORE:AFTER], square:PERIOD[:DUTY[:START]] "
