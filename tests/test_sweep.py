@@ -198,6 +198,11 @@ BAD = [
     ("scene: chain\nmeasure: steady\n", "", "seeds"),
     ("scene: and_chain_and\nmeasure: square_response\nparams:\n  dt: 0.5\n  frequency: 5\nseeds: 1\n", ":4",
      "quarter of the drive period"),
+    # mlc simulate's step limit, before any run (each run failed alone, and mlc sweep exited 0)
+    ("scene: gate\nmeasure: steady\nparams:\n  time: 10\n  dt: 1.0e-12\nseeds: 1\n", ":5",
+     "dt 1e-12 t0 is 1e+13 steps over the run's 10 t0 (more than 1e+09) (use a larger dt"),
+    ("scene: and_chain_and\nmeasure: square_response\nruns:\n  - {}\n  - {dt: 1.0e-9}\nseeds: 1\n", ":5",
+     "6e+09 steps over the run's 6 t0"),
 ]
 
 
@@ -210,6 +215,20 @@ def test_bad_specs_are_one_clear_error(tmp_path, capsys, text, line, words):
     assert err.startswith(f"mlc: error: {p}{line}") and err.count("\n") == 1, err
     assert words in err and "Traceback" not in err
     assert not out.exists()
+
+
+def test_a_sweep_of_only_failed_runs_exits_1(tmp_path, capsys):
+    """Each failed run is a row with its error; when every run failed, mlc sweep says so, exit 1."""
+    bad = TINY.replace("runs:\n  - {}\n  - {scheme: euler, dt: 0.002}\n  - {scheme: euler, dt: 9.0e-5}\n",
+                       "runs:\n  - {scheme: euler, dt: 0.002}\n").replace("seeds: 2", "seeds: 1")
+    p = _write(tmp_path, bad)
+    out = tmp_path / "out"
+    code, stdout, err = run(capsys, "sweep", p, "-o", out, "--json", "--quiet")
+    rows = _table(out)
+    assert code == 1, err
+    assert json.loads(stdout)["failed"] == 2 and [r["status"] for r in rows] == ["failed", "failed"]
+    assert err.startswith("mlc: error: every run of the sweep failed (2 of 2), the first: --dt: unstable") \
+        and err.count("\n") == 1 and "--retry-failed" in err, err
 
 
 def test_unreachable_scheduler(tmp_path, capsys):

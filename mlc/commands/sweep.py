@@ -53,6 +53,12 @@ def run(args) -> int:
     else:
         print(f"{spec.name}: {info['runs']} runs, {info['skipped']} already in the table, {info['ran']} run now "
               f"({info['failed']} failed); table {info['table']}")
+    if info["ran"] and info["failed"] == info["ran"]:
+        # each failure is a row of the table (issue 11), but a sweep of nothing but failures is not a result
+        sys.stderr.write(f"mlc: error: every run of the sweep failed ({info['failed']} of {info['ran']}), "
+                         f"the first: {info['first_error'][:300]} (see the error column of {info['table']}; "
+                         f"fix the spec, then run it again with --retry-failed)\n")
+        return 1
     return 0
 
 

@@ -148,7 +148,8 @@ def _client(scheduler: str | None, workers: int):
 
 def run_sweep(spec: SweepSpec, outdir, scheduler: str | None = None, workers: int | None = None,
               retry_failed: bool = False, progress: bool | None = None, log=None) -> dict:
-    """Run the spec's missing runs; returns {"runs", "skipped", "ran", "failed", "table"}."""
+    """Run the spec's missing runs; returns {"runs", "skipped", "ran", "failed", "table"} and, when a
+    run failed, "first_error" (the first failure's error, in the order the runs finished)."""
     from mlc.io.progress import Progress
     try:
         import dask.distributed  # noqa: F401
@@ -212,6 +213,8 @@ def run_sweep(spec: SweepSpec, outdir, scheduler: str | None = None, workers: in
                 _write_table(table, spec, rows, old_cols)
                 info["ran"] += 1
                 info["failed"] += res["status"] != "ok"
+                if res["status"] != "ok" and "first_error" not in info:
+                    info["first_error"] = res["error"]
                 if log and res["status"] != "ok":
                     log(f"run {rid} ({', '.join(f'{a}={b}' for a, b in run.varied.items())}, seed {run.seed}) "
                         f"failed: {res['error'][:300]}")

@@ -176,3 +176,11 @@ def _semantic(p: dict, scene: str, measure: str, where_map, path):
     for k, v in p.items():
         if isinstance(v, float) and not math.isfinite(v):
             fail(f"{k} must be finite", k)
+    if p["dt"] is not None and p["dt"] > 0:
+        # mlc simulate's rule (Simulation.run): more than max_steps steps is refused before the run
+        from mlc.sim.integrator import SimOptions
+        T = 1.0 / p["frequency"] * p["cycles"] if measure == "square_response" else p["time"]
+        n = math.ceil(T / p["dt"] - 1e-9)
+        if n > SimOptions.max_steps:
+            fail(f"dt {p['dt']} t0 is {n:.3g} steps over the run's {T:g} t0 (more than {SimOptions.max_steps:.3g})",
+                 "dt", "use a larger dt (the stiff scheme takes any dt) or a shorter run")
