@@ -743,6 +743,12 @@ def test_kernel_compile_notice_once(monkeypatch):
        ["--set a: ", "drive", "finite", "give times in t0"])
       for v in ("nan", "inf", "-inf", "step:nan", "step:1:nan:1", "step:1:0:inf", "square:inf", "square:1:nan",
                 "square:1:0.5:nan", "table:0=0,1=nan", "table:0=0,inf=1")],
+    # kT 1e308 overflowed the noise: the error named --dt ("no time step helps"), after the compile's work
+    *[(argv + ["--kT", "1e308"], ["--kT", "from 0 to 10"])
+      for argv in (["simulate", "{scene}", "--time", "0.1", "--out", "{d}/t.gsd"],
+                   ["verify", "{scene}", "--dynamic", "--seeds", "1"],
+                   ["compile", "-e", "f = a & b", "-o", "{d}/o", "--verify", "--dynamic", "--seeds", "1"],
+                   ["check-gate", "NAND", "--dynamic", "--seeds", "1"])],
 ])
 def test_refused_at_once(argv, words, scene_text, tmp_path, capsys):
     src = tmp_path / "s.yaml"

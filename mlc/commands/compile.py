@@ -218,8 +218,8 @@ def run(args) -> int:
         raise MlcError("--dynamic only applies to --verify", "--dynamic", "add --verify")
     if not 1 <= args.seeds <= 1000:
         raise MlcError(f"--seeds must be between 1 and 1000, got {args.seeds}", "--seeds")
-    if not (args.kT >= 0 and args.kT < float("inf")):
-        raise MlcError(f"kT must be finite and >= 0, got {args.kT}", "--kT")
+    from mlc.sim import check_kT
+    check_kT(args.kT)
     joint_k = getattr(args, "joint_k", None)
     if joint_k is not None:
         if not want_circuit:

@@ -63,8 +63,8 @@ def run(args) -> int:
     from mlc.scene.io import load_scene
     from mlc.verify.circuit import format_report
 
-    if not (args.kT >= 0 and args.kT < float("inf")):
-        raise MlcError(f"kT must be finite and >= 0, got {args.kT}", "--kT")
+    from mlc.sim import check_kT
+    check_kT(args.kT)
     if args.dynamic and not 1 <= args.seeds <= MAX_SEEDS:
         raise MlcError(f"--seeds must be between 1 and {MAX_SEEDS}, got {args.seeds} (each seed of each row is a "
                        f"Brownian-dynamics run of minutes on a circuit)", "--seeds")

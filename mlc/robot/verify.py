@@ -298,15 +298,14 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
     more than 8 min for a 2000-body robot).  Seeds are ``first_seed``, ``first_seed + 1``, ..."""
     from mlc.io.progress import Progress
     from mlc.sim.drive import Drive
-    from mlc.sim.integrator import SimOptions, Simulation
+    from mlc.sim.integrator import SimOptions, Simulation, check_kT
     from mlc.verify.dynamic import TAU_FACTOR, relaxation_time
 
     rm = robot_meta(scene)
     states = select_rows(scene, rows)
     if int(seeds) < 1:
         raise MlcError(f"need at least one seed, got {seeds}", "--seeds")
-    if not (math.isfinite(kT) and kT >= 0):
-        raise MlcError(f"kT must be finite and >= 0, got {kT}", "--kT")
+    check_kT(kT)
     for opt, v in (("--tau", tau), ("--dt", dt)):
         if v is not None and not (isinstance(v, str) and v == "compute" and opt == "--tau") \
                 and not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):

@@ -23,6 +23,7 @@ import numpy as np
 from mlc.errors import MlcError
 from mlc.scene.model import Scene
 from mlc.sim import kernels as K
+from mlc.sim import check_kT
 from mlc.sim.drive import Drive, pack_drives
 
 SCHEMES = ("euler", "stiff")
@@ -108,8 +109,7 @@ class Simulation:
         if o.fluct and o.scheme != "stiff":
             raise MlcError("the fluctuation mode is a variant of the stiff scheme", "--fluct",
                            "use --scheme stiff, or Euler well below its limit (see docs/simulation.md)")
-        if not (math.isfinite(o.kT) and o.kT >= 0):
-            raise MlcError(f"kT must be finite and >= 0, got {o.kT}", "--kT")
+        check_kT(o.kT)
         if not (math.isfinite(o.fluct_stages) and (o.fluct_stages == 0 or o.fluct_stages >= 1)):
             raise MlcError(f"the fluctuation mode's stage factor must be 0 (auto) or >= 1, got {o.fluct_stages}",
                            "fluct_stages", "fewer stages than the stable minimum would be unstable")

@@ -53,7 +53,7 @@ import numpy as np
 
 from mlc.errors import MlcError
 from mlc.sim.drive import Drive
-from mlc.sim.integrator import SimOptions, Simulation
+from mlc.sim.integrator import SimOptions, Simulation, check_kT
 
 WINDOW = 0.05          # t0: shortest window
 MIN_WINDOWS = 3        # windows on the plateau, at least
@@ -340,8 +340,7 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
     from mlc.verify.circuit import select_rows
 
     states = select_rows(scene, rows)          # truth table, probes and the rows, checked
-    if not (math.isfinite(kT) and kT >= 0):
-        raise MlcError(f"kT must be finite and >= 0, got {kT}", "--kT")
+    check_kT(kT)
     seed_list = _seed_list(seeds)
     opt0 = SimOptions(scheme=scheme)
     tau_given = tau is not None
