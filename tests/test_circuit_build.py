@@ -219,3 +219,31 @@ def test_rip_up_reroutes_a_chain_and_the_one_it_presses_into(monkeypatch):
     moved = {t for pair in ripped.scene.meta["connector"]["rerouted"] for t in pair}
     keep = lambda sc: {b.name: tuple(b.position) for b in sc.bodies if not any(b.name.startswith(t + "_") for t in moved)}
     assert keep(plain.scene) == keep(ripped.scene)
+
+
+def test_build_time_estimate_follows_the_measured_adders():
+    """The refusal's estimate (mlc.circuit.build.build_cpu_estimate) against the committed
+    build CPU of the 1- to 3-bit adders: within a factor 3 of each (a power law of 3 points)."""
+    import json
+    from pathlib import Path
+
+    from mlc.circuit import build as cb
+    res = json.loads((Path(__file__).resolve().parents[1] / "benchmarks" / "results" /
+                      "circuit_scaling.json").read_text())
+    for a in res["adders"]:
+        ratio = cb.build_cpu_estimate(a["gates"]) / a["build_cpu_s"]
+        assert 1 / 3 < ratio < 3, (a["gates"], a["build_cpu_s"], ratio)
+    assert 40 <= cb.MAX_GATES <= 100          # about an hour of CPU
+
+
+def test_a_netlist_too_large_to_build_is_refused_with_the_estimate(monkeypatch, tmp_path, capsys):
+    """An 84-AND circuit (EPFL ctrl) routed for 45 min without a word; now refused before the work,
+    naming the estimate and --no-circuit, exit 2, nothing written."""
+    from mlc.circuit import build as cb
+    from mlc.cli import main
+    monkeypatch.setattr(cb, "MAX_GATES", 2)
+    out = tmp_path / "o"
+    assert main(["compile", "-e", "s = a ^ b ^ c; k = a & b | c", "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "gates; placing and routing it as one mechanism would take about" in err and "--no-circuit" in err, err
+    assert err.count("\n") == 1 and not out.exists()

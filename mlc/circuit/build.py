@@ -41,7 +41,19 @@ from mlc.gates.connector import (POST_WIDTH, Pair, Parts, branch_angles, chain_p
 from mlc.gates.parts import slab_body
 from mlc.scene.model import Body, Bond, Muscle, Probe, Scene
 
-MAX_GATES = 2000            # larger netlists are refused (the scene would not fit a verification)
+# Build CPU grows as gates^2.75 (bodies ~ gates^1.32, routing CPU ~ bodies^2.09; the 1- to 3-bit
+# adders in benchmarks/results/circuit_scaling.json: 0.9, 27.6, 103 s for 3, 10, 17 gates): larger
+# netlists are refused before the work, with the estimate (a 84-AND circuit routed for 45 min unasked).
+BUILD_CPU_REF = (17, 103.0)      # (gates, CPU s) of the 3-bit adder's build
+BUILD_CPU_EXPONENT = 2.75        # in gates
+MAX_BUILD_CPU = 3600.0           # s: about 60 gates
+MAX_GATES = int(BUILD_CPU_REF[0] * (MAX_BUILD_CPU / BUILD_CPU_REF[1]) ** (1 / BUILD_CPU_EXPONENT))
+
+
+def build_cpu_estimate(gates: int) -> float:
+    """CPU seconds to place and route a netlist of ``gates`` gates (an order of magnitude: the fit of
+    three adders, ``benchmarks/circuit_scaling.py --refit``)."""
+    return BUILD_CPU_REF[1] * (max(gates, 1) / BUILD_CPU_REF[0]) ** BUILD_CPU_EXPONENT
 MAX_INPUTS = 14             # the scene's truth table lists every row
 LEVEL_PITCH = 23.0          # sigma between logic levels (z), plus LAYER_PITCH per route arriving
 GATE_PITCH = 12.0           # sigma between gates of one level (x)
@@ -251,11 +263,15 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     opt = options or CircuitOptions()
     t_start = time.perf_counter()
     if len(netlist.gates) > MAX_GATES:
-        raise MlcError(f"netlist has {len(netlist.gates)} gates; the circuit back end builds at most {MAX_GATES}",
-                       netlist.source, "split the design, or compile without the circuit (netlist only)")
+        est = build_cpu_estimate(len(netlist.gates))
+        raise MlcError(f"netlist has {len(netlist.gates)} gates; placing and routing it as one mechanism would take "
+                       f"about {est / 3600:.2g} h of CPU (it grows as gates^{BUILD_CPU_EXPONENT:g}); the circuit back "
+                       f"end builds at most {MAX_GATES} gates", netlist.source,
+                       "compile with --no-circuit for the netlist alone, or split the design")
     if len(netlist.inputs) > MAX_INPUTS:
         raise MlcError(f"netlist has {len(netlist.inputs)} inputs; a circuit scene lists every row of its truth "
-                       f"table and holds at most {MAX_INPUTS}", netlist.source, "split the design")
+                       f"table and holds at most {MAX_INPUTS}", netlist.source,
+                       "compile with --no-circuit for the netlist alone, or split the design")
     signal = netlist.signal
     design = connector_geometry(signal, gap=opt.gap)
     k_muscle = design.k                            # muscles: the design stiffness

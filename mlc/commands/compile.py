@@ -49,10 +49,10 @@ def check_table_memory(spec) -> None:
 
 
 def register(sub):
-    p = sub.add_parser("compile", help="compile Boolean logic (.tt .pla .expr .blif .aag or -e) into mechanical gates",
+    p = sub.add_parser("compile", help="compile Boolean logic (.tt .pla .expr .blif .aag .aig or -e) into mechanical gates",
                        description="Synthesize a minimum-gate And-Inverter Graph, map it onto the library gates, "
-                                   "prove it equivalent to the input, and write OUTDIR/netlist.json, .blif, .aag and .dot.")
-    p.add_argument("input", nargs="?", metavar="INPUT", help="specification file (.tt .pla .expr .eqn .blif .aag)")
+                                   "prove it equivalent to the input, and write OUTDIR/netlist.json, .blif, .aag, .aig and .dot.")
+    p.add_argument("input", nargs="?", metavar="INPUT", help="specification file (.tt .pla .expr .eqn .blif .aag .aig)")
     p.add_argument("-e", "--expr", metavar="EXPR", help='expressions instead of a file, e.g. "s = a ^ b; c = a & b"')
     p.add_argument("-o", "--outdir", metavar="OUTDIR", default="out", help="output directory (default: out)")
     p.add_argument("-O", dest="level", metavar="LEVEL", type=int, default=2, choices=range(4),
