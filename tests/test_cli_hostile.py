@@ -743,6 +743,11 @@ def test_kernel_compile_notice_once(monkeypatch):
        ["--set a: ", "drive", "finite", "give times in t0"])
       for v in ("nan", "inf", "-inf", "step:nan", "step:1:nan:1", "step:1:0:inf", "square:inf", "square:1:nan",
                 "square:1:0.5:nan", "table:0=0,1=nan", "table:0=0,inf=1")],
+    # a drive value outside 0 (rest) .. 1 (actuated) ran: a=-1 pushed the muscle past its rest length, exit 0
+    *[(["simulate", "{scene}", "--time", "0.1", "--out", "{d}/t.gsd", "--set", f"a={v}"],
+       ["--set a: ", f"drive value {bad} is outside 0..1", "0 holds the input's muscles at rest, 1 actuated"])
+      for v, bad in (("-1", "-1"), ("1.5", "1.5"), ("step:1:0:2", "2"), ("step:1:-0.5:1", "-0.5"),
+                     ("square:1:0.5:0:-1:1", "-1"), ("square:1:0.5:0:0:3", "3"), ("table:0=0,1=1.01", "1.01"))],
     # kT 1e308 overflowed the noise: the error named --dt ("no time step helps"), after the compile's work
     *[(argv + ["--kT", "1e308"], ["--kT", "from 0 to 10"])
       for argv in (["simulate", "{scene}", "--time", "0.1", "--out", "{d}/t.gsd"],

@@ -22,7 +22,8 @@ def register(sub):
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--set", action="append", default=[], metavar="INPUT=VALUE",
                    help="drive an input: 0, 1, step:T[:BEFORE:AFTER], square:PERIOD[:DUTY[:START]], "
-                        "table:T0=V0,T1=V1,... (repeatable; unset inputs stay at 0)")
+                        "table:T0=V0,T1=V1,... (values from 0, muscles at rest, to 1, actuated; times in t0; "
+                        "repeatable; unset inputs stay at 0)")
     p.add_argument("--drift-tol", type=float, default=0.01, metavar="SIGMA",
                    help="stiff scheme: largest drift of a body per substep (sigma, default 0.01); "
                         "probe errors come out about a tenth of it")

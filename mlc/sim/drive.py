@@ -11,6 +11,9 @@ fractions interpolate the rest length linearly.  Times are in t0 = gamma/(1e-3 k
 
 Text form (``--set``/``--drive`` on the command line): ``0``, ``1``, ``0.3``,
 ``step:T[:BEFORE:AFTER]``, ``square:PERIOD[:DUTY[:START]]``, ``table:T0=V0,T1=V1,...``.
+Its values must lie in [0, 1] (:data:`LOW`, :data:`HIGH`): past them a muscle would be driven
+beyond its rest or actuated length, which no mechanism is designed for.  The constructors
+accept any finite value (tests push a gate past its actuated length on purpose).
 """
 from __future__ import annotations
 
@@ -21,6 +24,7 @@ import numpy as np
 from mlc.errors import MlcError
 
 KINDS = {"constant": 0, "step": 1, "square": 2, "table": 3}
+LOW, HIGH = 0.0, 1.0          # the values a drive given as text may take: muscles at rest .. actuated
 
 
 def _finite(kind: str, *nums: float) -> tuple:
@@ -72,31 +76,52 @@ class Drive:
 
     @staticmethod
     def parse(text: str, where: str = "--set") -> "Drive":
+        """The drive of a text form (module docstring); one :class:`MlcError` naming ``where`` if it
+        cannot be read or takes a value outside [0, 1]."""
         s = text.strip()
         try:
-            if ":" not in s:
-                return Drive.constant(float(s))
-            kind, rest = s.split(":", 1)
-            if kind == "step":
-                p = [float(x) for x in rest.split(":")]
-                if len(p) not in (1, 3):
-                    raise ValueError
-                return Drive.step(*p)
-            if kind == "square":
-                p = [float(x) for x in rest.split(":")]
-                if not 1 <= len(p) <= 5:
-                    raise ValueError
-                return Drive.square(*p)
-            if kind == "table":
-                pairs = [x.split("=") for x in rest.split(",") if x]
-                return Drive.table([float(a) for a, _ in pairs], [float(b) for _, b in pairs])
-            raise ValueError
+            d = Drive._parse(s)
         except MlcError as e:          # a constructor's complaint, about this option
             raise MlcError(e.message, where, e.fix) from None
         except (ValueError, TypeError):
             raise MlcError(f"cannot read drive {text!r}", where,
                            "use 0, 1, step:T[:BEFORE:AFTER], square:PERIOD[:DUTY[:START]] "
                            "or table:T0=V0,T1=V1,... (times in t0)") from None
+        out = [v for v in d.levels() if not LOW <= v <= HIGH]
+        if out:
+            raise MlcError(f"drive value {out[0]:g} is outside {LOW:g}..{HIGH:g}", where,
+                           "0 holds the input's muscles at rest, 1 actuated, a fraction in between")
+        return d
+
+    @staticmethod
+    def _parse(s: str) -> "Drive":
+        if ":" not in s:
+            return Drive.constant(float(s))
+        kind, rest = s.split(":", 1)
+        if kind == "step":
+            p = [float(x) for x in rest.split(":")]
+            if len(p) not in (1, 3):
+                raise ValueError
+            return Drive.step(*p)
+        if kind == "square":
+            p = [float(x) for x in rest.split(":")]
+            if not 1 <= len(p) <= 5:
+                raise ValueError
+            return Drive.square(*p)
+        if kind == "table":
+            pairs = [x.split("=") for x in rest.split(",") if x]
+            return Drive.table([float(a) for a, _ in pairs], [float(b) for _, b in pairs])
+        raise ValueError
+
+    def levels(self) -> tuple:
+        """Every value the drive takes at a switch or table point (times left out)."""
+        if self.kind == "constant":
+            return self.params[:1]
+        if self.kind == "step":
+            return self.params[1:3]
+        if self.kind == "square":
+            return self.params[3:5]
+        return self.values
 
     # -- evaluation (Python side, for tests and plots) ------------------------
     def value(self, t: float) -> float:
