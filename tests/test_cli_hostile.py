@@ -626,6 +626,20 @@ def test_simulate_outputs_checked_before_the_run(scene_text, tmp_path, capsys):
     assert_clean_failure(code, err, before, d, "--out", "is an input")
 
 
+def test_scene_input_without_a_muscle_is_refused_on_load(scene_text, tmp_path, capsys):
+    # both muscles follow input a: input b, declared, moved nothing when set (was accepted, exit 0)
+    assert scene_text.count("  input: b\n") == 1
+    src = tmp_path / "s.yaml"
+    src.write_text(scene_text.replace("  input: b\n", "  input: a\n"))
+    line = next(i for i, l in enumerate(src.read_text().splitlines(), 1) if l.startswith("inputs:"))
+    before = listing(tmp_path)
+    for argv in (["simulate", src, "--time", "0.1", "--set", "b=1", "--out", tmp_path / "t.gsd"],
+                 ["verify", src], ["draw", src, "-o", tmp_path / "s.png"]):
+        code, _, err = run(capsys, *argv)
+        assert_clean_failure(code, err, before, tmp_path, f"{src}:{line}:", "input 'b' drives no muscle",
+                             "add a muscle with 'input: b', or remove b from inputs")
+
+
 def test_simulate_writes_all_outputs(scene_text, tmp_path, capsys):
     src = tmp_path / "s.yaml"
     src.write_text(scene_text)

@@ -53,7 +53,7 @@ def test_minimal_scene_parses():
     assert [b.name for b in s.bodies] == ["p", "q"]
 
 
-@pytest.mark.parametrize("text, line, words", ids=range(9), argvalues=[
+@pytest.mark.parametrize("text, line, words", ids=range(11), argvalues=[
     (_minimal(bond_sites="[p.x, q.nope]"), 16, "no site 'nope'"),
     (_minimal(bond_sites="[p.x, z.y]"), 16, "no body named 'z'"),
     (_minimal(quat="[1, 1, 0, 0]"), 6, "not a unit quaternion"),
@@ -63,6 +63,9 @@ def test_minimal_scene_parses():
     (_minimal().replace("input: m,", "input: w,"), 18, "not in inputs"),
     (_minimal().replace("name: t\n", "name: t\nextra: 1\n"), 3, "unknown key 'extra'"),
     (_minimal().replace("bonds:\n", "bonds:\n  - [\n"), 17, "YAML syntax error"),
+    # an input no muscle follows was accepted: setting it moved nothing
+    (_minimal().replace("inputs: [m]", "inputs: [m, n]"), 3, "input 'n' drives no muscle"),
+    (_minimal().replace("inputs: [m]", "inputs:\n  - n\n  - m"), 4, "add a muscle with 'input: n'"),
 ])
 def test_malformed_scene_reports_file_line(text, line, words):
     assert text != _minimal()

@@ -62,7 +62,14 @@ def scene_from_data(data, filename: str = "<scene>") -> Scene:
         truth_table=dict(tt) if tt is not None else None, meta=_plain(data.get("meta") or {}),
         units={"sigma": 1.0, "k0": 1.0, "gamma": 1.0, **(data.get("units") or {})}, source=filename,
     )
-    return scene.check()
+    scene.check()
+    driven = {m.input for m in scene.muscles}
+    for i, name in enumerate(scene.inputs):      # setting such an input would move nothing
+        if name not in driven:
+            raise MlcError(f"input {name!r} drives no muscle: setting it would move nothing",
+                           loc(data["inputs"], i) or filename,
+                           f"add a muscle with 'input: {name}', or remove {name} from inputs")
+    return scene
 
 
 def _plain(v):
