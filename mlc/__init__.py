@@ -16,30 +16,71 @@ trust-region step) amplifies last-bit differences between kernels, so the same n
 routed with OpenBLAS's SkylakeX kernels built a different full adder (4012 bodies against
 3988 with Haswell's; docs/circuits.md, "Reproducibility").  With the pin, every such
 machine builds the same circuit, the one mlc's committed results were verified on.
+
+On CPUs with AVX-512 it also turns off numpy's AVX-512 code paths (``NPY_DISABLE_CPU_FEATURES``,
+unless already set): there numpy computes float64 sin, cos, arcsin, arctan2 and others with its
+own SIMD routines instead of the C library's, and their last bits differ.  The same router
+amplifies those too: the full adder built with these five functions one ulp off on some elements
+had 4012 bodies instead of 3948 (``benchmarks/build_ulp_sensitivity.py``).  Without AVX-512 numpy
+computes them with the C library, the same bits as :mod:`math`.
 """
 import os as _os
 import sys as _sys
 
 
-def _avx2_fma() -> bool:
-    """True on an x86-64 Linux CPU that lists the avx2 and fma flags (OpenBLAS's Haswell kernels run there)."""
+def _cpu_flags() -> set[str]:
+    """The CPU's feature flags from /proc/cpuinfo on x86-64 Linux (empty elsewhere)."""
     import platform
     if platform.machine().lower() not in ("x86_64", "amd64"):
-        return False
+        return set()
     try:
         with open("/proc/cpuinfo") as f:
             for line in f:
                 if line.startswith("flags"):
-                    flags = line.split(":", 1)[1].split()
-                    return "avx2" in flags and "fma" in flags
+                    return set(line.split(":", 1)[1].split())
     except OSError:
         pass
-    return False
+    return set()
+
+
+def _avx2_fma() -> bool:
+    """True on an x86-64 Linux CPU that lists the avx2 and fma flags (OpenBLAS's Haswell kernels run there)."""
+    flags = _cpu_flags()
+    return "avx2" in flags and "fma" in flags
+
+
+def _numpy_avx512_targets(version: str) -> str | None:
+    """The names of numpy ``version``'s AVX-512 dispatch targets, as NPY_DISABLE_CPU_FEATURES takes
+    them (a name numpy does not dispatch draws an ImportWarning), or None for a numpy mlc does not know."""
+    try:
+        major, minor = (int(x) for x in version.split(".")[:2])
+    except ValueError:
+        return None
+    if (major, minor) >= (2, 4):  # dispatch targets regrouped by x86-64 level
+        return "X86_V4 AVX512_ICL AVX512_SPR"
+    if (major, minor) < (1, 26):
+        return None
+    names = "AVX512F AVX512CD AVX512_KNL AVX512_KNM AVX512_SKX AVX512_CLX AVX512_CNL AVX512_ICL"
+    return names + " AVX512_SPR" if (major, minor) >= (2, 3) else names
+
+
+def _pin_numpy_dispatch() -> None:
+    """Set NPY_DISABLE_CPU_FEATURES to numpy's AVX-512 targets on a CPU with AVX-512 (see above)."""
+    if "NPY_DISABLE_CPU_FEATURES" in _os.environ or "avx512f" not in _cpu_flags():
+        return
+    from importlib import metadata
+    try:
+        names = _numpy_avx512_targets(metadata.version("numpy"))
+    except metadata.PackageNotFoundError:
+        return
+    if names:
+        _os.environ["NPY_DISABLE_CPU_FEATURES"] = names
 
 
 if "numpy" not in _sys.modules:
     _os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
     if "OPENBLAS_CORETYPE" not in _os.environ and _avx2_fma():
         _os.environ["OPENBLAS_CORETYPE"] = "Haswell"
+    _pin_numpy_dispatch()
 
 __version__ = "0.1.0"

@@ -1,6 +1,8 @@
 """mlc/__init__.py: importing mlc before numpy pins OpenBLAS's kernels (OPENBLAS_CORETYPE) so
 that a circuit routes to the same bodies on every x86-64 CPU with AVX2 (the router's SVDs
-amplify last-bit differences between kernels: docs/circuits.md, "Reproducibility")."""
+amplify last-bit differences between kernels: docs/circuits.md, "Reproducibility"), and on CPUs
+with AVX-512 turns off numpy's AVX-512 code paths (NPY_DISABLE_CPU_FEATURES), whose float64
+sin, cos, arcsin, arctan2 differ from the C library's in the last bits."""
 import os
 import subprocess
 import sys
@@ -42,3 +44,46 @@ def test_user_choice_kept():
 def test_no_pin_once_numpy_is_loaded():
     # too late to take effect: mlc leaves the environment as it is
     assert _run("import numpy, mlc, os; print(os.environ.get('OPENBLAS_CORETYPE'))") == "None"
+
+
+def test_avx512_names_are_numpy_s_own():
+    # the names mlc gives NPY_DISABLE_CPU_FEATURES for the installed numpy are all targets that
+    # numpy dispatches: a name it does not know would draw an ImportWarning (an error here)
+    from importlib import metadata
+    try:
+        from numpy._core._multiarray_umath import __cpu_dispatch__
+    except ImportError:  # numpy 1.x
+        from numpy.core._multiarray_umath import __cpu_dispatch__
+    names = mlc._numpy_avx512_targets(metadata.version("numpy"))
+    assert names and set(names.split()) <= set(__cpu_dispatch__)
+    assert all("512" in n or n == "X86_V4" for n in names.split())
+    env = {k: v for k, v in os.environ.items() if k != "NPY_DISABLE_CPU_FEATURES"}
+    env["NPY_DISABLE_CPU_FEATURES"] = names
+    r = subprocess.run([sys.executable, "-W", "error::ImportWarning", "-c", "import numpy"], env=env,
+                       capture_output=True, text=True)
+    assert r.returncode == 0, r.stderr
+
+
+def test_avx512_names_by_numpy_version():
+    assert mlc._numpy_avx512_targets("2.4.6") == "X86_V4 AVX512_ICL AVX512_SPR"
+    assert "AVX512_SPR" in mlc._numpy_avx512_targets("2.3.5").split()
+    assert "AVX512_SPR" not in mlc._numpy_avx512_targets("2.2.6").split()
+    assert "AVX512_SKX" in mlc._numpy_avx512_targets("1.26.4").split()
+    assert mlc._numpy_avx512_targets("1.25.0") is None and mlc._numpy_avx512_targets("dev") is None
+
+
+@pytest.mark.parametrize("flags,user,expect", [
+    ({"avx2", "fma", "avx512f"}, None, "names"),
+    ({"avx2", "fma"}, None, None),              # no AVX-512: numpy already calls the C library
+    ({"avx2", "fma", "avx512f"}, "AVX2", "AVX2"),  # a user's own setting is kept
+])
+def test_numpy_dispatch_pin(monkeypatch, flags, user, expect):
+    from importlib import metadata
+    monkeypatch.setattr(mlc, "_cpu_flags", lambda: flags)
+    if user is None:
+        monkeypatch.delenv("NPY_DISABLE_CPU_FEATURES", raising=False)
+    else:
+        monkeypatch.setenv("NPY_DISABLE_CPU_FEATURES", user)
+    mlc._pin_numpy_dispatch()
+    want = mlc._numpy_avx512_targets(metadata.version("numpy")) if expect == "names" else expect
+    assert os.environ.get("NPY_DISABLE_CPU_FEATURES") == want
