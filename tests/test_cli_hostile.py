@@ -1160,6 +1160,28 @@ def test_draw_shows_progress(tmp_path, capsys, monkeypatch):
     assert "mlc draw: solving and drawing NAND_expand [" in err and "4/5" in err and err.endswith("5/5  ETA     0 s  \n")
 
 
+def test_compile_synthesis_display_names_its_steps(tmp_path, capsys, monkeypatch):
+    """The synthesis display was a bare timer (a 24-input table of 200 rows: 22 s of 'synthesizing
+    and proving t24.tt  19 s', 20 s of them decomposing); it names the step it is in, 3 in all, and
+    the improving step's share of its work budget."""
+    from mlc.io import progress
+    moves = []
+
+    class Recorded(progress.Progress):
+        def _move(self, name, fraction=None):
+            super()._move(name, fraction)
+            moves.append((self.label, self.line(), fraction))
+
+    monkeypatch.setattr(progress, "Progress", Recorded)
+    code, out, err = run(capsys, "compile", "-e", "inputs a, b, c; f = a ^ (b & c); g = a | c", "-o", tmp_path / "o",
+                         "--no-circuit")
+    assert code == 0, err
+    shown = [(line, f) for label, line, f in moves if label.startswith("synthesizing and proving")]
+    assert [line.split(": step ")[1].split(" ")[0] for line, _ in shown] == ["1/3,", "2/3,", "3/3,"], shown
+    f = shown[1][1]                                  # improving: the work clock against its budget
+    assert "improving" in shown[1][0] and 0 < f() < 1.5, shown
+
+
 def test_compile_checks_the_mesh_profile_before_the_work(tmp_path, capsys, monkeypatch):
     """compile --stl with a bad --profile failed only after synthesis and place and route."""
     from mlc.commands import compile as cc
@@ -1212,7 +1234,12 @@ def test_robot_fold_interrupted_and_shapes_progress(tmp_path, tiny_robot_yaml, c
 
 def test_draw_refuses_more_panels_than_a_picture_shows(scene_text, tmp_path, capsys):
     """A NAND scene declaring 8 inputs (6 without a muscle) drew 256 panels in 3 min, silently."""
-    lines = scene_text.replace("inputs: [a, b]", "inputs: [a, b, c, d, e, f, g]", 1).splitlines(keepends=True)
+    extra = "".join(f"- name: muscle_{x}\n  input: {x}\n  sites: [a_hi.in, a_lo.in]\n  rest: 1.0\n  actuated: 1.5\n"
+                    for x in "cdefg")                 # an input no muscle follows is refused on load
+    assert scene_text.count("\nprobes:\n") == 1
+    text = scene_text.replace("inputs: [a, b]", "inputs: [a, b, c, d, e, f, g]", 1).replace("\nprobes:\n",
+                                                                                           "\n" + extra + "probes:\n")
+    lines = text.splitlines(keepends=True)
     i = lines.index("truth_table:\n")
     j = next(k for k in range(i + 1, len(lines)) if not lines[k].startswith(" "))
     src = tmp_path / "wide.yaml"

@@ -153,7 +153,6 @@ def test_scene_without_bonds():
 def test_malformed_scenes_rejected_with_file_line(edit, words):
     text = """mlc_scene: 1
 name: t
-inputs: [m]
 bodies:
   - name: p
     position: [0, 0, 0]

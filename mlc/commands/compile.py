@@ -246,7 +246,8 @@ def run(args) -> int:
 
     spec = load(args.input, args.expr, strict=args.strict)
     check_table_memory(spec)
-    with Progress(f"synthesizing and proving {spec.source}"):      # a timer: 24-input tables take ~1 min
+    from mlc.logic.synth import STEPS
+    with Progress(f"synthesizing and proving {spec.source}", steps=STEPS):   # 24-input tables take ~1 min
         c = compile_spec(spec, args.level, args.signal)
     files = render(c, draw=bool(args.draw))
     report = None

@@ -1823,7 +1823,9 @@ def optimize(spec, effort: int, time_budget: float | None = None) -> AIG:
 
 
 def _optimize_spec(spec, effort: int, time_budget: float | None = None) -> AIG:
+    from mlc.io.progress import stage
     from mlc.logic import canon
+    stage("decomposing")
     n = len(spec.inputs)
     if isinstance(spec, TableSpec) and 0 < n <= canon.MAX_INPUTS:
         c = canon.canonical(spec)
@@ -1859,6 +1861,8 @@ def _optimize(spec, effort: int, time_budget: float | None = None,
         # budget leaves few passes; add 3 s per 1000 ANDs (at most 16 s; measured on
         # EPFL: sin 5275 -> 5149, i2c 1133 -> 1093 ANDs for 25 s in all)
         time_budget += min(16.0, 3.0 * min(c.num_ands() for c in cands) / 1000.0)
+    from mlc.io.progress import stage
+    stage("improving", lambda: (work._ticks * 1e-6 - t0) / time_budget)    # the work clock against the budget
     care = _care(spec)
     results = []
     cands.sort(key=cost)

@@ -11,6 +11,7 @@ from mlc.logic import equiv
 from mlc.logic.aig import AIG
 
 MAX_EFFORT = 3
+STEPS = ("decomposing", "improving", "proving")     # the steps a progress display names (mlc.io.progress.stage)
 
 
 def synthesize(spec, effort: int = 2, stats: dict | None = None,
@@ -27,6 +28,8 @@ def synthesize(spec, effort: int = 2, stats: dict | None = None,
     from mlc.logic import opt
     g = opt.optimize(spec, effort, time_budget)
     t1 = time.perf_counter()
+    from mlc.io.progress import stage
+    stage("proving")
     report = equiv.check_equivalent(g, spec)
     t2 = time.perf_counter()
     if stats is not None:
