@@ -23,6 +23,10 @@ own SIMD routines instead of the C library's, and their last bits differ.  The s
 amplifies those too: the full adder built with these five functions one ulp off on some elements
 had 4012 bodies instead of 3948 (``benchmarks/build_ulp_sensitivity.py``).  Without AVX-512 numpy
 computes them with the C library, the same bits as :mod:`math`.
+
+When neither mlc's folder nor the user's cache directory is writable (a read-only install run
+by a user without a writable home), it points Numba's kernel cache at a private temporary
+directory (:mod:`mlc.io.numba_cache`), which Numba would otherwise refuse with "cannot cache".
 """
 import os as _os
 import sys as _sys
@@ -84,3 +88,7 @@ if "numpy" not in _sys.modules:
     _pin_numpy_dispatch()
 
 __version__ = "0.1.0"
+
+from mlc.io.numba_cache import ensure as _ensure_numba_cache  # noqa: E402  (before Numba is loaded)
+
+_ensure_numba_cache()
