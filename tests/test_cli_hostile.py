@@ -1285,3 +1285,14 @@ def test_ctrl_c_inside_a_compiler_callback_is_an_interruption(monkeypatch, capsy
     monkeypatch.setattr(version, "run", other)
     code, _, err = run(capsys, "info")
     assert code == 3 and "internal error: RuntimeError: an mlc bug" in err and seen == [ValueError]
+
+
+def test_every_command_is_in_the_readme_table():
+    """What a newcomer sees: `mlc info` was missing from the README's command table."""
+    import argparse
+    from mlc.cli import build_parser
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    table = [line for line in (ROOT / "README.md").read_text().splitlines() if line.startswith("| `mlc ")]
+    listed = {line.split("`mlc ", 1)[1].split()[0].rstrip("`") for line in table}
+    assert set(sub.choices) - listed == set(), "add these commands to the README's command table"
+    assert "info" in sub.choices and len(sub.choices) >= 10
