@@ -1230,6 +1230,11 @@ def test_robot_fold_interrupted_and_shapes_progress(tmp_path, tiny_robot_yaml, c
     code, out, err = run(capsys, "robot", "shapes", robot, "-o", tmp_path / "s.png")
     assert code == 0 and "mlc robot shapes: the equilibrium of each row of" in err and "2/2" in err, err
     assert (tmp_path / "s.png").read_bytes()[:4] == b"\x89PNG"
+    # fold: drawing the frames was a bare timer; a bar counts them (the count is known before)
+    code, out, err = run(capsys, "robot", "fold", robot, "--row", "1", "--time", "0.5", "--frames", "3",
+                         "--png-dir", tmp_path / "frames")
+    assert code == 0 and "mlc robot fold: drawing the frames [" in err and "3/3  ETA" in err, err
+    assert sorted(p.name for p in (tmp_path / "frames").iterdir()) == [f"frame_{k:03d}.png" for k in range(3)]
 
 
 def test_draw_refuses_more_panels_than_a_picture_shows(scene_text, tmp_path, capsys):

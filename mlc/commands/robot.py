@@ -133,9 +133,9 @@ def run_fold(args) -> int:
     with outs:
         if gif is not None or pdir is not None:
             from mlc.io.progress import Progress
-            with Progress(f"mlc robot fold: drawing {len(res.frame_times)} frames"):
+            with Progress("mlc robot fold: drawing the frames", total=len(res.frame_times)) as bar:
                 pngs = render_frames(scene, res.frame_pos, res.frame_quat, res.frame_times, title,
-                                     shape["cells_expected"])
+                                     shape["cells_expected"], progress=bar.update)
             if gif is not None:
                 gif.write_bytes(gif_bytes(pngs))
             if pdir is not None:

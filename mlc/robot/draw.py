@@ -103,8 +103,8 @@ def render_shapes(scene, poses: dict, rows_info: dict, title: str | None = None)
     return buf.getvalue()
 
 
-def render_frames(scene, frames_pos, frames_quat, times, title: str, cells=None) -> list[bytes]:
-    """PNG bytes of each frame of a fold (the skeleton only)."""
+def render_frames(scene, frames_pos, frames_quat, times, title: str, cells=None, progress=None) -> list[bytes]:
+    """PNG bytes of each frame of a fold (the skeleton only); ``progress(k)`` after the k-th frame."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -118,6 +118,8 @@ def render_frames(scene, frames_pos, frames_quat, times, title: str, cells=None)
         fig.savefig(buf, format="png", dpi=80)
         plt.close(fig)
         out.append(buf.getvalue())
+        if progress is not None:
+            progress(len(out))
     return out
 
 
