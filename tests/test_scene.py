@@ -53,7 +53,7 @@ def test_minimal_scene_parses():
     assert [b.name for b in s.bodies] == ["p", "q"]
 
 
-@pytest.mark.parametrize("text, line, words", ids=range(11), argvalues=[
+@pytest.mark.parametrize("text, line, words", ids=range(13), argvalues=[
     (_minimal(bond_sites="[p.x, q.nope]"), 16, "no site 'nope'"),
     (_minimal(bond_sites="[p.x, z.y]"), 16, "no body named 'z'"),
     (_minimal(quat="[1, 1, 0, 0]"), 6, "not a unit quaternion"),
@@ -66,6 +66,11 @@ def test_minimal_scene_parses():
     # an input no muscle follows was accepted: setting it moved nothing
     (_minimal().replace("inputs: [m]", "inputs: [m, n]"), 3, "input 'n' drives no muscle"),
     (_minimal().replace("inputs: [m]", "inputs:\n  - n\n  - m"), 4, "add a muscle with 'input: n'"),
+    # truth-table rows were refused at the file alone, without a line
+    (_minimal().replace("outputs: [o]\n", "outputs: [o]\ntruth_table:\n  '0': '1'\n  '01': '0'\n"), 7,
+     "truth table row '01' is not 1 input bits"),
+    (_minimal().replace("outputs: [o]\n", "outputs: [o]\ntruth_table:\n  '0': '1'\n  '1': '00'\n"), 7,
+     "truth table value '00' for 1 is not 1 output bits"),
 ])
 def test_malformed_scene_reports_file_line(text, line, words):
     assert text != _minimal()

@@ -13,7 +13,7 @@ from mlc.errors import MlcError
 from mlc.io import yamlsrc
 from mlc.io.atomic import write_text
 from mlc.io.schema import load_schema, validate
-from mlc.scene.model import Body, Bond, Box, Muscle, Probe, Scene
+from mlc.scene.model import Body, Bond, Box, Muscle, Probe, Scene, check_row
 
 FORMAT_VERSION = 1
 _IDQ = [1.0, 0.0, 0.0, 0.0]
@@ -56,6 +56,9 @@ def scene_from_data(data, filename: str = "<scene>") -> Scene:
                     float(x["actuated"]), loc(data["probes"], i))
               for i, x in enumerate(data.get("probes") or [])]
     tt = data.get("truth_table")
+    for key, val in (tt or {}).items():       # each row at its line (Scene.check has no lines for them)
+        check_row(str(key), str(val), len(data.get("inputs") or []), len(data.get("outputs") or []),
+                  loc(tt, key) or filename)
     scene = Scene(
         name=data["name"], bodies=bodies, bonds=bonds, muscles=muscles, probes=probes,
         inputs=list(data.get("inputs") or []), outputs=list(data.get("outputs") or []),

@@ -255,10 +255,7 @@ class Scene:
                         raise MlcError(f"probe {it.name}: rest and actuated lengths are equal", loc)
         if self.truth_table is not None:
             for key, val in self.truth_table.items():
-                if len(key) != len(self.inputs) or set(key) - {"0", "1"}:
-                    raise MlcError(f"truth table row {key!r} is not {len(self.inputs)} input bits", where)
-                if len(val) != len(self.outputs) or set(val) - {"0", "1", "-"}:
-                    raise MlcError(f"truth table value {val!r} for {key} is not {len(self.outputs)} output bits", where)
+                check_row(key, val, len(self.inputs), len(self.outputs), where)
         return self
 
     def _resolve(self, ref: str, loc) -> str:
@@ -313,6 +310,15 @@ class Scene:
         out.bodies = [Body(b.name, np.array(p, float), np.array(q, float), b.boxes, b.sites, b.loc)
                       for b, p, q in zip(self.bodies, pos, quat)]
         return out
+
+
+def check_row(key: str, val: str, n_inputs: int, n_outputs: int, where) -> None:
+    """One truth-table row: ``key`` of ``n_inputs`` input bits, ``val`` of ``n_outputs`` output bits
+    ("-" = don't care); an :class:`MlcError` at ``where`` otherwise."""
+    if len(key) != n_inputs or set(key) - {"0", "1"}:
+        raise MlcError(f"truth table row {key!r} is not {n_inputs} input bits", where)
+    if len(val) != n_outputs or set(val) - {"0", "1", "-"}:
+        raise MlcError(f"truth table value {val!r} for {key} is not {n_outputs} output bits", where)
 
 
 def _finite(v, n, what, loc):
