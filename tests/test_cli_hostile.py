@@ -1078,6 +1078,27 @@ def test_table_memory_estimate_covers_the_measured_peaks():
     for (n, m), peak in cc.TABLE_MEASURED_PEAKS.items():
         spec = TableSpec([f"x{i}" for i in range(n)], [f"f{j}" for j in range(m)], [0] * m, [0] * m)
         assert peak <= cc.table_memory(spec) <= 1.5 * peak, (n, m)
+    # -O3 peaks higher: at 24 inputs it passed 23.9 GB and was killed (an estimate of 6.9 GB let it start)
+    for (n, m), peak in cc.TABLE_MEASURED_PEAKS_O3.items():
+        spec = TableSpec([f"x{i}" for i in range(n)], [f"f{j}" for j in range(m)], [0] * m, [0] * m)
+        assert peak <= cc.table_memory(spec, 3) <= 6 * peak, (n, m)
+
+
+def test_compile_O3_refuses_a_table_that_O2_takes(tmp_path, capsys, monkeypatch):
+    """The 24-input 200-row table of 2 outputs: -O2 peaks under 6 GB, -O3 passed 23.9 GB and was
+    killed after 7.7 min; with a 12 GiB budget (half this machine's memory) -O3 is refused at once."""
+    from mlc.mesh import profiles
+    rng = random.Random(24)
+    n = 24
+    rows = sorted({"".join(rng.choice("01") for _ in range(n)) for _ in range(20)})
+    src = tmp_path / "t24.tt"
+    src.write_text(f".inputs {' '.join(f'x{i}' for i in range(n))}\n.outputs f g\n"
+                   + "".join(f"{r} | {rng.choice('01')}{rng.choice('01')}\n" for r in rows))
+    monkeypatch.setattr(profiles, "memory_budget", lambda: 12.0 * 2 ** 30)
+    before = listing(tmp_path)
+    code, stdout, err = run(capsys, "compile", src, "-o", tmp_path / "o", "--no-circuit", "-O3")
+    assert_clean_failure(code, err, before, tmp_path, f"{src}: ", "24-input truth table at -O3", "GiB of memory",
+                         "use -O2, which needs less")
 
 
 def _wires_through_boxes(dot_text: str) -> list:

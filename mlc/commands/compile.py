@@ -26,25 +26,33 @@ TABLE_BASE = 0.2e9
 TABLE_PER_MINTERM = 300
 TABLE_PER_OUTPUT = 50
 TABLE_MEASURED_PEAKS = {(18, 2): 0.260e9, (20, 2): 0.448e9, (22, 2): 1.611e9, (22, 6): 2.373e9, (24, 2): 5.815e9}
+# -O3 peaks higher (mlc compile -O3, max RSS, same tables): (16, 2) 1.0 GB, (18, 2) 0.44, (20, 2) 1.33,
+# (22, 2) 4.51 GB in 96 s; (24, 2) passed 23.9 GB and was killed by the kernel after 7.7 min
+TABLE_O3_FACTOR = 5.0
+TABLE_MEASURED_PEAKS_O3 = {(16, 2): 1.0e9, (18, 2): 0.44e9, (20, 2): 1.33e9, (22, 2): 4.51e9, (24, 2): 23.9e9}
 
 
-def table_memory(spec) -> float:
-    """Estimated peak bytes of compiling ``spec`` if it is a truth table (0 for a network)."""
+def table_memory(spec, level: int = 2) -> float:
+    """Estimated peak bytes of compiling ``spec`` at -O``level`` if it is a truth table (0 for a network)."""
     from mlc.spec import TableSpec
     if not isinstance(spec, TableSpec):
         return 0.0
-    return TABLE_BASE + 2.0 ** spec.n * (TABLE_PER_MINTERM + TABLE_PER_OUTPUT * len(spec.outputs))
+    need = TABLE_BASE + 2.0 ** spec.n * (TABLE_PER_MINTERM + TABLE_PER_OUTPUT * len(spec.outputs))
+    return need * TABLE_O3_FACTOR if level >= 3 else need
 
 
-def check_table_memory(spec) -> None:
+def check_table_memory(spec, level: int = 2) -> None:
     """Refuse a truth table whose synthesis would need more than the memory budget (half the
     memory available, at least 2 GiB: :func:`mlc.mesh.profiles.memory_budget`)."""
     from mlc.mesh.profiles import memory_budget
-    need, budget = table_memory(spec), memory_budget()
+    need, budget = table_memory(spec, level), memory_budget()
     if need > budget:
-        raise MlcError(f"synthesizing this {spec.n}-input truth table would need about {need / 2 ** 30:.3g} GiB "
-                       f"of memory ({len(spec.outputs)} outputs over 2^{spec.n} input combinations); the limit is "
-                       f"{budget / 2 ** 30:.3g} GiB (half the memory available, at least 2 GiB)", spec.source,
+        lower = level >= 3 and table_memory(spec, 2) <= budget
+        raise MlcError(f"synthesizing this {spec.n}-input truth table at -O{level} would need about "
+                       f"{need / 2 ** 30:.3g} GiB of memory ({len(spec.outputs)} outputs over 2^{spec.n} input "
+                       f"combinations); the limit is {budget / 2 ** 30:.3g} GiB (half the memory available, "
+                       f"at least 2 GiB)", spec.source,
+                       "use -O2, which needs less" if lower else
                        "describe the function with fewer inputs, or as BLIF, AIGER or expressions (not tabulated)")
 
 
@@ -245,7 +253,7 @@ def run(args) -> int:
     outs.check()                                    # every output location, before the work
 
     spec = load(args.input, args.expr, strict=args.strict)
-    check_table_memory(spec)
+    check_table_memory(spec, args.level)
     from mlc.logic.synth import STEPS
     with Progress(f"synthesizing and proving {spec.source}", steps=STEPS):   # 24-input tables take ~1 min
         c = compile_spec(spec, args.level, args.signal)
