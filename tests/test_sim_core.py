@@ -177,6 +177,27 @@ def test_same_seed_same_trajectory_and_chunking_invariance():
     assert np.array_equal(s3.pos, s4.pos) and np.array_equal(s3.quat, s4.quat)
 
 
+def test_record_times_do_not_depend_on_chunking(monkeypatch):
+    # run() sizes its compiled chunks by wall time; the record times must be the exact
+    # multiples of the step, whatever the chunks (they used to be a per-chunk running sum,
+    # which differed in the last bits between a busy and an idle machine)
+    sc = chain_scene(4)
+
+    def times(fake_clock):
+        if fake_clock:  # every chunk seems to take 1 s: chunks shrink to a step or two
+            ticks = iter(range(10**6))
+            monkeypatch.setattr("mlc.sim.integrator._time.perf_counter", lambda: float(next(ticks)))
+        sim = Simulation(sc, None, SimOptions(kT=1e-4, seed=3, scheme="euler", dt=3e-5))
+        res = sim.run(0.0123, record_interval=3e-4, quiet=True)
+        monkeypatch.undo()
+        return res.times, res.pos
+
+    (ta, pa), (tb, pb) = times(False), times(True)
+    assert np.array_equal(pa, pb)
+    assert len(ta) == len(tb) and np.array_equal(ta, tb)
+    assert np.max(np.abs(ta - np.arange(len(ta)) * 3e-4)) < 1e-15 and ta[-1] == 0.0123
+
+
 def test_orientations_stay_unit():
     res = simulate(tongs_scene(4), 0.5, {"a": 1}, SimOptions(kT=1e-5, dt=0.01, seed=2))
     assert np.allclose(np.linalg.norm(res.quat, axis=1), 1.0, atol=1e-12)

@@ -346,10 +346,13 @@ class Simulation:
         return lev
 
     def advance(self, nsteps: int, rec_every: int = 0, frame_every: int = 0, rec_phase: int = 0,
-                frame_phase: int = 0, dt: float | None = None):
+                frame_phase: int = 0, dt: float | None = None, origin: tuple | None = None):
         """Run ``nsteps`` steps of ``dt`` t0 (default the simulation's) in one compiled call,
         recording probes at steps whose global index (``rec_phase`` + local) is a multiple of
         ``rec_every`` and frames likewise; returns (records, frames_pos, frames_quat, done).
+        Step n of the call is at time t_o + (k_o + n) dt, with ``origin`` = (t_o internal
+        time, k_o steps) (default: the simulation's time, 0), so that a run cut into calls
+        has the same step times, bit for bit, however it is cut.
         A neighbour-list overflow grows the list and redoes the call from its start."""
         o = self.opt
         P = len(self.scene.probes)
@@ -367,7 +370,8 @@ class Simulation:
         while True:
             self.status[:] = 0
             self._grow_nlist()
-            common = (self.pos, self.quat, float(self.t), int(self.step), int(nsteps), float(dt), float(o.kT),
+            t_o, k_o = origin if origin is not None else (self.t, 0)
+            common = (self.pos, self.quat, float(t_o), int(k_o), int(self.step), int(nsteps), float(dt), float(o.kT),
                       float(self.gamma), float(self.gamma_r), bool(o.rot_noise),
                       np.uint64(int(o.seed) & 0xFFFFFFFFFFFFFFFF),
                       self.site_body, self.site_local, self.bsite0, self.sp_i, self.sp_j, self.sp_k, self.sp_rest0,
@@ -406,7 +410,8 @@ class Simulation:
             self.pos[:], self.quat[:], self.stages_out[:], self.pv[:] = saved
             rec[:] = 0.0
         self.step += done
-        self.t += done * dt
+        t_o, k_o = origin if origin is not None else (self.t, 0)
+        self.t = t_o + (k_o + done) * dt
         if self.status[0] != K.OK:
             self._fail(dt / self.t_unit)
         nr, nf = _count(done, rec_every, rph), _count(done, frame_every, fph)
@@ -664,7 +669,8 @@ class Simulation:
             while done_total < nsteps and not stop.hit:
                 n = min(chunk, nsteps - done_total)
                 c0 = _time.perf_counter()
-                rec, fp, fq, done = self.advance(n, rec_every, frame_every, done_total, done_total, dt)
+                rec, fp, fq, done = self.advance(n, rec_every, frame_every, done_total, done_total, dt,
+                                                 origin=(t_start, done_total))
                 el = _time.perf_counter() - c0
                 recs.append(rec)
                 if len(fp):

@@ -521,7 +521,7 @@ def _failed(mon, wca_min, status, step):
     return False
 
 
-def _euler_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_noise, seed,
+def _euler_py(pos, quat, t_start, t_k0, step0, nsteps, dt, kT, gamma, gamma_r, rot_noise, seed,
               site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_rest0, sp_rest1, sp_tol, sp_inp, sp_bound,
               end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v, wca_eps, wca_s, wca_rc, wca_min,
               ex0, ex_list, head, nxt, cell, nl0, nl, pos_nl, nlstate, max_disp, max_rot,
@@ -539,7 +539,7 @@ def _euler_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_noi
     nrec = 0
     nfr = 0
     for n in range(nsteps):
-        t = t_start + n * dt
+        t = t_start + (t_k0 + n) * dt
         step = step0 + n
         _eval(pos, quat, t, site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_rest0, sp_rest1, sp_tol,
               sp_inp, sp_bound, end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v,
@@ -755,7 +755,7 @@ def _sk_step_py(pos, quat, t, h, gamma, gamma_r, noisy, s, eta,
     _stage_f(K1, qn, pos, quat)
 
 
-def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_noise, seed,
+def _skrock_py(pos, quat, t_start, t_k0, step0, nsteps, dt, kT, gamma, gamma_r, rot_noise, seed,
                site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_rest0, sp_rest1, sp_tol, sp_inp, sp_bound,
                end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v, wca_eps, wca_s, wca_rc, wca_min,
                ex0, ex_list, head, nxt, cell, nl0, nl, pos_nl, nlstate, max_disp, max_rot,
@@ -811,7 +811,7 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
     if h_last > 0.0:
         lev = int(round(math.log2(dt / h_last)))
         lev = min(max(lev, lev_min), LMAX)
-    _eval(pos, quat, t_start, site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_rest0, sp_rest1, sp_tol,
+    _eval(pos, quat, t_start + t_k0 * dt, site_body, site_local, bsite0, sp_i, sp_j, sp_k, sp_rest0, sp_rest1, sp_tol,
           sp_inp, sp_bound, end0, end_sp, end_sign, dkind, dpar, tab_t, tab_v,
           wca_eps, wca_s, wca_rc, ex0, ex_list, head, nxt, cell, nl0, nl, pos_nl, nlstate,
           uval, ws, arm, fsp, ratio, dmin, dpart, F, T, mon)
@@ -821,7 +821,7 @@ def _skrock_py(pos, quat, t_start, step0, nsteps, dt, kT, gamma, gamma_r, rot_no
         status[1] = step0
         return 0
     for n in range(nsteps):
-        t = t_start + n * dt
+        t = t_start + (t_k0 + n) * dt
         step = step0 + n
         # F, T, ws, arm, mon hold the state at (pos, quat, t)
         if fixed_s <= 0 and (step % rho_every == 0 or rho_b == 0.0):
