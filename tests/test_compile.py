@@ -220,8 +220,8 @@ def test_compile_force_reaches_mlc_stl(monkeypatch, tmp_path):
     assert "--force" in seen[0] and "--force" not in seen[1]
 
 
-@pytest.mark.parametrize("k,words", [("0", "must be > 0"), ("nan", "must be > 0"), ("1e5", "at most 10000"),
-                                     ("-3", "must be > 0")])
+@pytest.mark.parametrize("k,words", [("0", "from 0.1 to 10000"), ("nan", "from 0.1"), ("1e5", "to 10000"),
+                                     ("-3", "from 0.1"), ("1e-320", "from 0.1"), ("0.09", "got 0.09")])
 def test_joint_k_is_checked_before_any_work(k, words, tmp_path, capsys):
     rc = main(["compile", "-e", "y = a & b", "-o", str(tmp_path / "out"), "--joint-k", k])
     err = capsys.readouterr().err
