@@ -1275,6 +1275,33 @@ def test_draw_refuses_more_panels_than_a_picture_shows(scene_text, tmp_path, cap
     assert_clean_failure(code, err, before, tmp_path, f"{src}: 7 inputs make 128 input states", "at most 64")
 
 
+def test_ctrl_c_swallowed_by_a_callback_still_stops_the_command(monkeypatch, capsys):
+    """A Ctrl-C that lands in a callback which swallows it (Python reports it to
+    sys.unraisablehook and the C code goes on) while the compile then succeeds: the command must
+    still stop, not run to its end (a simulate interrupted 1 s after its start ran on for 10
+    minutes)."""
+    import time
+    import types
+    import mlc.commands.version as version
+    finished = []
+
+    def swallowed_then_work(args):
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as ki:
+            sys.unraisablehook(types.SimpleNamespace(exc_type=KeyboardInterrupt, exc_value=ki,
+                                                     exc_traceback=ki.__traceback__, err_msg=None, object=None))
+        t = time.perf_counter()
+        while time.perf_counter() - t < 2.0:     # the rest of the command, in Python
+            pass
+        finished.append(True)
+        return 0
+
+    monkeypatch.setattr(version, "run", swallowed_then_work)
+    code, _, err = run(capsys, "info")
+    assert code == 130 and err == "mlc: interrupted\n" and not finished, (code, err)
+
+
 def test_ctrl_c_inside_a_compiler_callback_is_an_interruption(monkeypatch, capsys):
     """Ctrl-C while Numba compiles lands in an LLVM callback: Python printed it as an ignored
     traceback, then Numba failed with "RuntimeError: no compiled object yet", reported as an mlc
