@@ -1166,6 +1166,23 @@ def test_compile_draw_says_when_a_circuit_is_too_large(tmp_path, capsys, monkeyp
     assert png.read_bytes()[:4] == b"\x89PNG"
 
 
+def test_compile_draw_of_a_large_circuit_shows_a_timer(tmp_path, capsys, monkeypatch):
+    """A schematic past the legible size is drawn by mlc itself (20 s for 3000 gates): a timer
+    with its estimate runs meanwhile (shown here as on a terminal)."""
+    from mlc.commands import compile as cc
+    from mlc.io import progress
+
+    class Shown(progress.Progress):
+        def __init__(self, label, total=None, expect=None, show=None, delay=2.0, stream=None, steps=None):
+            super().__init__(label, total, expect, True, 0.0, stream, steps)
+
+    monkeypatch.setattr(cc, "DRAW_LEGIBLE_GATES", 2)
+    monkeypatch.setattr(progress, "Progress", Shown)
+    code, _, err = run(capsys, "compile", ROOT / "examples" / "tetris.tt", "-o", tmp_path / "o", "--no-circuit",
+                       "--draw", tmp_path / "c.png")
+    assert code == 0 and "drawing 3 gates" in err, err
+
+
 def test_draw_shows_progress(tmp_path, capsys, monkeypatch):
     """mlc draw of a compiled circuit solves each input state for minutes (1328 bodies: ~3 min):
     a bar counts the states, then the picture (shown here as on a terminal)."""
