@@ -1048,17 +1048,22 @@ def test_stl_refuses_a_mechanism_too_large_to_mesh(tmp_path, capsys, monkeypatch
                          "mlc stl NAND")
 
 
+def _wide_table(path, n: int, rows: int, seed: int):
+    """A .tt file of ``n`` inputs x0.. and outputs f, g on up to ``rows`` random rows (seeded)."""
+    rng = random.Random(seed)
+    rs = sorted({"".join(rng.choice("01") for _ in range(n)) for _ in range(rows)})
+    path.write_text(f".inputs {' '.join(f'x{i}' for i in range(n))}\n.outputs f g\n"
+                    + "".join(f"{r} | {rng.choice('01')}{rng.choice('01')}\n" for r in rs))
+    return path
+
+
 def test_compile_refuses_a_table_too_large_for_memory(tmp_path, capsys, monkeypatch):
     """A 24-input truth table (the format's maximum) peaked at 5.8 GB in synthesis, silently:
     the estimate is checked before any work, against the budget (lowered here to 1 GiB)."""
     from mlc.commands import compile as cc
     from mlc.mesh import profiles
-    rng = random.Random(14)
     n = 22
-    rows = sorted({"".join(rng.choice("01") for _ in range(n)) for _ in range(50)})
-    src = tmp_path / "wide.tt"
-    src.write_text(f".inputs {' '.join(f'x{i}' for i in range(n))}\n.outputs f g\n"
-                   + "".join(f"{r} | {rng.choice('01')}{rng.choice('01')}\n" for r in rows))
+    src = _wide_table(tmp_path / "wide.tt", n, 50, seed=14)
     monkeypatch.setattr(profiles, "memory_budget", lambda: 2.0 ** 30)
     before = listing(tmp_path)
     code, stdout, err = run(capsys, "compile", src, "-o", tmp_path / "o", "--no-circuit")
@@ -1088,12 +1093,8 @@ def test_compile_O3_refuses_a_table_that_O2_takes(tmp_path, capsys, monkeypatch)
     """The 24-input 200-row table of 2 outputs: -O2 peaks under 6 GB, -O3 passed 23.9 GB and was
     killed after 7.7 min; with a 12 GiB budget (half this machine's memory) -O3 is refused at once."""
     from mlc.mesh import profiles
-    rng = random.Random(24)
     n = 24
-    rows = sorted({"".join(rng.choice("01") for _ in range(n)) for _ in range(20)})
-    src = tmp_path / "t24.tt"
-    src.write_text(f".inputs {' '.join(f'x{i}' for i in range(n))}\n.outputs f g\n"
-                   + "".join(f"{r} | {rng.choice('01')}{rng.choice('01')}\n" for r in rows))
+    src = _wide_table(tmp_path / "t24.tt", n, 20, seed=24)
     monkeypatch.setattr(profiles, "memory_budget", lambda: 12.0 * 2 ** 30)
     before = listing(tmp_path)
     code, stdout, err = run(capsys, "compile", src, "-o", tmp_path / "o", "--no-circuit", "-O3")
