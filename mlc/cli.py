@@ -99,8 +99,8 @@ class _Unraisable:
     compiler calls back from LLVM) is noted, not printed as a traceback, and delivered again
     (SIGINT raised anew), so that it takes effect once control is back in Python code.  If the
     compiler fails with an error of its own first, :func:`_main` reports that as the
-    interruption it is.  (Noting it alone lost the Ctrl-C whenever the compile then succeeded:
-    seen once, a simulate interrupted 1 s after its start ran on for 10 minutes.)"""
+    interruption it is.  (Noting it alone would lose the Ctrl-C whenever the compile then
+    succeeded.)"""
 
     def __init__(self, inner):
         self.inner, self.hit = inner, False
