@@ -1177,8 +1177,17 @@ def test_compile_draw_of_a_large_circuit_shows_a_timer(tmp_path, capsys, monkeyp
         def __init__(self, label, total=None, expect=None, show=None, delay=2.0, stream=None, steps=None):
             super().__init__(label, total, expect, True, 0.0, stream, steps)
 
+    from mlc.netlist.ir import Netlist
+    render = Netlist.render_png
+
+    def slow_render(self, *a, **k):      # as long as a large schematic: the timer ticks every 0.5 s
+        import time
+        time.sleep(1.2)
+        return render(self, *a, **k)
+
     monkeypatch.setattr(cc, "DRAW_LEGIBLE_GATES", 2)
     monkeypatch.setattr(progress, "Progress", Shown)
+    monkeypatch.setattr(Netlist, "render_png", slow_render)
     code, _, err = run(capsys, "compile", ROOT / "examples" / "tetris.tt", "-o", tmp_path / "o", "--no-circuit",
                        "--draw", tmp_path / "c.png")
     assert code == 0 and "drawing 3 gates" in err, err
