@@ -1302,21 +1302,27 @@ def test_draw_refuses_more_panels_than_a_picture_shows(scene_text, tmp_path, cap
     assert_clean_failure(code, err, before, tmp_path, f"{src}: 7 inputs make 128 input states", "at most 64")
 
 
+def _ctrl_c_in_a_callback():
+    """What Python does with a Ctrl-C that lands in a C callback (Numba's compiler, from LLVM):
+    it hands the KeyboardInterrupt to sys.unraisablehook, and the C code goes on."""
+    import types
+    try:
+        raise KeyboardInterrupt
+    except KeyboardInterrupt as ki:
+        sys.unraisablehook(types.SimpleNamespace(exc_type=KeyboardInterrupt, exc_value=ki,
+                                                 exc_traceback=ki.__traceback__, err_msg=None, object=None))
+
+
 def test_ctrl_c_swallowed_by_a_callback_still_stops_the_command(monkeypatch, capsys):
     """A Ctrl-C that lands in a callback which swallows it (Python reports it to
     sys.unraisablehook and the C code goes on) while the compile then succeeds: the command must
     still stop, not run to its end."""
     import time
-    import types
     import mlc.commands.version as version
     finished = []
 
     def swallowed_then_work(args):
-        try:
-            raise KeyboardInterrupt
-        except KeyboardInterrupt as ki:
-            sys.unraisablehook(types.SimpleNamespace(exc_type=KeyboardInterrupt, exc_value=ki,
-                                                     exc_traceback=ki.__traceback__, err_msg=None, object=None))
+        _ctrl_c_in_a_callback()
         t = time.perf_counter()
         while time.perf_counter() - t < 2.0:     # the rest of the command, in Python
             pass
@@ -1336,11 +1342,7 @@ def test_ctrl_c_inside_a_compiler_callback_is_an_interruption(monkeypatch, capsy
     import mlc.commands.version as version
 
     def compile_interrupted(args):
-        try:
-            raise KeyboardInterrupt
-        except KeyboardInterrupt as ki:
-            sys.unraisablehook(types.SimpleNamespace(exc_type=KeyboardInterrupt, exc_value=ki,
-                                                     exc_traceback=ki.__traceback__, err_msg=None, object=None))
+        _ctrl_c_in_a_callback()
         raise RuntimeError("no compiled object yet for <Library 'eval_s'>")
 
     def chained(args):
