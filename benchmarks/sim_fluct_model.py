@@ -12,8 +12,8 @@ m = 1 and no refinement it is what mlc does on this scene.
 
 Session 13: the stage rule.  ``stage_rule`` is the rule mlc's fluctuation mode now uses
 (mlc.sim.integrator.Simulation.fluct_stages_target), written again here from its statement:
-base factor m0 = 3 when one step's noise variance per axis 2 kT h/gamma exceeds 0.5 sigma^2,
-else 1; s0 = ceil(m0 sqrt(h rho 1.2/2)); s = the smallest s in [s0, 1.5 s0] whose
+base factor m0 = 3 when one step's noise variance per axis 2 kT h/gamma exceeds 1.5e-3 sigma^2
+(0.5 sigma^2 in sessions 13-16), else 1; s0 = ceil(m0 sqrt(h rho 1.2/2)); s = the smallest s in [s0, 1.5 s0] whose
 R_s(-h rho) = T_s(1 - h rho/s^2) (the stiffest mode's one-step factor, rho without the
 safety factor) lies in [-0.5, 0.5], else the one there nearest that window.  Each point
 reports two estimators of the variance: ``time`` (per pair over its 200 records, averaged
@@ -58,7 +58,7 @@ def R_stiff(h, s, lam):
     return math.cos(s * math.acos(max(-1.0, min(1.0, x))))
 
 
-def stage_rule(kT, h, rho, gamma=1.0, safety=1.2, m_hi=3.0, noise_hi=0.5, lo=-0.5, hi=0.5, span=1.5):
+def stage_rule(kT, h, rho, gamma=1.0, safety=1.2, m_hi=3.0, noise_hi=1.5e-3, lo=-0.5, hi=0.5, span=1.5):
     """Stages of the session-13 rule (module docstring); rho = the stiffest mode's rate."""
     m0 = m_hi if 2.0 * kT * h / gamma > noise_hi else 1.0
     s0 = max(2, math.ceil(m0 * math.sqrt(h * rho * safety / 2.0)))

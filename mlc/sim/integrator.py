@@ -459,7 +459,7 @@ class Simulation:
         noise the nonlinearity injects (+40 % at kT = 1e-3 k0 sigma^2, dt = 0.2 t0, R = -0.99)
         and one with R near +1 decorrelates over many steps.  Rule: base factor m0 =
         ``FLUCT_M_HI`` (3) when one step's noise variance per axis 2 kT h/gamma exceeds
-        ``FLUCT_NOISE_HI`` (0.5 sigma^2; a 1 sigma bond then turns by ~1 rad a step), else 1;
+        ``FLUCT_NOISE_HI`` (1.5e-3 sigma^2: a 1 sigma bond turns by ~0.05 rad a step), else 1;
         s0 = ceil(m0 sqrt(h rho 1.2/2)); s = the smallest s in [s0, 1.5 s0] with R in
         ``FLUCT_R_WINDOW`` ([-0.5, 0.5]), else the one there nearest that window.  This places
         the estimated stiffest mode of a full-size step; the scene's other modes are kept off
@@ -723,8 +723,14 @@ def _count(done: int, every: int, phase: int) -> int:
 #: one step's noise variance per axis 2 kT h/gamma exceeds FLUCT_NOISE_HI (sigma^2), else 1;
 #: then the fewest stages (up to FLUCT_SPAN times the base) whose stiffest-mode factor
 #: T_s(1 - h rho/s^2) lies in FLUCT_R_WINDOW.
+#: FLUCT_NOISE_HI was 0.5 sigma^2 (a radian a step) in sessions 13-16; 1.5e-3 since session 17: on
+#: the scene of many stiff modes (benchmarks/sim_fluct_modes.py) groups read up to +8 % at
+#: kT = 1e-3, dt = 0.05-0.2 t0 and +21 % at kT = 1e-2, dt = 0.01 t0 with m0 = 1 (noise variance
+#: 0.02-0.4 sigma^2 a step), within 5 % with m0 = 3 (not a round 1e-3: that is the noise at
+#: kT = 1e-5, dt = 0.05 t0, a measured point, where rounding would pick the factor); at kT = 0
+#: (trajectories) nothing changes
 FLUCT_M_HI = 3.0
-FLUCT_NOISE_HI = 0.5
+FLUCT_NOISE_HI = 1.5e-3
 FLUCT_R_WINDOW = (-0.5, 0.5)
 FLUCT_SPAN = 1.5
 #: ... and random least substep levels (SimOptions.fluct_levels, session 15) only where a full
@@ -748,16 +754,17 @@ def _cheb_factor(hr: float, s: int) -> float:
 #: centres, no rotational noise), per kT (k0 sigma^2): (dt in t0, ratio); 50 steps of
 #: burn-in, 200 measured, sampling error ~0.01; the session-13 stage rule (before it, kT = 1e-3,
 #: dt = 0.2 t0 gave +40 %: 16 stages put the pair's mode on an interior Chebyshev extremum) and
-#: the session-15 random substep levels above 4 stages (SimOptions.fluct_levels).
+#: the session-15 random substep levels above 4 stages (SimOptions.fluct_levels); re-run in
+#: session 17 with the base factor 3 from 1.5e-3 sigma^2 of noise a step (FLUCT_NOISE_HI).
 FLUCT_PAIR_RATIO = {
-    1e-05: ((0.01, 0.994), (0.05, 0.999), (0.2, 0.998), (0.5, 1.005), (2.0, 0.990), (5.0, 1.000), (20.0, 0.999),
-            (100.0, 1.014)),
-    0.0001: ((0.01, 1.003), (0.05, 0.997), (0.2, 0.983), (0.5, 0.993), (2.0, 0.998), (5.0, 0.999), (20.0, 1.000),
-             (100.0, 1.004)),
-    0.001: ((0.01, 1.005), (0.05, 0.991), (0.2, 1.026), (0.5, 1.002), (2.0, 1.015), (5.0, 0.992), (20.0, 0.981),
-            (100.0, 1.009)),
-    0.01: ((0.01, 1.007), (0.05, 1.011), (0.2, 1.027), (0.5, 1.029), (2.0, 1.008), (5.0, 1.007), (20.0, 1.019),
-           (100.0, 1.009)),
+    1e-05: ((0.01, 0.994), (0.05, 0.999), (0.2, 1.003), (0.5, 1.001), (2.0, 1.001), (5.0, 0.986),
+            (20.0, 0.997), (100.0, 1.014)),
+    0.0001: ((0.01, 0.977), (0.05, 1.004), (0.2, 0.987), (0.5, 0.986), (2.0, 1.004), (5.0, 0.999),
+             (20.0, 1.000), (100.0, 1.004)),
+    0.001: ((0.01, 0.979), (0.05, 0.998), (0.2, 1.000), (0.5, 1.002), (2.0, 1.015), (5.0, 0.992),
+            (20.0, 0.981), (100.0, 1.009)),
+    0.01: ((0.01, 1.010), (0.05, 1.011), (0.2, 1.027), (0.5, 1.029), (2.0, 1.008), (5.0, 1.007),
+           (20.0, 1.019), (100.0, 1.009)),
 }
 
 
