@@ -152,7 +152,7 @@ def main():
     out = {"benchmark": "numpy model of post-processed SK-ROCK (eta = 0) on a bonded pair's relative coordinate: "
                         "bond-length variance / exact (no substeps, no step-size control)",
            "settings": "2000 pairs, 50 steps burn-in, 200 measured, seed 1", "rows": rows,
-           "stage_rule": {"rule": "m0 = 3 if 2 kT h/gamma > 0.5 sigma^2 else 1; s0 = ceil(m0 sqrt(1.2 h rho/2)); "
+           "stage_rule": {"rule": "m0 = 3 if 2 kT h/gamma > 1.5e-3 sigma^2 else 1 (0.5 sigma^2 before session 17); s0 = ceil(m0 sqrt(1.2 h rho/2)); "
                                   "s = smallest s in [s0, 1.5 s0] with T_s(1 - h rho/s^2) in [-0.5, 0.5], else the "
                                   "nearest to that window (rho = 2 k/gamma, the pair's mode)",
                           "old": "s = ceil(m sqrt(1.2 h rho/2)), m = 2 if 2 kT h/gamma > 1 sigma^2 else 1",
