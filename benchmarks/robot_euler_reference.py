@@ -40,13 +40,14 @@ from mlc.io.atomic import atomic_path
 OUT = Path(__file__).resolve().parent / "results" / "robot_euler_reference.json"
 
 
-def trajectory(scene, row: str, scheme: str, dt: float | None, T: float, every: float) -> dict:
-    """Poses and DOF angles at t = every, 2 every, ... T from rest (kT = 0)."""
+def trajectory(scene, row: str, scheme: str, dt: float | None, T: float, every: float, **opt) -> dict:
+    """Poses and DOF angles at t = every, 2 every, ... T from rest (kT = 0); ``opt``: further
+    SimOptions (benchmarks/robot_drift_probe.py sets ``disp_acc``)."""
     from mlc.robot.verify import dof_angles
     from mlc.sim.drive import Drive
     from mlc.sim.integrator import SimOptions, Simulation
     drives = {inp: Drive.constant(int(b)) for inp, b in zip(scene.inputs, row)}
-    sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=0.0, seed=0, dt=dt))
+    sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=0.0, seed=0, dt=dt, **opt))
     n = int(round(T / every))
     pos, ang, times = [], [], []
     w0, c0 = time.perf_counter(), time.process_time()
