@@ -39,15 +39,17 @@ import time
 
 
 def run_one(scene, state: str, seed: int, dt: float, tau: float, max_time: float, kT: float = 1e-5,
-            every: float = 100.0, scheme: str = "stiff", min_time: float | None = None) -> dict:
+            every: float = 100.0, scheme: str = "stiff", min_time: float | None = None,
+            disp_acc: float | None = None) -> dict:
     from mlc.robot.verify import _shape_row, robot_meta, run_fold
     from mlc.sim.drive import Drive
     from mlc.sim.integrator import SimOptions, Simulation
 
     rm = robot_meta(scene)
     drives = {inp: Drive.constant(int(b)) for inp, b in zip(scene.inputs, state)}
-    sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed, dt=dt))
-    wall = time.perf_counter()
+    extra = {} if disp_acc is None else {"disp_acc": disp_acc}     # the step control's drift bound (sigma)
+    sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed, dt=dt, **extra))
+    wall, cpu = time.perf_counter(), time.process_time()
     pm, t, relaxed, detail, hist = run_fold(sim, scene, state, kT, tau, max_time, every, min_time)
     sh = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy(), pm)
     want = scene.truth_table.get(state)
@@ -67,6 +69,7 @@ def run_one(scene, state: str, seed: int, dt: float, tau: float, max_time: float
             "dof_angles": [{k2: (round(v, 3) if isinstance(v, float) else v) for k2, v in d.items()}
                            for d in sh["dof_angles"]],
             "relaxed": relaxed, "time_t0": round(t, 3), "wall_s": round(time.perf_counter() - wall, 1),
+            "cpu_s": round(time.process_time() - cpu, 1),
             "relax_test": {"drift_deg": [round(v, 2) for v in detail.get("drift_deg", [])],
                            "tol_deg": [round(v, 2) for v in detail.get("tol_deg", [])],
                            "noise_deg": [round(v, 2) for v in noise],

@@ -11,6 +11,8 @@
 """
 from __future__ import annotations
 
+import math
+
 import json
 
 
@@ -38,8 +40,8 @@ def register(sub):
     a.add_argument("--kT", type=float, default=1e-5)
     a.add_argument("--seed", type=int, default=0)
     a.add_argument("--dt", type=float, metavar="DT",
-                   help="--dynamic: the integrator's step (t0; default mlc.robot.verify.ROBOT_DT, "
-                        "0.2 is within the noise of it for the Tetris robot: docs/robot.md 3.5)")
+                   help="--dynamic: the integrator's step (t0; default mlc.robot.verify.ROBOT_DT = 0.8 with a drift "
+                        "bound of ROBOT_DISP_ACC = 0.1 sigma: docs/robot.md 3.4)")
     a.add_argument("--json", metavar="JSON", help="also write the verification report here")
     a.set_defaults(func=run_shapes)
     b = rs.add_parser("fold", help="one fold by Brownian dynamics: GIF, PNG frames, GSD")
@@ -50,7 +52,8 @@ def register(sub):
     b.add_argument("--kT", type=float, default=1e-5)
     b.add_argument("--seed", type=int, default=0)
     b.add_argument("--dt", type=float, metavar="DT",
-                   help="the integrator's step (t0; default mlc.robot.verify.ROBOT_DT, the stiff scheme's)")
+                   help="the integrator's step (t0; default mlc.robot.verify.ROBOT_DT, the stiff scheme's for a "
+                        "robot, shortened to divide the frame interval)")
     b.add_argument("--gif", metavar="GIF")
     b.add_argument("--png-dir", metavar="DIR", help="write the frames as DIR/frame_000.png ...")
     b.add_argument("--gsd", metavar="GSD", help="GSD trajectory of the whole robot (slab shapes)")
@@ -101,7 +104,7 @@ def run_fold(args) -> int:
     from mlc.errors import MlcError
     from mlc.io.outputs import Outputs
     from mlc.robot.draw import gif_bytes, render_frames
-    from mlc.robot.verify import ROBOT_DT, _shape_row, robot_meta
+    from mlc.robot.verify import ROBOT_DISP_ACC, ROBOT_DT, _shape_row, robot_meta
     from mlc.scene.io import load_scene
     from mlc.sim.drive import Drive
     from mlc.sim.integrator import SimOptions, Simulation
@@ -123,8 +126,11 @@ def run_fold(args) -> int:
     if args.row not in scene.states():
         raise MlcError(f"row {args.row!r} is not an input state (inputs {scene.inputs})", "--row")
     drives = {n: Drive.constant(int(b)) for n, b in zip(scene.inputs, args.row)}
-    sim = Simulation(scene, drives, SimOptions(scheme="stiff", kT=args.kT, seed=args.seed,
-                                               dt=ROBOT_DT if args.dt is None else args.dt))
+    # default step: the verifier's, shortened to divide the frame interval (a frame ends a step)
+    gap = args.time / (args.frames - 1)
+    dt = gap / math.ceil(gap / ROBOT_DT - 1e-9) if args.dt is None else args.dt
+    sim = Simulation(scene, drives, SimOptions(scheme="stiff", kT=args.kT, seed=args.seed, dt=dt,
+                                               disp_acc=ROBOT_DISP_ACC))
     res = sim.run(args.time, frames=args.frames)         # a progress bar on a terminal
     if res.interrupted:          # Ctrl-C: a fold cut short is not the row's shape; nothing is written
         raise KeyboardInterrupt

@@ -20,7 +20,8 @@ static check, the largest joint stretch is below ``TOL_STRETCH``.
   relaxed (:func:`run_fold`: the time floor of 3 tau, the circuit outputs on a plateau,
   the joint angles within their own thermal noise, :func:`angles_relaxed`) or the fold
   time; the shape is read from the final poses.  tau and dt default to ``ROBOT_TAU``
-  and ``ROBOT_DT`` (no relaxation-time computation, docs/robot.md section 3).
+  and ``ROBOT_DT`` (no relaxation-time computation, docs/robot.md section 3); the stiff
+  scheme's drift bound is ``ROBOT_DISP_ACC``.
 
 Units: sigma, k0, t0, degrees in reports.
 """
@@ -42,7 +43,11 @@ TOL_STRETCH = 1e-3        # sigma
 TOL_LENGTH = 0.05         # sigma: static probe lengths within this of the ideal
 FOLD_TIME = 1800.0        # t0: the paper's fold time, a dynamic run's default limit
 ROBOT_TAU = 100.0         # t0: a robot's slowest relaxation time, measured, not computed (docs/robot.md section 3)
-ROBOT_DT = 0.05           # t0: the stiff scheme's largest documented step (mlc.sim.integrator.STIFF_DT_DEFAULT)
+ROBOT_DT = 0.8            # t0: the stiff scheme's step for a robot's fold ...
+ROBOT_DISP_ACC = 0.1      # sigma: ... with this drift bound (SimOptions.disp_acc, default 0.01). Against dt 0.2 t0
+                          # at 0.01 sigma: 1.67 times less CPU for the Tetris robot's 12 runs, all right, angles
+                          # within 2.3 deg (docs/robot.md 3.4, benchmarks/results/robot_verify_speed.json);
+                          # dt 3.2 t0 was 2.75 times faster but slowed a locked DOF's creep by 3 deg
 
 
 def robot_meta(scene: Scene) -> dict:
@@ -317,7 +322,8 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
     tau = ROBOT_TAU if tau is None else float(tau)
     dt = ROBOT_DT if (dt is None and scheme == "stiff") else dt
     rep = Report(scene.name, "dynamic", params={"kT": kT, "seeds": int(seeds), "first_seed": int(first_seed),
-                                                "scheme": scheme, "tau": tau, "dt": dt, "robot": True})
+                                                "scheme": scheme, "tau": tau, "dt": dt, "robot": True,
+                                                "disp_acc": ROBOT_DISP_ACC if scheme == "stiff" else None})
     poses = {}
     total, done = len(states) * int(seeds), 0
     bar = Progress(f"dynamic check of {scene.name}", total=total, show=None if progress is None else False)
@@ -329,7 +335,8 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
             per = []
             for seed in range(int(first_seed), int(first_seed) + int(seeds)):
                 sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed,
-                                                     dt=None if dt is None else float(dt)))
+                                                           dt=None if dt is None else float(dt),
+                                                           disp_acc=ROBOT_DISP_ACC))
                 # the bar moves within a fold: time run over 3 tau (tau at rest)
                 inner = bar.within(done, TAU_FACTOR * tau if state != "0" * len(scene.inputs) else tau)
                 means, t_rel, relaxed, _, _ = run_fold(sim, scene, state, kT, tau, t_max, on_window=inner)
@@ -442,4 +449,4 @@ def format_any(rep: Report) -> str:
     return format_report(rep)
 
 
-__all__ = ["FOLD_TIME", "ROBOT_DT", "ROBOT_TAU", "angles_relaxed", "dof_angles", "format_any", "run_fold", "format_robot_report", "read_shape", "robot_meta", "verify_robot_dynamic", "verify_robot_static"]
+__all__ = ["FOLD_TIME", "ROBOT_DISP_ACC", "ROBOT_DT", "ROBOT_TAU", "angles_relaxed", "dof_angles", "format_any", "run_fold", "format_robot_report", "read_shape", "robot_meta", "verify_robot_dynamic", "verify_robot_static"]
