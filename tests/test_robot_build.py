@@ -64,6 +64,9 @@ def test_dynamic_verify_folds(robot, capsys):
     r1 = rep["rows"][0]
     assert r1["state"] == "1" and r1["relaxed"] and r1["shape_read"] == "hook"
     assert r1["max_dof_mean_error_rad"] < 0.2 and r1["max_dof_error_rad"] < 0.3
+    # at the robot defaults (docs/robot.md 3.4): the step and drift bound the report says it ran
+    from mlc.robot.verify import ROBOT_DISP_ACC, ROBOT_DT
+    assert rep["params"]["dt"] == ROBOT_DT and rep["params"]["disp_acc"] == ROBOT_DISP_ACC
 
 
 def test_pictures_and_trajectory(robot, capsys):

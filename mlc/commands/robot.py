@@ -11,9 +11,8 @@
 """
 from __future__ import annotations
 
-import math
-
 import json
+import math
 
 
 def robot_files(circuit_scene, robot_path):
