@@ -187,7 +187,7 @@ def main(argv=None) -> int:
                       f"relaxed {r['relaxed']} at {r['time_t0']} t0, cpu {r['cpu_s']} s "
                       f"{'ok' if r['ok'] else 'WRONG'}", flush=True)
                 allr = sorted(runs.values(), key=lambda r: (r["row"], r["seed"], r["setting"]))
-                data = {"what": "Tetris robot: dynamic verification at two step settings "
+                data = {"what": "Tetris robot: dynamic verification at several step settings "
                                 "(benchmarks/robot_verify_speed.py)",
                         "scene": a.scene, "scene_digest": digest, "bodies": len(sc.bodies),
                         "machine": f"{platform.machine()}, {os.cpu_count()} cores, shared",
@@ -196,13 +196,12 @@ def main(argv=None) -> int:
                 with atomic_path(a.out) as tmp:
                     Path(tmp).write_text(json.dumps(data, indent=1))
     if data:
+        # once at the end: the centres check, and the comparison also when every run was resumed
         data["nearest_unbonded_centres_sigma"] = nearest_unbonded_centres(sc)
-        with atomic_path(a.out) as tmp:
-            Path(tmp).write_text(json.dumps(data, indent=1))
-        print("nearest centres of two unjoined bodies (sigma):", data["nearest_unbonded_centres_sigma"])
         data["comparison"] = compare(data["runs"])
         with atomic_path(a.out) as tmp:
             Path(tmp).write_text(json.dumps(data, indent=1))
+        print("nearest centres of two unjoined bodies (sigma):", data["nearest_unbonded_centres_sigma"])
         print(json.dumps(data["comparison"]["settings"], indent=1))
         print("CPU of A over each:", data["comparison"]["cpu_ratio_vs_A"])
         print("largest difference:", json.dumps(data["comparison"]["largest_difference"], indent=1))
