@@ -110,9 +110,10 @@ def test_report_json_round_trip():
     rep = check_assembly(_hinge())
     d = json.loads(json.dumps(rep.to_dict()))
     assert d["ok"] is True and [c["name"] for c in d["checks"]] == [
-        "watertight", "part_count", "min_gap", "states", "retention", "features", "wall_thickness",
-        "bed_contact", "supports"]
+        "watertight", "part_count", "min_gap", "states", "motion_clearance", "retention", "features",
+        "wall_thickness", "bed_contact", "supports"]
     assert [c["blocking"] for c in d["checks"]][-3:] == [False, False, False]
+    assert d["checks"][4]["blocking"] is False
 
 
 @pytest.mark.parametrize("profile", ["mjp", "fdm"])
@@ -128,3 +129,37 @@ def test_coarse_polygons_keep_the_clearance():
     rep = check_assembly(_hinge(overrides={"circular_segments": 12}))
     assert rep.ok, rep.text()
     assert rep.check("min_gap").value >= 0.2 - 1e-6
+
+
+def test_motion_clearance_fails_within_the_clearance_without_meeting():
+    """Two parallel slabs, no joint: posed so that their faces are half a clearance apart
+    (measured on the meshes' own vertices, not by the check) the motion_clearance goal fails
+    naming that pose and gives that gap, while the states check (intersection) passes on the
+    same poses; 1.5 clearances apart both pass."""
+    from mlc.mesh.checks import motion_check
+    from mlc.mesh.export import part_meshes
+    from mlc.scene.model import Scene
+    prof = load_profile("mjp")
+    c, s = prof.clearance, prof.sigma_mm
+    sc = Scene("two_slabs", [ex._slab("A", 0.0), ex._slab("B", 0.0, origin=(0.0, 1.0, 0.0))], []).check()
+    rest = (np.array([b.position for b in sc.bodies], float), np.array([b.orientation for b in sc.bodies], float))
+    meshes = dict(part_meshes(build_assembly(sc, prof, {"0": rest}, resolve=False)))
+    g0 = meshes["B"].vertices[:, 1].min() - meshes["A"].vertices[:, 1].max()      # mm, faces normal to y
+
+    def moved(gap):
+        p = rest[0].copy()
+        p[1, 1] -= (g0 - gap) / s
+        return p, rest[1]
+
+    poses = {"0": rest, "near": moved(0.5 * c), "clear": moved(1.5 * c)}
+    asm = build_assembly(sc, prof, poses, resolve=False)
+    rep = check_assembly(asm, walls=False, motion_poses=poses)
+    mc = rep.check("motion_clearance")
+    assert not mc.ok and not mc.blocking
+    assert len(mc.failures) == 1 and mc.failures[0].startswith("near: A - B"), mc.failures
+    assert abs(mc.value - 0.5 * c) < 1e-6
+    assert rep.check("states").ok and rep.ok          # no intersection: the blocking checks pass
+    del poses["near"]
+    mc = motion_check(asm, poses)
+    assert mc.ok and (mc.value is None or mc.value >= c - 1e-6), mc.detail
+    assert not motion_check(asm, None).ok              # not measured: not met

@@ -54,3 +54,42 @@ def test_oriented_boxes_drop_only_pairs_apart():
     assert meet <= kept                            # sound: every intersecting pair is kept
     assert len(kept) < 0.5 * len(pairs)            # and it does narrow the candidates
     assert len(kept - meet) <= 0.05 * len(pairs)
+
+
+def test_posed_gaps_against_every_pose_measured_and_the_distance():
+    """Four balls that close in on the four vertical edges of a cube, each with its own step,
+    from twice the clearance to under half of it (their boxes within the clearance well before
+    the balls are: the bound decides those poses): posed_gaps, which skips the poses its bound
+    proves clear, flags exactly the poses a measurement of every pose flags (manifold3d min_gap,
+    no bound), and its gaps are the distance from each ball's centre to the cube less the
+    radius (to the polygon's sagitta)."""
+    from mlc.mesh.spatial import posed_gaps
+    r, c, n = 0.3, 0.2, 128
+    solids = [mf.Manifold.cube([1.0] * 3, True)] + [mf.Manifold.sphere(r, n) for _ in range(4)]
+    frames = [np.eye(4)] * 5
+    lo, hi = local_boxes(solids, frames)
+    edges = [np.array([sx * 0.5, sy * 0.5, 0.0]) for sx, sy in ((1, 1), (-1, 1), (-1, -1), (1, -1))]
+    dirs = [np.array([np.cos(a) * np.sign(e[0]), np.sin(a) * np.sign(e[1]), 0.0])
+            for a, e in zip(np.radians([30, 45, 55, 65]), edges)]
+    steps = [0.17, 0.29, 0.41, 0.53]                    # per pose, in clearances
+    poses, gaps = [], []
+    for k in range(40):
+        T, g = [np.eye(4)], []
+        for e, d, st in zip(edges, dirs, steps):
+            gk = max(2.0 * c - k * st * c, 0.3 * c)
+            M = np.eye(4)
+            M[:3, 3] = e + (r + gk) * d
+            T.append(M)
+            g.append(gk)
+        poses.append(T)
+        gaps.append(g)
+    close, smallest = posed_gaps(solids, frames, lo, hi, poses, c)
+    brute = {(k, b) for k, T in enumerate(poses) for b in range(1, 5)
+             if solids[0].min_gap(solids[b].translate(T[b][:3, 3].tolist()), 2 * c) < c - 1e-6}
+    assert {(k, j) for k, here in enumerate(close) for (_, j) in here} == brute
+    assert len(brute) > 100
+    sag = r * (1 - np.cos(np.pi / n)) + 1e-9
+    for k, here in enumerate(close):
+        for (i, j), g in here.items():
+            assert i == 0 and abs(g - gaps[k][j - 1]) < sag
+    assert abs(smallest[0] - 0.3 * c) < sag

@@ -312,6 +312,13 @@ def transform_solid(solid: mf.Manifold, T) -> mf.Manifold:
     return solid.transform(np.asarray(T, float)[:3, :4])
 
 
+def reuses(scene: Scene) -> bool:
+    """Whether :func:`build_assembly` reuses results across congruent parts by default: an
+    assembly of at least :data:`REUSE_MIN_PARTS` parts (bodies and universal-joint parts)."""
+    n_uj = sum(1 for bonds in scene.joints().values() if bonds[0].kind == "universal")
+    return len(scene.bodies) + n_uj >= REUSE_MIN_PARTS
+
+
 # --------------------------------------------------------------------------- build
 def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                    resolve: bool = True, reuse: bool | None = None) -> Assembly:
@@ -457,8 +464,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse) -> Assembly:
 
     state_T = _state_transforms(scene, prof, poses)
     if reuse is None:
-        n_uj = sum(1 for bonds in joints.values() if bonds[0].kind == "universal")
-        reuse = len(scene.bodies) + n_uj >= REUSE_MIN_PARTS
+        reuse = reuses(scene)
     memo: dict | None = {} if reuse else None      # sampled trim radii of congruent joints
     h = _sample_step(t, c, s)
 

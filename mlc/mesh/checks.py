@@ -11,6 +11,9 @@ Checks (each one can fail; a failed check makes ``mlc stl`` exit non-zero unless
                  equilibrium of every logic state and points on the way to them (static
                  verification, see mlc.mesh.pipeline.state_poses), joint parts following
                  their bodies
+``motion_clearance`` (a goal) no two parts closer than the clearance in any pose of the dense
+                 paths from rest and of every switch between two states (a mechanism of fewer
+                 than 64 parts, such as a library gate; not measured for a compiled circuit)
 ``retention``    every jointed part displaced by 1.5 x clearance in each of six directions
                  (along and across its axis) runs into a joint partner: nothing falls out
 ``features``     every feature is at least the profile's minimum (slab, knuckle wall, pin,
@@ -34,7 +37,7 @@ from mlc.mesh.build import Assembly, _log, _perp_frame, box, transform_solid, un
 from mlc.mesh.congruence import shape_key
 
 #: checks reported but not (yet) failing an export: the library gates do not meet them (issue 13)
-NON_BLOCKING = ("wall_thickness", "bed_contact", "supports")
+NON_BLOCKING = ("motion_clearance", "wall_thickness", "bed_contact", "supports")
 VOL_EPS = 1e-6    # mm^3: intersections smaller than this are numerical contact, not overlap
 GAP_EPS = 1e-6    # mm
 BED_CONTACT_MIN = 0.20     # first-layer area / footprint
@@ -120,8 +123,47 @@ def _pairs(boxes, margin):
     return box_pairs([b[0] for b in boxes], [b[1] for b in boxes], margin)
 
 
-def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True) -> Report:
-    """Run every check of the module docstring on ``asm`` (``poses`` default: ``asm.poses``).
+def motion_check(asm: Assembly, poses: dict | None) -> Check:
+    """The ``motion_clearance`` goal: in every pose of ``poses`` (``{name: (pos, quat)}``, sigma:
+    the dense paths and switches of :func:`mlc.mesh.pipeline.state_poses` with ``max_move``) every
+    pair of parts keeps the clearance (:func:`mlc.mesh.spatial.posed_gaps`); not measured without
+    poses (a compiled circuit: the states check tests its coarse poses for intersection only)."""
+    c = asm.profile.clearance
+    blocking = "motion_clearance" not in NON_BLOCKING
+    if not poses:
+        return Check("motion_clearance", False, None, c, "not measured: no dense poses (a mechanism of 64 "
+                     "parts or more, such as a compiled circuit, is posed coarsely and checked for intersection "
+                     "only)", ["the clearance in motion was not measured"], blocking)
+    from mlc.mesh.spatial import local_boxes, part_frames, posed_gaps
+    parts = asm.parts
+    frames = part_frames(asm)
+    llo, lhi = local_boxes([p.solid for p in parts], frames)
+    names = list(poses)
+    Ts = [asm.part_transforms(*poses[st]) for st in names]
+    close, smallest = posed_gaps([p.solid for p in parts], frames, llo, lhi,
+                                 [[T[p.name] for p in parts] for T in Ts], c, GAP_EPS)
+    low = [f"{names[k]}: {parts[i].name} - {parts[j].name}: {g:.4f} mm" + (" (touching)" if g <= GAP_EPS else "")
+           for k, here in enumerate(close) for (i, j), g in sorted(here.items())]
+    n_path = sum("@" in str(k) and ">" not in str(k) for k in poses)
+    n_switch = sum(">" in str(k) for k in poses)
+    what = (f"{len(poses) - n_path - n_switch} logic states, {n_path} poses on the way to them from rest and "
+            f"{n_switch} on the switches between them")
+    if smallest is None:
+        detail = f"no two parts within the clearance {c:g} mm in {what}"
+    else:
+        g, i, j, k = smallest
+        pairs = {ij for here in close for ij in here}
+        detail = (f"smallest gap {g:.3f} mm ({parts[i].name} - {parts[j].name}, {names[k]}) in {what}"
+                  + (f"; {len(pairs)} pairs closer than the clearance {c:g} mm in {len(low)} poses" if low
+                     else f" >= clearance {c:g} mm"))
+    return Check("motion_clearance", not low, None if smallest is None else round(smallest[0], 5), c, detail,
+                 low, blocking)
+
+
+def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True,
+                   motion_poses: dict | None = None) -> Report:
+    """Run every check of the module docstring on ``asm`` (``poses`` default: ``asm.poses``;
+    ``motion_poses``: the dense poses of the ``motion_clearance`` goal, :func:`motion_check`).
     ``walls=False`` leaves out the measured wall thickness (the slowest check: seconds per gate;
     for tests of other checks only -- ``mlc stl`` always measures)."""
     t0 = time.perf_counter()
@@ -285,6 +327,7 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True)
                             "no equilibrium poses: the logic states were not checked",
                             ["static verification gave no poses (use --force to export unchecked)"]))
 
+    checks.append(motion_check(asm, motion_poses))
     _log("check states done")
     # -- retention ---------------------------------------------------------------------------
     checks.append(_retention(asm))

@@ -19,8 +19,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mlc.mesh.build import Assembly, Part, _log, _orientation, build_assembly, transform_solid
-from mlc.mesh.checks import (GAP_EPS, VOL_EPS, Check, Report, _bbox, _pairs, bed_checks, check_assembly,
-                             print_size)
+from mlc.mesh.checks import (GAP_EPS, NON_BLOCKING, VOL_EPS, Check, Report, _bbox, _pairs, bed_checks,
+                             check_assembly, print_size)
 from mlc.mesh.profiles import Profile
 from mlc.scene.model import Scene
 
@@ -28,6 +28,13 @@ from mlc.scene.model import Scene
 MAX_STATES = 64
 #: poses checked on the way from rest to each state (besides the states themselves)
 PATH_STEPS = 6
+#: dense paths (state_poses ``max_move``): mechanisms with at most this many input states are
+#: also posed on every switch between two states
+TRANSITION_STATES = 8
+#: dense paths: at most this many poses on one path
+MAX_PATH_POSES = 400
+#: sigma added to a body's reach (state_poses ``max_move``) for its knuckles and yokes
+PART_MARGIN = 0.25
 
 
 @dataclass
@@ -97,11 +104,48 @@ def _signature(scene: Scene):
     return tuple(sig)
 
 
-def state_poses(scene: Scene, max_states: int = MAX_STATES, path_steps: int = PATH_STEPS) -> tuple[dict, str | None]:
+def _reach(scene: Scene) -> np.ndarray:
+    """Per body, the largest distance (sigma) from its centre of a point of its slabs or sites,
+    plus ``PART_MARGIN`` for the knuckles and yokes a printed part adds."""
+    out = np.zeros(len(scene.bodies))
+    for k, b in enumerate(scene.bodies):
+        r = [float(np.linalg.norm(s)) for s in b.sites.values()]
+        r += [float(np.linalg.norm(bx.center) + 0.5 * np.linalg.norm(bx.size)) for bx in b.boxes]
+        out[k] = max(r, default=0.0) + PART_MARGIN
+    return out
+
+
+def _moves(p, q, reach) -> float:
+    """The largest move (sigma) of a point of any body from pose ``p`` to pose ``q``
+    (``(pos, quat)``): |dx| + |R_q - R_p| r, with |R_q - R_p| = 2 sin(angle / 2)."""
+    from mlc.geometry.rotation import quat_to_matrix
+    (x1, q1), (x2, q2) = p, q
+    d = np.linalg.norm(np.asarray(x2) - np.asarray(x1), axis=1)
+    rot = np.array([np.linalg.norm(quat_to_matrix(b) - quat_to_matrix(a), 2) for a, b in zip(q1, q2)])
+    return float(np.max(d + rot * reach, initial=0.0))
+
+
+def state_poses(scene: Scene, max_states: int = MAX_STATES, path_steps: int = PATH_STEPS,
+                max_move: float | None = None) -> tuple[dict, str | None]:
     """Body poses (sigma) at the equilibrium of the input states: ``{state: (pos, quat)}``,
     plus ``path_steps`` points on the way from rest to each state (keys ``"01@0.50"``: the
     equilibrium with the muscles that state actuates half-way there), and a note when only a
-    sample of the states was posed."""
+    sample of the states was posed.
+
+    ``max_move`` (sigma; ``mlc stl`` passes the profile's clearance for a mechanism of fewer
+    than ``REUSE_MIN_PARTS`` parts, such as a library gate, for its ``motion_clearance`` goal)
+    makes the paths dense and adds the switches between states (for at most
+    ``TRANSITION_STATES`` states; keys ``"01@0.500"`` on the paths from rest):
+
+    * every path is followed quasi-statically, each pose solved from the one before, with
+      poses added until no point of any body (``_reach``) moves more than ``max_move`` from one
+      to the next (at most ``MAX_PATH_POSES`` a path);
+    * besides the paths from rest, every switch from a state ``a`` other than rest to any other
+      state ``b``: every muscle moved on a straight line from its length in ``a`` to its length
+      in ``b``, from ``a``'s pose (keys ``"01>10@0.500"``, and ``"01>10"`` for the end: the pose
+      of ``b`` reached from ``a``, which a floppy mode can leave apart from ``b`` reached from
+      rest).  With the paths from rest these are all the moves between logic states in which
+      the inputs switch together."""
     try:
         from mlc.verify.static import equilibrium
     except ImportError:  # pragma: no cover - static verification ships with mlc
@@ -121,21 +165,95 @@ def state_poses(scene: Scene, max_states: int = MAX_STATES, path_steps: int = PA
         note = (f"{scene.name}: {len(scene.inputs)} inputs; posed {len(states)} of {2 ** n} input states "
                 f"(all zero, all one, each input alone on and off, then a fixed random sample)")
     out = {}
+    eqs = {}
     for st in states:
-        eq = equilibrium(scene, st)
+        eqs[st] = eq = equilibrium(scene, st)
         out[st] = (np.asarray(eq.pos, float), np.asarray(eq.quat, float))
     rest = "0" * len(scene.inputs)
-    for k in range(1, path_steps + 1):
-        f = k / (path_steps + 1)
+    if max_move is not None and not max_move > 0:
+        raise ValueError(f"max_move must be positive, not {max_move}")
+    if max_move is None:
+        for k in range(1, path_steps + 1):
+            f = k / (path_steps + 1)
+            part = copy.copy(scene)
+            part.muscles = [copy.copy(m) for m in scene.muscles]
+            for m in part.muscles:
+                m.actuated = m.rest + f * (m.actuated - m.rest)
+            for st in states:
+                if st != rest:
+                    eq = equilibrium(part, st)
+                    out[f"{st}@{f:.2f}"] = (np.asarray(eq.pos, float), np.asarray(eq.quat, float))
+        return out, note
+
+    A = scene.arrays()
+    reach = _reach(scene)
+
+    def held(lengths):
+        """The scene with every muscle held at ``lengths`` in every state."""
         part = copy.copy(scene)
         part.muscles = [copy.copy(m) for m in scene.muscles]
-        for m in part.muscles:
-            m.actuated = m.rest + f * (m.actuated - m.rest)
-        for st in states:
-            if st != rest:
-                eq = equilibrium(part, st)
-                out[f"{st}@{f:.2f}"] = (np.asarray(eq.pos, float), np.asarray(eq.quat, float))
+        for m, L in zip(part.muscles, lengths):
+            m.rest = m.actuated = float(L)
+        return part
+
+    def follow(a, La, Lb, fs):
+        """Poses at the fractions ``fs`` (ascending, the last 1) of the straight move of the
+        muscles from ``La`` to ``Lb``, each solved from the one before, from ``a``'s pose."""
+        poses, pq = [], (eqs[a].pos, eqs[a].quat)
+        for f in fs:
+            eq = equilibrium(held(La + f * (Lb - La)), a, pos=pq[0], quat=pq[1])
+            pq = (np.asarray(eq.pos, float), np.asarray(eq.quat, float))
+            poses.append(pq)
+        return poses
+
+    coarse = []
+    if scene.muscles:
+        for a, b in itertools.product(states, states):
+            if a == b or (a != rest and len(states) > TRANSITION_STATES):
+                continue
+            La = A.muscle_lengths(np.array([int(x) for x in a], float))
+            Lb = A.muscle_lengths(np.array([int(x) for x in b], float))
+            fs = list(np.arange(1, path_steps + 2) / (path_steps + 1))
+            poses = follow(a, La, Lb, fs)
+            for _ in range(3):          # refine until every step moves at most max_move
+                seq = [(eqs[a].pos, eqs[a].quat)] + poses
+                mv = [_moves(p, q, reach) for p, q in zip(seq, seq[1:])]
+                if max(mv) <= max_move:
+                    break
+                f0 = [0.0] + fs
+                new = sorted(set(fs) | {f0[i] + (fs[i] - f0[i]) * j / m for i, m in
+                                        enumerate(int(np.ceil(1.1 * d / max_move)) for d in mv)
+                                        for j in range(1, m)})
+                if len(new) > MAX_PATH_POSES:
+                    break
+                fs, poses = new, follow(a, La, Lb, new)
+            seq = [(eqs[a].pos, eqs[a].quat)] + poses
+            worst = max(_moves(p, q, reach) for p, q in zip(seq, seq[1:]))
+            name = b if a == rest else f"{a}>{b}"
+            if worst > max_move:
+                coarse.append(f"{name} ({worst:.3g} sigma)")
+            for f, pq in zip(fs, poses):
+                out[f"{name}@{f:.3f}" if f < 1.0 or a == rest else name] = pq
+    if coarse:
+        extra = (f"{scene.name}: poses on the way more than {max_move:.3g} sigma apart on "
+                 + ", ".join(coarse[:4]) + (" ..." if len(coarse) > 4 else ""))
+        note = extra if note is None else note + "; " + extra
     return out, note
+
+
+def _dense_poses(scene: Scene, profile: Profile, notes: list) -> dict | None:
+    """The poses of the ``motion_clearance`` goal (mlc.mesh.checks.motion_check): for a mechanism
+    of fewer than ``REUSE_MIN_PARTS`` parts, :func:`state_poses` with ``max_move`` the clearance in
+    sigma (two parts that keep the clearance in two consecutive poses, each point moving at most
+    that much, cannot meet between them); None for a larger one (a compiled circuit: too many)."""
+    from mlc.mesh.build import reuses
+    if reuses(scene) or profile.clearance <= 0:
+        return None          # (no clearance: nothing to keep; min_gap fails the export)
+    _log("static verification: dense paths and switches for the clearance in motion")
+    dense, note = state_poses(scene, max_move=profile.clearance / profile.sigma_mm)
+    if note and note not in notes:
+        notes.append(note)
+    return dense
 
 
 def export_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
@@ -149,16 +267,18 @@ def export_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     mechs = split_mechanisms(scene)
     if poses is not None or len(mechs) == 1:
         notes = []
+        dense = None
         if poses is None and solve:
             _log("static verification: posing every logic state")
             poses, note = state_poses(scene)
             if note:
                 notes.append(note)
+            dense = _dense_poses(scene, profile, notes)
         _log("building parts")
         asm = build_assembly(scene, profile, poses)
         asm.notes[:0] = notes
         _log("printability checks")
-        rep = check_assembly(asm)
+        rep = check_assembly(asm, motion_poses=dense)
         rep.seconds = time.perf_counter() - t0
         _log("checks done")
         return asm, rep
@@ -182,8 +302,9 @@ def export_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         p, note = state_poses(sub) if solve else ({}, None)
         if note:
             notes.append(note)
+        dense = _dense_poses(sub, profile, notes) if solve else None
         a = build_assembly(sub, profile, p or None)
-        r = check_assembly(a)
+        r = check_assembly(a, motion_poses=dense)
         built[k] = (a, r)
 
     # the full assembly: representative parts, translated for the copies
@@ -298,6 +419,14 @@ def _merge_reports(scene, profile, mechs, built, full, owner) -> Report:
         st.ok = st.ok and not fails
     st.detail += (f"; {len(close)} pairs of mechanisms sweep through shared space (checked in every state "
                   f"combination)" if close else "; mechanisms never share space")
+    # the clearance in motion, within each distinct mechanism (not between mechanisms: the states
+    # check above sees those in every combination of their states, for intersection)
+    subs = [(k, reps[k].check("motion_clearance")) for k in reps]
+    vals = [ch.value for _, ch in subs if ch.value is not None]
+    checks.append(Check("motion_clearance", all(ch.ok for _, ch in subs), min(vals) if vals else None, c,
+                        "; ".join(f"{mechs[k].scene.name}: {ch.detail}" for k, ch in subs)[:2000],
+                        [f"{mechs[k].scene.name}: {f}" for k, ch in subs for f in ch.failures],
+                        "motion_clearance" not in NON_BLOCKING))
     # measured walls: per distinct mechanism (copies are translated, their walls the same)
     walls = [(k, reps[k].check("wall_thickness")) for k in reps if "wall_thickness" in
              {c.name for c in reps[k].checks}]
