@@ -125,6 +125,15 @@ def _moves(p, q, reach) -> float:
     return float(np.max(d + rot * reach, initial=0.0))
 
 
+def _with_muscles(scene: Scene, rest, actuated) -> Scene:
+    """A copy of ``scene`` whose muscles have these rest and actuated lengths (sigma)."""
+    part = copy.copy(scene)
+    part.muscles = [copy.copy(m) for m in scene.muscles]
+    for m, r, a in zip(part.muscles, rest, actuated):
+        m.rest, m.actuated = float(r), float(a)
+    return part
+
+
 def state_poses(scene: Scene, max_states: int = MAX_STATES, path_steps: int = PATH_STEPS,
                 max_move: float | None = None) -> tuple[dict, str | None]:
     """Body poses (sigma) at the equilibrium of the input states: ``{state: (pos, quat)}``,
@@ -175,10 +184,8 @@ def state_poses(scene: Scene, max_states: int = MAX_STATES, path_steps: int = PA
     if max_move is None:
         for k in range(1, path_steps + 1):
             f = k / (path_steps + 1)
-            part = copy.copy(scene)
-            part.muscles = [copy.copy(m) for m in scene.muscles]
-            for m in part.muscles:
-                m.actuated = m.rest + f * (m.actuated - m.rest)
+            part = _with_muscles(scene, [m.rest for m in scene.muscles],
+                                 [m.rest + f * (m.actuated - m.rest) for m in scene.muscles])
             for st in states:
                 if st != rest:
                     eq = equilibrium(part, st)
@@ -188,20 +195,13 @@ def state_poses(scene: Scene, max_states: int = MAX_STATES, path_steps: int = PA
     A = scene.arrays()
     reach = _reach(scene)
 
-    def held(lengths):
-        """The scene with every muscle held at ``lengths`` in every state."""
-        part = copy.copy(scene)
-        part.muscles = [copy.copy(m) for m in scene.muscles]
-        for m, L in zip(part.muscles, lengths):
-            m.rest = m.actuated = float(L)
-        return part
-
     def follow(a, La, Lb, fs):
         """Poses at the fractions ``fs`` (ascending, the last 1) of the straight move of the
         muscles from ``La`` to ``Lb``, each solved from the one before, from ``a``'s pose."""
         poses, pq = [], (eqs[a].pos, eqs[a].quat)
         for f in fs:
-            eq = equilibrium(held(La + f * (Lb - La)), a, pos=pq[0], quat=pq[1])
+            L = La + f * (Lb - La)          # held there in every state
+            eq = equilibrium(_with_muscles(scene, L, L), a, pos=pq[0], quat=pq[1])
             pq = (np.asarray(eq.pos, float), np.asarray(eq.quat, float))
             poses.append(pq)
         return poses
@@ -215,10 +215,10 @@ def state_poses(scene: Scene, max_states: int = MAX_STATES, path_steps: int = PA
             Lb = A.muscle_lengths(np.array([int(x) for x in b], float))
             fs = list(np.arange(1, path_steps + 2) / (path_steps + 1))
             poses = follow(a, La, Lb, fs)
-            for _ in range(3):          # refine until every step moves at most max_move
+            for refined in range(4):    # refine (three times at most) until every step moves at most max_move
                 seq = [(eqs[a].pos, eqs[a].quat)] + poses
                 mv = [_moves(p, q, reach) for p, q in zip(seq, seq[1:])]
-                if max(mv) <= max_move:
+                if max(mv) <= max_move or refined == 3:
                     break
                 f0 = [0.0] + fs
                 new = sorted(set(fs) | {f0[i] + (fs[i] - f0[i]) * j / m for i, m in
@@ -227,8 +227,7 @@ def state_poses(scene: Scene, max_states: int = MAX_STATES, path_steps: int = PA
                 if len(new) > MAX_PATH_POSES:
                     break
                 fs, poses = new, follow(a, La, Lb, new)
-            seq = [(eqs[a].pos, eqs[a].quat)] + poses
-            worst = max(_moves(p, q, reach) for p, q in zip(seq, seq[1:]))
+            worst = max(mv)
             name = b if a == rest else f"{a}>{b}"
             if worst > max_move:
                 coarse.append(f"{name} ({worst:.3g} sigma)")
