@@ -6,7 +6,8 @@ states check's clearance confirmed by a second distance code.
 Each case goes through ``export_assembly`` (what ``mlc stl`` runs): the poses of the logic
 states and 6 points on each path from rest (the parts' trims and the blocking ``states``
 check), the dense paths from rest and every switch between two states (``state_poses`` with
-``max_move`` = the profile's clearance: the ``motion_clearance`` goal), the parts, the report.
+``max_move`` = the profile's clearance: the motion trims and the ``motion_clearance`` goal), the
+parts, the report.
 Writes benchmarks/results/mesh_gates.json: per (gate, signal, profile) whether the report
 passes, the failed checks (blocking, and the goals that do not block yet), part count, the
 number of dense poses, the smallest gap in motion and the pairs under the clearance, wall and
@@ -16,7 +17,8 @@ CPU seconds.
 dependency): the Flexible Collision Library's mesh-mesh distance (its own BVH and
 triangle-triangle distance, not manifold3d's ``min_gap``) between every two parts whose posed
 bounding boxes come within twice the clearance, in every ``--fcl-every``-th dense pose and in
-every pose where mlc's goal names a pair (``--fcl-profiles``: about 20 ms a query, so not every
+every pose where mlc's goal names a pair or where a motion trim was made (the pair was closer
+than the clearance there before the trim) (``--fcl-profiles``: about 20 ms a query, so not every
 profile); recorded as ``fcl_smallest_gap_mm``, ``fcl_pairs_below_clearance`` (poses x pairs)
 and ``fcl_poses``, with ``motion_below_clearance_in_fcl_poses`` (mlc's count in the same poses).
 """
@@ -103,7 +105,8 @@ def main() -> int:
                 wall, cpu = time.perf_counter() - t0, time.process_time() - c0
                 mc = rep.check("motion_clearance")
                 dense, _ = state_poses(scene, max_move=profile.clearance / profile.sigma_mm)   # as export_assembly
-                named = {f.split(": ")[0] for f in mc.failures}
+                # FCL also in every pose where a motion trim was made (short of the clearance before)
+                named = {f.split(": ")[0] for f in mc.failures} | {k for t in asm.motion_trims for k in t["poses"]}
                 sub = {k: v for n, (k, v) in enumerate(dense.items()) if n % args.fcl_every == 0 or k in named}
                 if prof not in args.fcl_profiles:
                     sub = {}
@@ -118,6 +121,9 @@ def main() -> int:
                        "fcl_smallest_gap_mm": None if g is None else round(g, 6), "fcl_pairs_below_clearance": below,
                        "fcl_queries": nq, "fcl_poses": len(sub), "motion_below_clearance_in_fcl_poses": mlc_in_sub,
                        "trims": [n for n in asm.notes if n.startswith("trimmed")],
+                       "motion_trims": [{k: v for k, v in t.items() if k != "poses"} | {"poses": len(t["poses"])}
+                                        for t in asm.motion_trims],
+                       "motion_trimmed_poses": len({k for t in asm.motion_trims for k in t["poses"]}),
                        "export_s": round(wall, 2), "export_cpu_s": round(cpu, 2)}
                 rows.append(row)
                 print(json.dumps(row), flush=True)

@@ -256,6 +256,9 @@ class Assembly:
     cores: dict = field(default_factory=dict)
     cone_conflicts: list = field(default_factory=list)   # pin: cone: [(part, part, state or None)]
     axis_cores: dict = field(default_factory=dict)   # compound junction's joint part: its stack knuckle and pin
+    # the motion trims (_clear_motion): {"part", "clear_of", "poses" (dense pose names where the
+    # pair was closer than the clearance before the trim), "removed_mm3", "settled"}
+    motion_trims: list = field(default_factory=list)
 
     def part(self, name: str) -> Part:
         for p in self.parts:
@@ -321,21 +324,28 @@ def reuses(scene: Scene) -> bool:
 
 # --------------------------------------------------------------------------- build
 def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
-                   resolve: bool = True, reuse: bool | None = None) -> Assembly:
+                   resolve: bool = True, reuse: bool | None = None,
+                   motion_poses: dict | None = None) -> Assembly:
     """Build the printable parts of ``scene`` (rest pose) for ``profile``.
 
     ``poses`` maps logic states to body poses ``(pos, quat)`` (sigma); hinge trim radii
     are chosen so that slabs clear each other in every one of them.  ``reuse``: test and trim
     each pair of congruent parts once per relative pose (:mod:`mlc.mesh.congruence`); by
     default on for assemblies of at least :data:`REUSE_MIN_PARTS` parts (compiled circuits),
-    off for the library gates, whose meshes stay exactly as they were."""
+    off for the library gates, whose meshes stay exactly as they were.
+
+    ``motion_poses`` (``{name: (pos, quat)}``, sigma: the dense paths and switches of
+    :func:`mlc.mesh.pipeline.state_poses` with ``max_move``): after the trims of the logic states,
+    slabs that come closer than the clearance in any of these poses are trimmed too
+    (:func:`_clear_motion`), as ``mlc stl`` does for a mechanism of fewer than
+    :data:`REUSE_MIN_PARTS` parts."""
     try:
-        return _build_assembly(scene, profile, poses, resolve, reuse)
+        return _build_assembly(scene, profile, poses, resolve, reuse, motion_poses)
     finally:
         _LOCAL[0] = None     # primitives are built in the world again, whatever happened
 
 
-def _build_assembly(scene, profile, poses, resolve, reuse) -> Assembly:
+def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) -> Assembly:
     prof = profile
     _LOCAL[0] = None
     s = prof.sigma_mm
@@ -821,6 +831,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse) -> Assembly:
             _cone_refuse(asm, scene, prof, poses, r_cone, h_cone)
     if resolve:
         _resolve(asm, protected, soft, state_T, asm.congruence, fat_guard)
+        if motion_poses and not reuse:
+            _clear_motion(asm, protected, soft, motion_poses)
     _log("final trims done; drilling")
     _drill(asm, lugs, lug_hole, lug_out, t)
     asm.orient = _orientation(asm)
@@ -1878,6 +1890,169 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
         if not changed:
             return
         filters.append(changed)
+
+
+#: growths of the other part (times the clearance) tried in turn by the motion trims
+MOTION_GROWS = (1.25, 1.5, 2.0)
+#: rounds of motion trims, each measuring the dense poses again
+MOTION_ROUNDS = 3
+#: gap (mm) below which a pair is closer than the clearance (mlc.mesh.checks.GAP_EPS)
+MOTION_EPS = 1e-6
+
+
+def _clear_motion(asm: "Assembly", protected: dict, soft_protected: dict, motion_poses: dict) -> None:
+    """Trim slabs that come closer than the clearance in a pose of ``motion_poses`` (``{name:
+    (pos, quat)}``, sigma: the dense paths and switches of the ``motion_clearance`` goal,
+    :func:`mlc.mesh.checks.motion_check`), after :func:`_resolve` has cleared the logic states.
+
+    Every pair closer than the clearance in some of the poses (:func:`mlc.mesh.spatial.posed_gaps`)
+    is settled by trimming one of its two parts, X (never a joint part), in X's rest frame: X loses,
+    for each such pose, the other part Y moved relative to X, cropped to the region of Y within
+    reach of X (:func:`_near_crop`), each connected piece replaced by its convex hull grown by
+    ``g`` (the hull of the piece and its 26 translates by ``g`` along the directions of a cube's
+    faces, edges and corners), less X's guards (knuckles, pins; first also the attachment-hole
+    spot, as in :func:`_resolve`).  Convex hulls keep the cost bounded: one union of a few convex
+    solids a pose and one subtraction, never a union of near-coincident translates (which took
+    gigabytes).  ``g`` is tried as :data:`MOTION_GROWS` times the clearance until every pose of the
+    pair keeps the clearance.  The trim kept is the one that settles, stays in one piece, keeps the
+    attachment spot and removes least; a trim that splits a part is never kept.  Trimming only
+    takes material away, so no other gap shrinks.  Notes say what was trimmed and what was not
+    settled (the goal reports it)."""
+    c = asm.profile.clearance
+    if c <= 0 or not motion_poses:
+        return
+    parts = asm.parts
+    names = list(motion_poses)
+    Ts = [asm.part_transforms(*motion_poses[k]) for k in names]
+    frames = part_frames(asm)
+    dirs = [np.array(v, float) / np.linalg.norm(v) for v in itertools.product((-1, 0, 1), repeat=3) if any(v)]
+    off = np.array([np.zeros(3)] + dirs)
+    h = 0.5 * c                       # spacing of the surface samples that find the near region
+    samples: dict = {}
+
+    def pts(P):
+        if samples.get(P.name, (None,))[0] is not P.solid:
+            samples[P.name] = (P.solid, _surface_points(P.solid, h))
+        return samples[P.name][1]
+
+    from mlc.mesh.spatial import posed_gaps
+    from scipy.spatial import cKDTree
+    tried: set = set()
+    only = None           # after the first round only the pairs of a trimmed part can change
+    for _round in range(MOTION_ROUNDS):
+        lo, hi = local_boxes([p.solid for p in parts], frames)
+        _log(f"motion trims round {_round}: measuring {len(Ts)} dense poses")
+        close, _ = posed_gaps([p.solid for p in parts], frames, lo, hi,
+                              [[T[p.name] for p in parts] for T in Ts], c, MOTION_EPS, only)
+        pairs: dict = {}
+        for k, here in enumerate(close):
+            for ij in here:
+                pairs.setdefault(ij, []).append(k)
+        _log(f"motion trims round {_round}: {len(pairs)} pair(s) within the clearance")
+        changed = set()
+        for (i, j), ks in sorted(pairs.items()):
+            A, B = parts[i], parts[j]
+            key = (A.name, B.name, A.solid.num_vert(), B.solid.num_vert(), tuple(ks))
+            if key in tried:
+                continue              # the same pair, unchanged, in the same poses: no better now
+            tried.add(key)
+            cands = []
+            for X, Y in ((A, B), (B, A)):
+                if X.kind == "joint":
+                    continue
+                tree = cKDTree(pts(X))
+                Ms = [np.linalg.solve(Ts[k][X.name], Ts[k][Y.name]) for k in ks]
+                guards = ((False, soft_protected.get(X.name)), (True, protected.get(X.name)))
+                for lost, guard in guards:
+                    if guard is None:
+                        continue
+                    keep = X.solid ^ guard
+                    trimmed, ok, best = None, False, -1.0
+                    for f in MOTION_GROWS:
+                        g = f * c
+                        _log(f"  {X.name} less {Y.name} grown by {g:.3g} in {len(Ms)} pose(s)")
+                        tool = []
+                        for M in Ms:
+                            Yp = transform_solid(Y.solid, M)
+                            crop = _near_crop(tree, pts(Y) @ M[:3, :3].T + M[:3, 3], g + 2 * h)
+                            if crop is None:
+                                continue
+                            for piece in (Yp ^ crop).decompose():
+                                V = np.asarray(piece.to_mesh().vert_properties, float)[:, :3]
+                                if len(V) >= 4:
+                                    tool.append(mf.Manifold.hull_points(
+                                        (V[None, :, :] + g * off[:, None, :]).reshape(-1, 3)))
+                        if not tool:
+                            break
+                        _log(f"    {len(tool)} hulls")
+                        trimmed = _clean(X.solid - (union(tool) - keep))
+                        _log(f"    trimmed: {trimmed.num_vert()} v")
+                        gaps = [trimmed.min_gap(transform_solid(Y.solid, M), c) for M in Ms]
+                        _log(f"    smallest gap {min(gaps):.5f} mm, {sum(x < c - MOTION_EPS for x in gaps)} pose(s) short")
+                        ok = all(x >= c - MOTION_EPS for x in gaps)
+                        if ok or min(gaps) <= best + MOTION_EPS:
+                            break     # settled, or the guards hold the short gap: growing more cannot help
+                        best = min(gaps)
+                    if trimmed is None:
+                        continue
+                    removed = X.solid.volume() - trimmed.volume()
+                    if removed <= 1e-9 or len(trimmed.decompose()) != 1:
+                        continue
+                    cands.append((not ok, lost, removed, X, trimmed, Y))
+                    if ok:
+                        break
+                if cands and cands[0][:2] == (False, False):
+                    break         # settled keeping the attachment spot: the other part is not tried
+            if not cands:
+                asm.notes.append(f"{A.name} and {B.name} come within the clearance in {len(ks)} pose(s) of the "
+                                 "dense paths: no trim settles it (knuckles, pins or the joint part)")
+                continue
+            unsettled, lost, removed, X, trimmed, Y = min(cands, key=lambda x: x[:3])
+            X.solid = trimmed
+            changed.add(parts.index(X))
+            asm.motion_trims.append({"part": X.name, "clear_of": Y.name, "poses": [names[k] for k in ks],
+                                     "removed_mm3": round(float(removed), 6), "settled": not unsettled})
+            asm.notes.append(f"trimmed {removed:.3g} mm^3 from {X.name} to keep the clearance from {Y.name} in "
+                             f"{len(ks)} pose(s) of the dense paths" + (" (not settled)" if unsettled else ""))
+        if not changed:
+            return
+        only = changed
+
+
+def _surface_points(solid: mf.Manifold, h: float) -> np.ndarray:
+    """Points on the surface of ``solid`` no farther than ``h`` (mm) from every surface point: each
+    triangle's vertices and a regular barycentric grid of edge at most ``h`` (deterministic)."""
+    m = solid.to_mesh()
+    V = np.asarray(m.vert_properties, float)[:, :3]
+    F = np.asarray(m.tri_verts, np.int64)
+    if len(F) == 0:
+        return V
+    a, b, cc = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    edge = np.max([np.linalg.norm(b - a, axis=1), np.linalg.norm(cc - b, axis=1), np.linalg.norm(a - cc, axis=1)],
+                  axis=0)
+    n = np.maximum(1, np.ceil(edge / h).astype(int))
+    out = [V]
+    for k in np.unique(n):
+        sel = n == k
+        ij = np.array([(x, y) for x in range(k + 1) for y in range(k + 1 - x)], float) / k
+        out.append((a[sel][:, None, :] + ij[None, :, 0, None] * (b[sel] - a[sel])[:, None, :]
+                    + ij[None, :, 1, None] * (cc[sel] - a[sel])[:, None, :]).reshape(-1, 3))
+    return np.concatenate(out)
+
+
+def _near_crop(tree, Y_pts, reach: float):
+    """A box (manifold, X's rest frame) holding every point of Y within ``reach - 2 h`` (mm) of X,
+    ``h`` the spacing of the surface samples: X's in ``tree`` (a cKDTree), Y's in ``Y_pts`` (posed
+    in X's frame).  A point y of Y within g of X has a surface point y' of Y on its way to X, as
+    near to X and at most g from y; y' lies within h of a sample of Y, and that sample within
+    g + 2 h of a sample of X; so the box of such samples grown by ``reach`` holds y.  None if no
+    sample of Y comes within ``reach``."""
+    d, _ = tree.query(Y_pts, distance_upper_bound=reach)
+    near = Y_pts[np.isfinite(d)]
+    if len(near) == 0:
+        return None
+    lo, hi = near.min(axis=0) - reach, near.max(axis=0) + reach
+    return mf.Manifold.cube((hi - lo).tolist()).translate(lo.tolist())
 
 
 TRIM_SECONDS = 30.0       # large assemblies: time cap of one pair's final trim (s)

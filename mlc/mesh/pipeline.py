@@ -274,7 +274,7 @@ def export_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                 notes.append(note)
             dense = _dense_poses(scene, profile, notes)
         _log("building parts")
-        asm = build_assembly(scene, profile, poses)
+        asm = build_assembly(scene, profile, poses, motion_poses=dense)
         asm.notes[:0] = notes
         _log("printability checks")
         rep = check_assembly(asm, motion_poses=dense)
@@ -302,7 +302,7 @@ def export_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
         if note:
             notes.append(note)
         dense = _dense_poses(sub, profile, notes) if solve else None
-        a = build_assembly(sub, profile, p or None)
+        a = build_assembly(sub, profile, p or None, motion_poses=dense)
         r = check_assembly(a, motion_poses=dense)
         built[k] = (a, r)
 

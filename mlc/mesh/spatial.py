@@ -148,7 +148,8 @@ def obb_overlap(pairs, frames, lo, hi, pad: float = 1e-6) -> list[tuple[int, int
     return [(int(x), int(y)) for x, y in P[ok]]
 
 
-def posed_gaps(solids, frames, lo, hi, poses, clearance: float, eps: float = 1e-6) -> tuple[list, tuple | None]:
+def posed_gaps(solids, frames, lo, hi, poses, clearance: float, eps: float = 1e-6,
+               only=None) -> tuple[list, tuple | None]:
     """The gaps (mm) between solids moved into each of ``poses`` (a list of lists of 4x4 rest ->
     posed transforms, one per solid), where they come closer than ``clearance``.
 
@@ -162,7 +163,7 @@ def posed_gaps(solids, frames, lo, hi, poses, clearance: float, eps: float = 1e-
     a point of the pair, and that move is largest at a corner of one solid's local box (the norm
     of an affine map is convex), so a pair measured at ``g`` in pose ``m`` is at least
     ``g - move`` apart in pose ``k``.  Poses along a path, in order, are measured only where the
-    pair has come close."""
+    pair has come close.  ``only``: a set of solid indices; pairs with neither are not measured."""
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
     F = np.asarray(frames, float).reshape(-1, 4, 4)
     sel = np.array([[(hi if (c >> a) & 1 else lo)[:, a] for a in range(3)] for c in range(8)])
@@ -174,8 +175,10 @@ def posed_gaps(solids, frames, lo, hi, poses, clearance: float, eps: float = 1e-
     for k, Tp in enumerate(poses):
         Tp = [np.asarray(t, float) for t in Tp]
         plo, phi = posed_boxes(wlo, whi, Tp)
-        pairs = obb_overlap(box_pairs(plo, phi, clearance), [t @ f for t, f in zip(Tp, F)], lo, hi,
-                            pad=0.5 * clearance + eps)
+        cand = box_pairs(plo, phi, clearance)
+        if only is not None:
+            cand = [(i, j) for i, j in cand if i in only or j in only]
+        pairs = obb_overlap(cand, [t @ f for t, f in zip(Tp, F)], lo, hi, pad=0.5 * clearance + eps)
         posed: dict = {}
         here = {}
         for i, j in pairs:
