@@ -2,8 +2,9 @@
 
     python benchmarks/slicer_gates.py [--signal expand] [--gates NAND,NOR] [--profiles mjp,sla,fdm]
 
-For each gate and profile: build the printable assembly (posed in every logic state and on the
-way to them, as ``mlc stl`` does), write the 3MF (one object, the parts as volumes), ask
+For each gate and profile: build the printable assembly with ``export_assembly``, exactly as
+``mlc stl`` does (posed in every logic state and on the way to them, the dense paths and their
+motion trims, the printability report), write the 3MF (one object, the parts as volumes), ask
 ``prusa-slicer --info`` how many objects and parts it sees, then slice it twice -- without and
 with supports (``--support-material``) -- and read the G-code's own summary: layers
 (``;LAYER_CHANGE``), estimated time, filament volume.  The support volume is the difference of
@@ -28,10 +29,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from mlc.gates.library import GATE_NAMES, gate_scene  # noqa: E402
-from mlc.mesh.build import build_assembly, transform_solid  # noqa: E402
+from mlc.mesh.build import transform_solid  # noqa: E402
 from mlc.mesh.checks import OVERHANG_DEG  # noqa: E402
 from mlc.mesh.export import part_meshes, threemf_bytes  # noqa: E402
-from mlc.mesh.pipeline import state_poses  # noqa: E402
+from mlc.mesh.pipeline import export_assembly  # noqa: E402
 from mlc.mesh.printability import bed_stats  # noqa: E402
 from mlc.mesh.profiles import load_profile  # noqa: E402
 
@@ -91,13 +92,10 @@ def main() -> int:
     tmp = Path(tempfile.mkdtemp(prefix="mlc_slicer_"))
     for g in a.gates.split(","):
         scene = gate_scene(g, a.signal)
-        t0 = time.perf_counter()
-        poses, _ = state_poses(scene)
-        t_pose = time.perf_counter() - t0
         for pn in a.profiles.split(","):
             prof = load_profile(pn)
             t0 = time.perf_counter()
-            asm = build_assembly(scene, prof, poses)
+            asm, rep = export_assembly(scene, prof)
             t_build = time.perf_counter() - t0
             f = tmp / f"{g}_{a.signal}_{pn}.3mf"
             f.write_bytes(threemf_bytes(part_meshes(asm), f"{g}_{a.signal}"))
@@ -106,7 +104,9 @@ def main() -> int:
                            first_layer=min(0.2, prof.min_wall / 2))
             row = {"gate": g, "signal": a.signal, "profile": pn, "orient": prof.orient, "layer_mm": LAYER[pn],
                    "parts": len(asm.parts), "part_volume_mm3": round(sum(float(p.solid.volume()) for p in asm.parts), 1),
-                   "pose_s": round(t_pose, 2), "build_s": round(t_build, 2), "mlc_bed": bs.to_dict(),
+                   "export_s": round(t_build, 2), "report_ok": rep.ok,
+                   "goals_not_met": sorted(c.name for c in rep.checks if not c.ok and not c.blocking),
+                   "motion_trims": len(asm.motion_trims), "mlc_bed": bs.to_dict(),
                    "prusa_info": info(exe, f),
                    "no_supports": slice_once(exe, f, LAYER[pn], False),
                    "supports": slice_once(exe, f, LAYER[pn], True)}

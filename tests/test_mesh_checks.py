@@ -163,3 +163,64 @@ def test_motion_clearance_fails_within_the_clearance_without_meeting():
     mc = motion_check(asm, poses)
     assert mc.ok and (mc.value is None or mc.value >= c - 1e-6), mc.detail
     assert not motion_check(asm, None).ok              # not measured: not met
+
+
+def _verts(asm, name):
+    """The vertices of a part's solid in the scene's frame (mm; part_meshes are in the print frame)."""
+    return np.asarray(asm.part(name).solid.to_mesh().vert_properties, float)[:, :3]
+
+
+def test_motion_trims_clear_a_pair_within_the_clearance():
+    """The two slabs of the test above, half a clearance apart in one pose, given to the build as a
+    motion pose (what ``mlc stl`` does with the dense paths): one slab is trimmed where it faces the
+    other, and in that pose the faces (measured on the meshes' own vertices) are at least the
+    clearance apart; the slab stays in one piece and loses only a layer of its face, and the goal
+    is met.  Without the motion pose nothing is trimmed."""
+    from mlc.scene.model import Scene
+    prof = load_profile("mjp")
+    c, s = prof.clearance, prof.sigma_mm
+    sc = Scene("two_slabs", [ex._slab("A", 0.0), ex._slab("B", 0.0, origin=(0.0, 1.0, 0.0))], []).check()
+    rest = (np.array([b.position for b in sc.bodies], float), np.array([b.orientation for b in sc.bodies], float))
+    plain = build_assembly(sc, prof, {"0": rest})
+    g0 = _verts(plain, "B")[:, 1].min() - _verts(plain, "A")[:, 1].max()      # mm, faces normal to y
+    p = rest[0].copy()
+    p[1, 1] -= (g0 - 0.5 * c) / s
+    near = {"near": (p, rest[1])}
+    asm = build_assembly(sc, prof, {"0": rest}, motion_poses=near)
+    assert plain.motion_trims == [] and len(asm.motion_trims) == 1, asm.motion_trims
+    t = asm.motion_trims[0]
+    assert t["poses"] == ["near"] and t["settled"] and {t["part"], t["clear_of"]} == {"A", "B"}
+    T = asm.part_transforms(*near["near"])
+    posed = {n: _verts(asm, n) @ T[n][:3, :3].T + T[n][:3, 3] for n in ("A", "B")}
+    assert posed["B"][:, 1].min() - posed["A"][:, 1].max() >= c - 1e-6
+    X = asm.part(t["part"]).solid
+    before = plain.part(t["part"]).solid.volume()
+    assert len(X.decompose()) == 1 and 0 < before - X.volume() < 0.5 * before
+    assert abs(before - X.volume() - t["removed_mm3"]) < 1e-5
+    mc = check_assembly(asm, walls=False, motion_poses=near).check("motion_clearance")
+    assert mc.ok, mc.detail
+
+
+def test_ring_lug_placement_keeps_the_clearance_in_motion():
+    """An attachment ring lug placed after the motion trims (build._drill) must keep the clearance
+    in the dense poses too: a ring on slab A's face is refused when slab B comes half a clearance
+    from that face in a dense pose, and accepted when that pose is only a logic state (meeting
+    nothing) or absent."""
+    from mlc.mesh.build import _ring_clear, box
+    from mlc.scene.model import Scene
+    prof = load_profile("mjp")
+    c, s = prof.clearance, prof.sigma_mm
+    sc = Scene("two_slabs", [ex._slab("A", 0.0), ex._slab("B", 0.0, origin=(0.0, 1.0, 0.0))], []).check()
+    rest = (np.array([b.position for b in sc.bodies], float), np.array([b.orientation for b in sc.bodies], float))
+    asm = build_assembly(sc, prof, {"0": rest}, resolve=False)
+    A = _verts(asm, "A")
+    top = A[:, 1].max()
+    g0 = _verts(asm, "B")[:, 1].min() - top
+    p = rest[0].copy()
+    p[1, 1] -= (g0 - 0.5 * c) / s
+    T = asm.part_transforms(p, rest[1])
+    ring = box(np.r_[A[:, 0].mean(), top - 0.1, A[:, 2].mean()], np.eye(3), [1.0, 0.2, 1.0])
+    assert _ring_clear(asm, asm.part("A"), ring)                  # as printed and at rest: clear
+    assert not _ring_clear(asm, asm.part("A"), ring, [T])         # within the clearance in motion
+    asm.poses = {"0": rest, "near": (p, rest[1])}
+    assert _ring_clear(asm, asm.part("A"), ring)                  # a logic state: only meeting counts

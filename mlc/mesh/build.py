@@ -834,7 +834,9 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         if motion_poses and not reuse:
             _clear_motion(asm, protected, soft, motion_poses)
     _log("final trims done; drilling")
-    _drill(asm, lugs, lug_hole, lug_out, t)
+    motion_T = ([asm.part_transforms(*pq) for pq in motion_poses.values()]
+                if resolve and motion_poses and not reuse else [])
+    _drill(asm, lugs, lug_hole, lug_out, t, motion_T)
     asm.orient = _orientation(asm)
     _log("assembly done")
     return asm
@@ -1599,32 +1601,43 @@ def _spot(sb, p, lug_out):
     return sb.center + sb.R @ q
 
 
-def _ring_clear(asm: "Assembly", part: "Part", ring) -> bool:
+def _ring_clear(asm: "Assembly", part: "Part", ring, motion_T=()) -> bool:
     """True if ``ring`` (in ``part``'s rest frame) keeps the clearance from every other part as
-    printed and meets none in any logic state."""
+    printed and meets none in any logic state; with ``motion_T`` (the part transforms of the dense
+    poses, :func:`_clear_motion`) it also keeps the clearance in each of those."""
     c = asm.profile.clearance
     rb = np.asarray(ring.bounding_box())
-    Ts = [asm.part_transforms(pos, quat) for pos, quat in (asm.poses or {}).values()]
+    Ts = [(T, False) for T in (asm.part_transforms(pos, quat) for pos, quat in (asm.poses or {}).values())]
+    Ts += [(T, True) for T in motion_T]
     for other in asm.parts:
         if other is part:
             continue
         ob = np.asarray(other.solid.bounding_box())
         if _bb_near(rb, ob, 2 * c) and ring.min_gap(other.solid, c) < c - 1e-6:
             return False
-        for T in Ts:
+        for T, keep_clear in Ts:
             M = np.linalg.inv(T[part.name]) @ T[other.name]
             plo, phi = posed_boxes(ob[:3], ob[3:], [M])
-            if not _bb_near(rb, np.concatenate([plo[0], phi[0]]), 0.0):
+            margin = c if keep_clear else 0.0
+            if not _bb_near(rb, np.concatenate([plo[0], phi[0]]), margin):
                 continue       # the moved part's box (which contains its exact box) misses the ring
             o = transform_solid(other.solid, M)
-            if _bb_near(rb, np.asarray(o.bounding_box()), 0.0) and (ring ^ o).volume() > 1e-6:
+            if not _bb_near(rb, np.asarray(o.bounding_box()), margin):
+                continue
+            if keep_clear:
+                if ring.min_gap(o, c) < c - 1e-6:
+                    return False
+            elif (ring ^ o).volume() > 1e-6:
                 return False
     return True
 
 
-def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t) -> None:
+def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t, motion_T=()) -> None:
     """Drill each attachment hole inside its slab, at the spot nearest to the site where a
-    full ring of material (``min_wall``) surrounds the hole."""
+    full ring of material (``min_wall``) surrounds the hole; where there is no room, on a ring lug
+    at the site or further along the arm: the first that keeps the clearance in the dense poses
+    ``motion_T`` too, else the first that meets no part in a logic state (the ``motion_clearance``
+    goal then reports it)."""
     n = asm.profile.circular_segments
     for part in asm.parts:
         for site, nrm, ring, _, sb, label in lugs.get(part.name, []):
@@ -1660,13 +1673,17 @@ def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t) -> None:
                 L = max(inplane, key=lambda i: sb.size[i])
                 along = [c for c in cands[order] if abs((sb.R.T @ (c - sb.center))[[i for i in inplane
                                                                                       if i != L][0]]) < step]
-                for c in [site] + along[:10]:
+                spots = [site] + along[:10]
+                tries = [(c, m) for m in ((motion_T, ()) if motion_T else ((),)) for c in spots]
+                for c, m in tries:
                     ringd = cylinder(c, nrm, -t / 2, t / 2, lug_out, n)
-                    if _ring_clear(asm, part, ringd):
+                    if _ring_clear(asm, part, ringd, m):
                         part.solid = subtract(union([part.solid, ringd]),
                                               [cylinder(c, nrm, -t - 1, t + 1, lug_hole, n, cutter=True)])
                         asm.notes.append(f"{label}: no room inside the trimmed slab; a ring lug "
-                                         f"{np.linalg.norm(c - site):.2f} mm from the site instead")
+                                         f"{np.linalg.norm(c - site):.2f} mm from the site instead"
+                                         + (" (it does not keep the clearance in motion)" if motion_T and not m
+                                            else ""))
                         break
                 else:
                     asm.notes.append(f"{label}: no room for an attachment hole in the trimmed slab, "
@@ -1956,17 +1973,19 @@ def _clear_motion(asm: "Assembly", protected: dict, soft_protected: dict, motion
             if key in tried:
                 continue              # the same pair, unchanged, in the same poses: no better now
             tried.add(key)
+            if {i, j} & changed and all(
+                    _posed_gap(A, B, Ts[k], c) >= c - MOTION_EPS for k in ks):
+                continue              # settled by a trim of one of them earlier in this round
             cands = []
             for X, Y in ((A, B), (B, A)):
                 if X.kind == "joint":
                     continue
                 tree = cKDTree(pts(X))
                 Ms = [np.linalg.solve(Ts[k][X.name], Ts[k][Y.name]) for k in ks]
-                guards = ((False, soft_protected.get(X.name)), (True, protected.get(X.name)))
-                for lost, guard in guards:
-                    if guard is None:
-                        continue
-                    keep = X.solid ^ guard
+                guards = [(lost, gd) for lost, gd in ((False, soft_protected.get(X.name)),
+                                                       (True, protected.get(X.name))) if gd is not None]
+                for lost, guard in guards or [(False, None)]:
+                    keep = mf.Manifold() if guard is None else X.solid ^ guard
                     trimmed, ok, best = None, False, -1.0
                     for f in MOTION_GROWS:
                         g = f * c
@@ -2017,6 +2036,13 @@ def _clear_motion(asm: "Assembly", protected: dict, soft_protected: dict, motion
         if not changed:
             return
         only = changed
+
+
+def _posed_gap(A: "Part", B: "Part", T: dict, search: float) -> float:
+    """The gap (mm) between parts ``A`` and ``B`` moved by the part transforms ``T``, searched to
+    ``search`` (manifold3d ``min_gap``)."""
+    M = np.linalg.solve(T[A.name], T[B.name])
+    return float(A.solid.min_gap(transform_solid(B.solid, M), search))
 
 
 def _surface_points(solid: mf.Manifold, h: float) -> np.ndarray:
