@@ -19,7 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from mlc.mesh.build import Assembly, Part, _log, _orientation, build_assembly, transform_solid
-from mlc.mesh.checks import (GAP_EPS, NON_BLOCKING, VOL_EPS, Check, Report, _bbox, _pairs, bed_checks,
+from mlc.mesh.checks import (GAP_EPS, VOL_EPS, Check, Report, _bbox, _pairs, bed_checks,
                              check_assembly, print_size)
 from mlc.mesh.profiles import Profile
 from mlc.scene.model import Scene
@@ -142,7 +142,8 @@ def state_poses(scene: Scene, max_states: int = MAX_STATES, path_steps: int = PA
     sample of the states was posed.
 
     ``max_move`` (sigma; ``mlc stl`` passes the profile's clearance for a mechanism of fewer
-    than ``REUSE_MIN_PARTS`` parts, such as a library gate, for its ``motion_clearance`` goal)
+    than ``REUSE_MIN_PARTS`` parts, such as a library gate, for its motion trims and its
+    ``motion_clearance`` check)
     makes the paths dense and adds the switches between states (for at most
     ``TRANSITION_STATES`` states; keys ``"01@0.500"`` on the paths from rest):
 
@@ -241,7 +242,8 @@ def state_poses(scene: Scene, max_states: int = MAX_STATES, path_steps: int = PA
 
 
 def _dense_poses(scene: Scene, profile: Profile, notes: list) -> dict | None:
-    """The poses of the ``motion_clearance`` goal (mlc.mesh.checks.motion_check): for a mechanism
+    """The dense poses of the motion trims (mlc.mesh.build._clear_motion) and of the
+    ``motion_clearance`` check (mlc.mesh.checks.motion_check): for a mechanism
     of fewer than ``REUSE_MIN_PARTS`` parts, :func:`state_poses` with ``max_move`` the clearance in
     sigma (two parts that keep the clearance in two consecutive poses, each point moving at most
     that much, cannot meet between them); None for a larger one (a compiled circuit: too many)."""
@@ -425,7 +427,8 @@ def _merge_reports(scene, profile, mechs, built, full, owner) -> Report:
     checks.append(Check("motion_clearance", all(ch.ok for _, ch in subs), min(vals) if vals else None, c,
                         "; ".join(f"{mechs[k].scene.name}: {ch.detail}" for k, ch in subs)[:2000],
                         [f"{mechs[k].scene.name}: {f}" for k, ch in subs for f in ch.failures],
-                        "motion_clearance" not in NON_BLOCKING))
+                        # a measured mechanism short of the clearance blocks; not measured does not
+                        any(not ch.ok and ch.blocking for _, ch in subs) or all(ch.ok for _, ch in subs)))
     # measured walls: per distinct mechanism (copies are translated, their walls the same)
     walls = [(k, reps[k].check("wall_thickness")) for k in reps if "wall_thickness" in
              {c.name for c in reps[k].checks}]
