@@ -1637,7 +1637,7 @@ def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t, motion_T=()) -> None:
     full ring of material (``min_wall``) surrounds the hole; where there is no room, on a ring lug
     at the site or further along the arm: the first that keeps the clearance in the dense poses
     ``motion_T`` too, else the first that meets no part in a logic state (the ``motion_clearance``
-    goal then reports it)."""
+    check then fails)."""
     n = asm.profile.circular_segments
     for part in asm.parts:
         for site, nrm, ring, _, sb, label in lugs.get(part.name, []):
@@ -1927,14 +1927,15 @@ def _clear_motion(asm: "Assembly", protected: dict, soft_protected: dict, motion
     for each such pose, the other part Y moved relative to X, cropped to the region of Y within
     reach of X (:func:`_near_crop`), each connected piece replaced by its convex hull grown by
     ``g`` (the hull of the piece and its 26 translates by ``g`` along the directions of a cube's
-    faces, edges and corners), less X's guards (knuckles, pins; first also the attachment-hole
+    faces, edges and corners, which holds the piece grown by a ball of radius 0.886 ``g``), less
+    X's guards (knuckles, pins; first also the attachment-hole
     spot, as in :func:`_resolve`).  Convex hulls keep the cost bounded: one union of a few convex
     solids a pose and one subtraction, never a union of near-coincident translates (which took
     gigabytes).  ``g`` is tried as :data:`MOTION_GROWS` times the clearance until every pose of the
     pair keeps the clearance.  The trim kept is the one that settles, stays in one piece, keeps the
     attachment spot and removes least; a trim that splits a part is never kept.  Trimming only
     takes material away, so no other gap shrinks.  Notes say what was trimmed and what was not
-    settled (the goal reports it)."""
+    settled (the ``motion_clearance`` check then fails)."""
     c = asm.profile.clearance
     if c <= 0 or not motion_poses:
         return
@@ -1955,6 +1956,7 @@ def _clear_motion(asm: "Assembly", protected: dict, soft_protected: dict, motion
     from mlc.mesh.spatial import posed_gaps
     from scipy.spatial import cKDTree
     tried: set = set()
+    version = {p.name: 0 for p in parts}      # trims of each part so far
     only = None           # after the first round only the pairs of a trimmed part can change
     for _round in range(MOTION_ROUNDS):
         lo, hi = local_boxes([p.solid for p in parts], frames)
@@ -1969,7 +1971,7 @@ def _clear_motion(asm: "Assembly", protected: dict, soft_protected: dict, motion
         changed = set()
         for (i, j), ks in sorted(pairs.items()):
             A, B = parts[i], parts[j]
-            key = (A.name, B.name, A.solid.num_vert(), B.solid.num_vert(), tuple(ks))
+            key = (A.name, B.name, version[A.name], version[B.name], tuple(ks))
             if key in tried:
                 continue              # the same pair, unchanged, in the same poses: no better now
             tried.add(key)
@@ -2028,6 +2030,7 @@ def _clear_motion(asm: "Assembly", protected: dict, soft_protected: dict, motion
                 continue
             unsettled, lost, removed, X, trimmed, Y = min(cands, key=lambda x: x[:3])
             X.solid = trimmed
+            version[X.name] += 1
             changed.add(parts.index(X))
             asm.motion_trims.append({"part": X.name, "clear_of": Y.name, "poses": [names[k] for k in ks],
                                      "removed_mm3": round(float(removed), 6), "settled": not unsettled})
