@@ -175,8 +175,8 @@ def test_motion_trims_clear_a_pair_within_the_clearance():
     """The two slabs of the test above, half a clearance apart in one pose, given to the build as a
     motion pose (what ``mlc stl`` does with the dense paths): one slab is trimmed where it faces the
     other, and in that pose the faces (measured on the meshes' own vertices) are at least the
-    clearance apart; the slab stays in one piece and loses only a layer of its face, and the goal
-    is met.  Without the motion pose nothing is trimmed."""
+    clearance apart; the slab stays in one piece and loses only a layer of its face, and the
+    motion_clearance check passes.  Without the motion pose nothing is trimmed."""
     from mlc.scene.model import Scene
     prof = load_profile("mjp")
     c, s = prof.clearance, prof.sigma_mm
