@@ -829,13 +829,14 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         asm.cone_conflicts = _cone_conflicts(asm, cone_cores)
         if asm.cone_conflicts and resolve and not _CONE_PROBE[0]:
             _cone_refuse(asm, scene, prof, poses, r_cone, h_cone)
-    if resolve:
-        _resolve(asm, protected, soft, state_T, asm.congruence, fat_guard)
-        if motion_poses and not reuse:
-            _clear_motion(asm, protected, soft, motion_poses)
-    _log("final trims done; drilling")
+    # the part transforms of the dense poses: trimmed against, then kept clear by the ring lugs
     motion_T = ([asm.part_transforms(*pq) for pq in motion_poses.values()]
                 if resolve and motion_poses and not reuse else [])
+    if resolve:
+        _resolve(asm, protected, soft, state_T, asm.congruence, fat_guard)
+        if motion_T:
+            _clear_motion(asm, protected, soft, list(motion_poses), motion_T)
+    _log("final trims done; drilling")
     _drill(asm, lugs, lug_hole, lug_out, t, motion_T)
     asm.orient = _orientation(asm)
     _log("assembly done")
@@ -1700,8 +1701,7 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
     if c <= 0:
         return
     grow = 1.5 * c
-    # 26 directions (faces, edges, corners of a cube): a close polyhedral stand-in for a ball
-    dirs = [np.array(v, float) / np.linalg.norm(v) for v in itertools.product((-1, 0, 1), repeat=3) if any(v)]
+    dirs = list(CUBE_DIRS)
     poses = asm.poses or {}
     parts = asm.parts
     # with reuse (compiled circuits) only what is too close as printed is trimmed here: the
@@ -1917,10 +1917,11 @@ MOTION_ROUNDS = 3
 MOTION_EPS = 1e-6
 
 
-def _clear_motion(asm: "Assembly", protected: dict, soft_protected: dict, motion_poses: dict) -> None:
-    """Trim slabs that come closer than the clearance in a pose of ``motion_poses`` (``{name:
-    (pos, quat)}``, sigma: the dense paths and switches of the ``motion_clearance`` goal,
-    :func:`mlc.mesh.checks.motion_check`), after :func:`_resolve` has cleared the logic states.
+def _clear_motion(asm: "Assembly", protected: dict, soft_protected: dict, names: list, Ts: list) -> None:
+    """Trim slabs that come closer than the clearance in a pose of the dense paths and switches of
+    the ``motion_clearance`` goal (:func:`mlc.mesh.checks.motion_check`): ``names`` the poses'
+    names, ``Ts`` their part transforms (:meth:`Assembly.part_transforms`), after
+    :func:`_resolve` has cleared the logic states.
 
     Every pair closer than the clearance in some of the poses (:func:`mlc.mesh.spatial.posed_gaps`)
     is settled by trimming one of its two parts, X (never a joint part), in X's rest frame: X loses,
@@ -1937,14 +1938,10 @@ def _clear_motion(asm: "Assembly", protected: dict, soft_protected: dict, motion
     takes material away, so no other gap shrinks.  Notes say what was trimmed and what was not
     settled (the ``motion_clearance`` check then fails)."""
     c = asm.profile.clearance
-    if c <= 0 or not motion_poses:
+    if c <= 0 or not Ts:
         return
     parts = asm.parts
-    names = list(motion_poses)
-    Ts = [asm.part_transforms(*motion_poses[k]) for k in names]
     frames = part_frames(asm)
-    dirs = [np.array(v, float) / np.linalg.norm(v) for v in itertools.product((-1, 0, 1), repeat=3) if any(v)]
-    off = np.array([np.zeros(3)] + dirs)
     h = 0.5 * c                       # spacing of the surface samples that find the near region
     samples: dict = {}
 
@@ -1998,17 +1995,13 @@ def _clear_motion(asm: "Assembly", protected: dict, soft_protected: dict, motion
                             crop = _near_crop(tree, pts(Y) @ M[:3, :3].T + M[:3, 3], g + 2 * h)
                             if crop is None:
                                 continue
-                            for piece in (Yp ^ crop).decompose():
-                                V = np.asarray(piece.to_mesh().vert_properties, float)[:, :3]
-                                if len(V) >= 4:
-                                    tool.append(mf.Manifold.hull_points(
-                                        (V[None, :, :] + g * off[:, None, :]).reshape(-1, 3)))
+                            tool += _grown_hulls(Yp ^ crop, g)
                         if not tool:
                             break
                         _log(f"    {len(tool)} hulls")
                         trimmed = _clean(X.solid - (union(tool) - keep))
                         _log(f"    trimmed: {trimmed.num_vert()} v")
-                        gaps = [trimmed.min_gap(transform_solid(Y.solid, M), c) for M in Ms]
+                        gaps = [_gap(trimmed, Y.solid, M, c) for M in Ms]
                         _log(f"    smallest gap {min(gaps):.5f} mm, {sum(x < c - MOTION_EPS for x in gaps)} pose(s) short")
                         ok = all(x >= c - MOTION_EPS for x in gaps)
                         if ok or min(gaps) <= best + MOTION_EPS:
@@ -2043,9 +2036,32 @@ def _clear_motion(asm: "Assembly", protected: dict, soft_protected: dict, motion
 
 def _posed_gap(A: "Part", B: "Part", T: dict, search: float) -> float:
     """The gap (mm) between parts ``A`` and ``B`` moved by the part transforms ``T``, searched to
-    ``search`` (manifold3d ``min_gap``)."""
-    M = np.linalg.solve(T[A.name], T[B.name])
-    return float(A.solid.min_gap(transform_solid(B.solid, M), search))
+    ``search``."""
+    return _gap(A.solid, B.solid, np.linalg.solve(T[A.name], T[B.name]), search)
+
+
+def _gap(a: mf.Manifold, b: mf.Manifold, M, search: float) -> float:
+    """The gap (mm) between solid ``a`` and solid ``b`` moved by ``M`` (4x4, into ``a``'s
+    frame), searched to ``search`` (manifold3d ``min_gap``)."""
+    return float(a.min_gap(transform_solid(b, M), search))
+
+
+# 26 directions (a cube's faces, edges and corners): a close polyhedral stand-in for a ball
+CUBE_DIRS = np.array([v for v in itertools.product((-1, 0, 1), repeat=3) if any(v)], float)
+CUBE_DIRS /= np.linalg.norm(CUBE_DIRS, axis=1)[:, None]
+
+
+def _grown_hulls(solid: mf.Manifold, g: float) -> list:
+    """Each connected piece of ``solid`` as the convex hull of the piece and its 26 translates
+    by ``g`` along :data:`CUBE_DIRS` (a superset of the piece grown by a ball of radius 0.886
+    ``g``): bounded cost, where a union of the near-coincident translates took gigabytes."""
+    off = np.vstack([np.zeros(3), g * CUBE_DIRS])
+    hulls = []
+    for piece in solid.decompose():
+        V = np.asarray(piece.to_mesh().vert_properties, float)[:, :3]
+        if len(V) >= 4:
+            hulls.append(mf.Manifold.hull_points((V[None, :, :] + off[:, None, :]).reshape(-1, 3)))
+    return hulls
 
 
 def _surface_points(solid: mf.Manifold, h: float) -> np.ndarray:
@@ -2296,17 +2312,12 @@ def _trim_by(X, Y, sts, grow, dirs, keep, state_grow, merged=False):
         # minutes (the memory growth of issue 13).
         res = X.solid
         hit = False
-        off = np.array([np.zeros(3)] + list(dirs))
         for g_, ys in groups.items():
             for Yc in ys:
                 yb = np.asarray(Yc.bounding_box())
                 if not _bb_near(np.asarray(res.bounding_box()), yb, 1.01 * g_):
                     continue
-                hulls = []
-                for piece in Yc.decompose():
-                    V = np.asarray(piece.to_mesh().vert_properties, float)[:, :3]
-                    if len(V) >= 4:
-                        hulls.append(mf.Manifold.hull_points((V[None, :, :] + g_ * off[:, None, :]).reshape(-1, 3)))
+                hulls = _grown_hulls(Yc, g_)
                 if not hulls:
                     continue
                 _log(f"    hull {sum(h.num_vert() for h in hulls)} v, X {res.num_vert()} v")
