@@ -10,7 +10,8 @@ check), the dense paths from rest and every switch between two states (``state_p
 parts, the report.
 Writes benchmarks/results/mesh_gates.json: per (gate, signal, profile) whether the report
 passes, the failed checks (blocking, and the goals that do not block yet), part count, the
-number of dense poses, the smallest gap in motion and the pairs under the clearance, wall and
+number of dense poses, the smallest gap in motion and the pairs under the clearance, the
+measured walls (``thinnest_wall_mm``, ``thin_walls``: the ``wall_thickness`` goal), wall and
 CPU seconds.
 
 **Outside check** (when ``python-fcl`` is installed, ``pip install python-fcl``; not an mlc
@@ -124,6 +125,9 @@ def main() -> int:
                        "motion_trims": [{k: v for k, v in t.items() if k != "poses"} | {"poses": len(t["poses"])}
                                         for t in asm.motion_trims],
                        "motion_trimmed_poses": len({k for t in asm.motion_trims for k in t["poses"]}),
+                       "thinnest_wall_mm": rep.check("wall_thickness").value,
+                       "min_wall_mm": profile.min_wall,
+                       "thin_walls": rep.check("wall_thickness").failures,
                        "export_s": round(wall, 2), "export_cpu_s": round(cpu, 2)}
                 rows.append(row)
                 print(json.dumps(row), flush=True)

@@ -172,11 +172,12 @@ def _verts(asm, name):
 
 
 def test_motion_trims_clear_a_pair_within_the_clearance():
-    """The two slabs of the test above, half a clearance apart in one pose, given to the build as a
-    motion pose (what ``mlc stl`` does with the dense paths): one slab is trimmed where it faces the
-    other, and in that pose the faces (measured on the meshes' own vertices) are at least the
-    clearance apart; the slab stays in one piece and loses only a layer of its face, and the
-    motion_clearance check passes.  Without the motion pose nothing is trimmed."""
+    """The two slabs of the test above, half a clearance apart in one pose even when each is
+    printed from its far face (the slab offsets), given to the build as a motion pose (what ``mlc
+    stl`` does with the dense paths): one slab is trimmed where it faces the other, and in that pose
+    the faces (measured on the meshes' own vertices) are at least the clearance apart; the slab
+    stays in one piece and loses only a layer of its face, and the motion_clearance check passes.
+    Without the motion pose nothing is trimmed."""
     from mlc.scene.model import Scene
     prof = load_profile("mjp")
     c, s = prof.clearance, prof.sigma_mm
@@ -184,8 +185,9 @@ def test_motion_trims_clear_a_pair_within_the_clearance():
     rest = (np.array([b.position for b in sc.bodies], float), np.array([b.orientation for b in sc.bodies], float))
     plain = build_assembly(sc, prof, {"0": rest})
     g0 = _verts(plain, "B")[:, 1].min() - _verts(plain, "A")[:, 1].max()      # mm, faces normal to y
+    d0 = 0.5 * (prof.slab_thickness - 0.01 * s)       # each slab's offset (the scene's slabs: 0.01 sigma)
     p = rest[0].copy()
-    p[1, 1] -= (g0 - 0.5 * c) / s
+    p[1, 1] -= (g0 - 0.5 * c + 2 * d0) / s
     near = {"near": (p, rest[1])}
     asm = build_assembly(sc, prof, {"0": rest}, motion_poses=near)
     assert plain.motion_trims == [] and len(asm.motion_trims) == 1, asm.motion_trims
@@ -200,6 +202,37 @@ def test_motion_trims_clear_a_pair_within_the_clearance():
     assert abs(before - X.volume() - t["removed_mm3"]) < 1e-5
     mc = check_assembly(asm, walls=False, motion_poses=near).check("motion_clearance")
     assert mc.ok, mc.detail
+
+
+def test_slabs_grow_away_from_a_part_passing_their_face():
+    """Printed thicker than in the scene, a slab grows from the face away from a part that passes
+    close to its other face (build._offset_slabs): two slabs whose centred faces would be half a
+    clearance apart in a motion pose are each printed from their far face, so they keep the
+    clearance in that pose with no trim and their full thickness (a trim there shaved a slab under
+    the minimum wall, issue 13).  Nothing moves without the pose."""
+    from mlc.scene.model import Scene
+    prof = load_profile("mjp")
+    c, s, t = prof.clearance, prof.sigma_mm, prof.slab_thickness
+    sc = Scene("two_slabs", [ex._slab("A", 0.0), ex._slab("B", 0.0, origin=(0.0, 1.0, 0.0))], []).check()
+    rest = (np.array([b.position for b in sc.bodies], float), np.array([b.orientation for b in sc.bodies], float))
+    plain = build_assembly(sc, prof, {"0": rest})
+    assert not any("printed from one face" in n for n in plain.notes)
+    g0 = _verts(plain, "B")[:, 1].min() - _verts(plain, "A")[:, 1].max()
+    p = rest[0].copy()
+    p[1, 1] -= (g0 - 0.5 * c) / s
+    near = {"near": (p, rest[1])}
+    asm = build_assembly(sc, prof, {"0": rest}, motion_poses=near)
+    assert asm.motion_trims == [], asm.motion_trims
+    assert sum("printed from one face" in n for n in asm.notes) == 2, asm.notes
+    T = asm.part_transforms(*near["near"])
+    posed = {n: _verts(asm, n) @ T[n][:3, :3].T + T[n][:3, 3] for n in ("A", "B")}
+    assert posed["B"][:, 1].min() - posed["A"][:, 1].max() >= c - 1e-6
+    for n in ("A", "B"):      # full thickness, each on the side away from the other
+        y = _verts(asm, n)[:, 1]
+        assert y.max() - y.min() == pytest.approx(t)
+    assert _verts(asm, "A")[:, 1].max() < _verts(plain, "A")[:, 1].max() - 0.1
+    assert _verts(asm, "B")[:, 1].min() > _verts(plain, "B")[:, 1].min() + 0.1
+    assert check_assembly(asm, walls=False, motion_poses=near).check("motion_clearance").ok
 
 
 def test_ring_lug_placement_keeps_the_clearance_in_motion():

@@ -17,9 +17,9 @@ body holds one knuckle between them with a hole of radius ``pin + clearance``:
 
 With ``pin: cone`` each knuckle instead carries a 45 degree cone on its upper face, seated
 in a recess (the cone offset by the clearance) of the next knuckle.  Knuckles are
-cylinders of radius ``R = pin/2 + clearance + min_wall`` and at least ``min_feature``
-long (the span grows past the slab width if needed; the slab is widened by a *yoke plate*
-to carry it).
+cylinders of radius ``R = pin/2 + clearance + min_wall`` and at least ``min_feature`` and
+``min_wall`` long (a knuckle is a ring: its length is a wall; the span grows past the slab
+width if needed; the slab is widened by a *yoke plate* to carry it).
 
 Trimming
 --------
@@ -153,6 +153,7 @@ class SlabBox:
     R: np.ndarray        # world orientation of the box axes
     size: np.ndarray     # mm, thickness already replaced
     normal_axis: int     # index of the thickness axis
+    offset: float = 0.0  # mm along the normal from the scene's mid-plane (_offset_slabs)
 
 
 @dataclass
@@ -383,7 +384,11 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
     r_hole = r_pin + c
     R = r_hole + prof.min_wall
     R = max(R, t / 2 + prof.min_wall / 2)
-    kmin = max(prof.min_feature, 0.0)
+    # a knuckle's length is a wall of the ring: at least the minimum wall as well as the
+    # minimum feature (mjp's 0.5 mm knuckles measured 0.37 mm walls against 0.6, issue 13).
+    # Not yet where connectors branch: the longer stacks of a branch junction met its pages in
+    # every state, and the trims of that ran out of memory
+    kmin = prof.min_feature if _branch_groups(scene.joints(), scene) else max(prof.min_feature, prof.min_wall)
     cones = prof.pin == "cone"
     r_cone = h_cone = 0.0
     if cones:
@@ -467,7 +472,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         ax = HingeAxis("+".join(jn), jn, mid * s, d, S, list(blist), intervals, k, R, r_pin, r_hole,
                        scene_span=L, layout=list(layout))
         axes.append(ax)
-        features.append((f"knuckle length ({ax.name})", k, prof.min_feature))
+        features.append((f"knuckle length ({ax.name})", k, kmin))
         if S > L + 1e-9:
             notes.append(f"hinge {ax.name}: knuckles need {S:.3g} mm, more than the slab width {L:.3g} mm: "
                          f"the slabs are widened to the knuckle span there")
@@ -510,10 +515,10 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
                         if u_.bodies[1] in ax_.bodies:
                             _own_lines(u_.bodies[1], u_.center, ax_.direction, [ax_], s)
                 features.append((f"knuckle length ({hx.name}, with joint {br_uj[0].part})", hx.knuckle,
-                                 prof.min_feature))
+                                 kmin))
                 features.append((f"hub wall ({br_uj[0].part})", br_uj[0].hub_r - r_pin, prof.min_wall))
                 ks = [iv[1] - iv[0] for uj in br_uj for iv in uj.layouts[1].own]
-                features.append((f"yoke knuckle length ({br_uj[0].part})", min(ks), prof.min_feature))
+                features.append((f"yoke knuckle length ({br_uj[0].part})", min(ks), kmin))
                 notes.append(f"branch junction {br_uj[0].part}: {len(br_uj)} universal joints "
                              f"({', '.join(u.name for u in br_uj)}) on one joint part, compound on hinge {hx.name}")
                 continue
@@ -587,19 +592,45 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
             if compound["o_axis"] is not None:
                 _own_ends(compound["o_axis"], ob)
             _own_lines(ob, center, uj.axes[1], axes, s)
-            features.append((f"knuckle length ({hx.name}, with joint {jname})", hx.knuckle, prof.min_feature))
+            features.append((f"knuckle length ({hx.name}, with joint {jname})", hx.knuckle, kmin))
             features.append((f"hub wall ({jname})", uj.hub_r - r_pin, prof.min_wall))
             notes.append(f"universal joint {jname}: compound junction on hinge {hx.name} (its pin is the joint's)")
         if uj.layouts[0].mode not in ("both", "host") or uj.layouts[1].mode != "both":
             notes.append(f"universal joint {jname}: one-sided yoke ({uj.layouts[0].mode} on {cb}, "
                          f"{uj.layouts[1].mode} on {ob}) with a capped pin, clear of the other arm")
         ks = [iv[1] - iv[0] for lay in uj.layouts for iv in lay.own + lay.caps]
-        features.append((f"yoke knuckle length ({jname})", min(ks), prof.min_feature))
+        features.append((f"yoke knuckle length ({jname})", min(ks), kmin))
         if compound is None:
             features.append((f"hub length ({jname})", hub, prof.min_feature))
 
     if memo is not None:
         _share_ujoint_radii(ujoints, base_samples, slabs)
+
+    # -- which face of each slab the printed thickness grows from: away from the slabs and
+    #    knuckles that pass close to it in the logic states and the dense paths (issue 13:
+    #    trims that shaved a slab face left walls under the minimum)
+    motion_ST = _state_transforms(scene, prof, motion_poses) if (resolve and motion_poses and not reuse) else []
+    bridge_T = [T for _, T in state_T + motion_ST] or [None]     # a thin web's bridge keeps clear in these
+    if resolve and not reuse and t > scene_t + 1e-9:
+        # not the bodies at a universal joint: its trim cylinder then cut the moved slab and
+        # its yoke plate into a 0.22 mm lip (out_hi at sla)
+        at_uj = {bn for uj in ujoints for bn in uj.bodies}
+        moved = _offset_slabs({bn: v for bn, v in slabs.items() if bn not in at_uj}, scene,
+                              [T for _, T in state_T + motion_ST], t, scene_t, c, R, h, s,
+                              _knuckle_samples(axes, ujoints, R, h), others=slabs)
+        for bn, sb, o in moved:
+            notes.append(f"slab of {bn} at ({', '.join(f'{x:.1f}' for x in sb.center)}) mm printed from one face "
+                         f"of the scene's slab ({o:+.3g} mm along its normal): room for the part passing the "
+                         "other side")
+        if moved:     # the universal joints' trim radii, again for the slabs where they are now
+            base_samples = {bn: _slab_samples(slabs[bn], h) for bn in slabs}
+            for uj in ujoints:
+                smp = {bn: base_samples[bn] for bn in uj.bodies}
+                for side, bn in enumerate(uj.bodies):
+                    smp[bn] = np.concatenate([smp[bn], _slab_samples(
+                        _uj_plates(uj, side, slabs[bn], uj.rho[side] + reach, t), h)])
+                need = _ujoint_trim(uj, smp, state_T, t, c, h)
+                uj.rho = (max(uj.rho[0], need[0]), max(uj.rho[1], need[1]))
 
     # -- yoke plates: widen slabs to the knuckle span near an axis ------------------
     plates: dict[str, list[SlabBox]] = {b.name: [] for b in scene.bodies}
@@ -663,41 +694,78 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         # moved (the same triangles wherever they are) and share every cached exact result
         Fb = _frame(slabs[bn][0].center, slabs[bn][0].R) if reuse and LOCAL_BUILD and slabs.get(bn) else None
         _LOCAL[0] = None if Fb is None else np.linalg.inv(Fb)
-        solid = union([box(sb.center, sb.R, sb.size) for sb in shapes[bn]])
+        solid = union([box(sb.center, sb.R, sb.size) for sb in shapes[bn]] + _bend_fills(slabs[bn]))
         my_axes = [ax for ax in axes if bn in ax.bodies]
         my_uj = [(uj, 0 if uj.bodies[0] == bn else 1) for uj in ujoints if bn in uj.bodies]
         # 1. clear the other bodies' knuckles
-        cuts = []
-        for ax in my_axes:
-            for a0, a1 in _ext(_complement(ax.intervals[bn], -ax.span / 2, ax.span / 2), ax.span, t):
-                cuts.append(cylinder(ax.origin, ax.direction, a0, a1, ax.rho, n, cutter=True))
+        def axis_cuts(ax, grow=0.0):
+            return [cylinder(ax.origin, ax.direction, a0, a1, ax.rho + grow, n, cutter=True)
+                    for a0, a1 in _ext(_complement(ax.intervals[bn], -ax.span / 2, ax.span / 2), ax.span, t)]
+        other_cuts, avoid = [], []
         for uj, side in my_uj:
             lay = uj.layouts[side]
             for a0, a1 in _complement(lay.own, *lay.cut):
-                cuts.append(cylinder(uj.center, uj.axes[side], a0, a1, uj.rho[side], n, cutter=True))
+                other_cuts.append(cylinder(uj.center, uj.axes[side], a0, a1, uj.rho[side], n, cutter=True))
+                avoid.append((uj.center, uj.axes[side], a0, a1, uj.rho[side]))
         for uj in ujoints:      # compound junction: the other bodies of its hinge clear the yoke too
             if uj.host is not None and bn in uj.host.bodies and bn not in uj.bodies:
-                cuts.append(cylinder(uj.center, uj.axes[0], *uj.layouts[0].cut, uj.rho[0], n, cutter=True))
+                other_cuts.append(cylinder(uj.center, uj.axes[0], *uj.layouts[0].cut, uj.rho[0], n, cutter=True))
+                avoid.append((uj.center, uj.axes[0], *uj.layouts[0].cut, uj.rho[0]))
+        cuts = [x for ax in my_axes for x in axis_cuts(ax)] + other_cuts
         cut_solid = _clean(subtract(solid, cuts))
-        if len(cut_solid.decompose()) > len(_clean(solid).decompose()):
-            # a slab running along an axis is severed by the clearance around another body's
-            # knuckle: bridge around it on the side no other body ever swings through
-            bridges = []
-            base_n = len(_clean(solid).decompose())
-            for ax in my_axes:
-                own = ax.intervals[bn]
-                axis_cuts = [cylinder(ax.origin, ax.direction, a0, a1, ax.rho, n, cutter=True)
-                             for a0, a1 in _ext(_complement(own, -ax.span / 2, ax.span / 2), ax.span, t)]
-                if len(_clean(subtract(solid, axis_cuts)).decompose()) <= base_n:
-                    continue
-                for a0, a1 in _complement(own, -ax.span / 2, ax.span / 2):
-                    if any(o1 <= a0 + 1e-9 for _, o1 in own) and any(o0 >= a1 - 1e-9 for o0, _ in own):
-                        bridges.append(_bridge(ax, bn, a0, a1, samples, state_T, t, prof))
-                        notes.append(f"hinge {ax.name}: {bn} bridges around the other knuckles "
-                                     f"({np.degrees(bridges[-1][1]):.0f} degrees from them)")
-            solid = _clean(subtract(union([solid] + [x for x, _ in bridges]), cuts)) if bridges else cut_solid
-        else:
-            solid = cut_solid
+        base_n = len(_clean(solid).decompose())
+        cut_n = len(cut_solid.decompose())
+        # a slab running along an axis is severed by the clearance around another body's
+        # knuckle: bridge around it on the side no other body ever swings through.  For a
+        # mechanism of its own (not reuse), also where that clearance and another trim leave
+        # only a web thinner than the minimum wall (the cut grown by the minimum wall severs it:
+        # core_cd between hinge c and its universal joint, 0.22 mm at mjp, issue 13)
+        def thin_at(ax):
+            return len(_clean(subtract(
+                solid, [x for a in my_axes for x in axis_cuts(a, prof.min_wall if a is ax else 0.0)]
+                + other_cuts)).decompose()) > cut_n
+        need = {}
+        for ax in my_axes:
+            if cut_n > base_n and len(_clean(subtract(solid, axis_cuts(ax))).decompose()) > base_n:
+                need[ax.name] = "severed"
+            elif not reuse and thin_at(ax):
+                # first the plates at the axis, carried along it as far as the body's slabs go
+                # (a slab beside the knuckle stack joins it there, clear of the other knuckles)
+                ext = _axis_extension(slabs[bn], ax, reach, t)
+                if ext:
+                    solid = _clean(union([solid] + [box(sb.center, sb.R, sb.size) for sb in ext]))
+                    base_n = len(solid.decompose())
+                    cut_solid = _clean(subtract(solid, cuts))
+                    cut_n = len(cut_solid.decompose())
+                    notes.append(f"hinge {ax.name}: {bn}'s plate at the axis carried along it past the knuckles "
+                                 f"({', '.join(f'{a0:.2f} to {a1:.2f}' for a0, a1 in _ext_ivs(slabs[bn], ax))} mm), "
+                                 "where only a web thinner than the minimum wall was left")
+                if thin_at(ax):
+                    need[ax.name] = "thin"
+        bridges, fins = [], []
+        for ax in my_axes:
+            if ax.name not in need:
+                continue
+            own = ax.intervals[bn]
+            mine = []
+            for a0, a1 in _complement(own, -ax.span / 2, ax.span / 2):
+                if any(o1 <= a0 + 1e-9 for _, o1 in own) and any(o0 >= a1 - 1e-9 for o0, _ in own):
+                    # (compiled circuits, reuse: as before, meshes unchanged); a bridge over a
+                    # thin web must keep clear of the other bodies in the dense paths too
+                    br = _bridge(ax, bn, a0, a1, samples, state_T, t, prof, () if reuse else avoid,
+                                 (bridge_T, t / 2 + c + 0.5 * (t - scene_t)) if need[ax.name] == "thin" else None)
+                    if br is None:
+                        continue
+                    mine.append(br)
+                    notes.append(f"hinge {ax.name}: {bn} bridges around the other knuckles "
+                                 f"({np.degrees(br[1]):.0f} degrees from them)"
+                                 + (", where only a web thinner than the minimum wall was left" if need[ax.name] == "thin" else ""))
+            if mine and need[ax.name] == "thin":
+                # the bridge carries the load now: the web around the other knuckles, thinner
+                # than the minimum wall, goes (the trim grown by the minimum wall, less the bridge)
+                fins.append(subtract(union(axis_cuts(ax, prof.min_wall)), [x for x, _ in mine]))
+            bridges += mine
+        solid = _clean(subtract(union([solid] + [x for x, _ in bridges]), cuts + fins)) if bridges else cut_solid
         # 2. own knuckles, attachment rings
         keep = []
         for ax in my_axes:
@@ -943,6 +1011,142 @@ def _state_transforms(scene, prof, poses):
             Ts[b.name] = T
         out.append((st, Ts))
     return out
+
+
+def _knuckle_samples(axes, ujoints, R, h) -> dict:
+    """Points on the outer surface of every knuckle (radius ``R``), by body: hinge knuckles
+    and the bodies' universal-joint yoke knuckles (mm, rest world)."""
+    out: dict = {}
+
+    def ring(bn, origin, d, a0, a1):
+        E = _perp_frame(d)
+        na = max(2, int(np.ceil((a1 - a0) / h)) + 1)
+        nt = max(8, int(np.ceil(2 * np.pi * R / h)))
+        a, th = np.meshgrid(np.linspace(a0, a1, na), np.linspace(0, 2 * np.pi, nt, endpoint=False), indexing="ij")
+        P = (origin + a.reshape(-1, 1) * d + R * (np.cos(th).reshape(-1, 1) * E[:, 0]
+                                                 + np.sin(th).reshape(-1, 1) * E[:, 1]))
+        out.setdefault(bn, []).append(P)
+    for ax in axes:
+        for bn, ivs in ax.intervals.items():
+            for a0, a1 in ivs:
+                ring(bn, ax.origin, ax.direction, a0, a1)
+    for uj in ujoints:
+        for side, bn in enumerate(uj.bodies):
+            for a0, a1 in uj.layouts[side].own:
+                ring(bn, uj.center, uj.axes[side], a0, a1)
+    return {bn: np.concatenate(v) for bn, v in out.items()}
+
+
+def _offset_slabs(slabs, scene, Ts, t, scene_t, c, R, h, s, extra=None, others=None) -> list:
+    """Move slab boxes along their normal so that the printed thickness ``t`` grows from one face
+    of the scene's slab (``scene_t`` thick) instead of both, where that keeps other bodies
+    farther away (all in mm, rest world).
+
+    For each slab box of body B and each pose of ``Ts`` (``{body: 4x4}``), the mid-plane samples
+    of every other body are moved into B's frame; those over the box (in its plane, within the
+    clearance ``c`` of its outline) and within ``t + c`` of its mid-plane could come closer than
+    the clearance when both are printed ``t`` thick (``extra``: more points by body, the
+    knuckles of :func:`_knuckle_samples`; ``others``: every body's slabs, when ``slabs`` holds
+    only the bodies that may move).  Points near B's own joints are left out
+    (the trim radii clear the knuckles there).  The offset ``o`` in (-d, 0, +d), ``d = (t -
+    scene_t) / 2``, that leaves the largest smallest estimated gap (``|dn - o| - t``: B's
+    face to the other slab's face, both ``t`` thick) is kept.  It is chosen per body, for all
+    its boxes at once: all centred, all towards the inside of the body's bends, or all towards
+    the outside (coplanar boxes: the same side), so that bent boxes still meet along their
+    whole thickness (one box moved alone left a 0.19 mm sliver at the bend of ``out_hi``); the
+    centred slabs win ties, so a body with nothing near it, or as near on both sides, is printed
+    as before.  Returns ``[(body, box, o)]`` for the boxes moved (their ``center`` is changed in
+    place)."""
+    d0 = 0.5 * (t - scene_t)
+    if not Ts or d0 <= 1e-9:
+        return []
+    samples = {bn: _slab_samples(sbs, h) for bn, sbs in (others or slabs).items()}
+    for bn, P in (extra or {}).items():
+        if bn in samples:
+            samples[bn] = np.concatenate([samples[bn], P])
+    # B's joints: hinge axes (segments between the bond ends) and universal joint points
+    near: dict = {bn: [] for bn in slabs}
+    for bonds in scene.joints().values():
+        ends = [0.5 * (scene.site_world(bd.a) + scene.site_world(bd.b)) * s for bd in bonds]
+        for bn in {ref.split(".")[0] for bd in bonds for ref in (bd.a, bd.b)}:
+            if bn in near:
+                near[bn].append((ends[0], ends[-1]))
+    reach = 2 * R + c + t           # a knuckle and the other body's next to it, plus a slab
+    offs = np.array([0.0, -d0, d0])
+    out = []
+    for bn, sbs in slabs.items():
+        if not sbs:
+            continue
+        mid = np.mean([sb.center for sb in sbs], axis=0)
+        n0 = sbs[0].R[:, sbs[0].normal_axis]
+        worsts, inner = [], []
+        for sb in sbs:
+            n = sb.R[:, sb.normal_axis]
+            w_in = float(np.dot(n, mid - sb.center))
+            inner.append(1 if (w_in if abs(w_in) > 1e-6 else float(np.dot(n, n0))) >= 0 else -1)
+            inplane = [i for i in range(3) if i != sb.normal_axis]
+            half = 0.5 * sb.size[inplane] + c
+            worst = np.full(3, np.inf)
+            for T in Ts:
+                for on, pts in samples.items():
+                    if on == bn or not len(pts):
+                        continue
+                    M = np.linalg.solve(T[bn], T[on])
+                    q = pts @ M[:3, :3].T + M[:3, 3]
+                    loc = (q - sb.center) @ sb.R
+                    dn = loc[:, sb.normal_axis]
+                    keep = (np.abs(dn) < t + c) & np.all(np.abs(loc[:, inplane]) <= half, axis=1)
+                    if not keep.any():
+                        continue
+                    q = q[keep]
+                    for a, b in near[bn]:
+                        ab = b - a
+                        u = np.clip((q - a) @ ab / max(float(ab @ ab), 1e-12), 0.0, 1.0)
+                        far = np.linalg.norm(q - (a + u[:, None] * ab), axis=1) > reach
+                        q = q[far]
+                    if not len(q):
+                        continue
+                    dn = (q - sb.center) @ n
+                    worst = np.minimum(worst, (np.abs(dn[None, :] - offs[:, None]) - t).min(axis=1))
+            worsts.append(worst)
+        # the body's options: centred, every box towards the inside of its bends, or the outside
+        # (offs index 2 = +d along the box normal, 1 = -d)
+        opts = [[0] * len(sbs), [2 if i > 0 else 1 for i in inner], [1 if i > 0 else 2 for i in inner]]
+        score = [min(w[k] for w, k in zip(worsts, ks)) for ks in opts]
+        best = int(np.argmax(score))        # the centred option first: it wins ties
+        if best and score[best] > score[0] + 1e-9:
+            for sb, k in zip(sbs, opts[best]):
+                sb.center = sb.center + offs[k] * sb.R[:, sb.normal_axis]
+                sb.offset = float(offs[k])
+                out.append((bn, sb, float(offs[k])))
+    return out
+
+
+def _bend_fills(sbs) -> list:
+    """Where two slab boxes of a body printed from one face (:func:`_offset_slabs`) meet at an
+    angle, each moved along its own normal: the convex hull of the four corners of each box
+    nearest the other box, which closes the step (a lip thinner than the wall, 0.22 mm at the
+    bend of ``out_hi`` at sla) between their ends.  None for centred or coplanar boxes."""
+    out = []
+    for i, a in enumerate(sbs):
+        for b in sbs[i + 1:]:
+            if not (a.offset or b.offset):
+                continue
+            na, nb = a.R[:, a.normal_axis], b.R[:, b.normal_axis]
+            if abs(float(np.dot(na, nb))) > 1 - 1e-6:
+                continue      # coplanar or parallel: moved alike, no step
+            ca, cb = _box_corners(a), _box_corners(b)
+            near_a = ca[np.argsort(np.linalg.norm(ca - b.center, axis=1))[:4]]
+            near_b = cb[np.argsort(np.linalg.norm(cb - a.center, axis=1))[:4]]
+            if (box(a.center, a.R, a.size) ^ box(b.center, b.R, b.size)).is_empty():
+                continue      # not joined to each other
+            out.append(mf.Manifold.hull_points(np.vstack([near_a, near_b])))
+    return out
+
+
+def _box_corners(sb) -> np.ndarray:
+    sgn = np.array(list(itertools.product((-0.5, 0.5), repeat=3)))
+    return sb.center + (sgn * sb.size) @ sb.R.T
 
 
 def _sample_step(t, c, s) -> float:
@@ -1530,10 +1734,36 @@ def _ujoint_trim(uj: UJoint, samples, state_T, t, c, h):
     return need[0], need[1]
 
 
-def _bridge(ax: HingeAxis, bn, a0, a1, samples, state_T, t, prof):
+def _ext_ivs(sbs, ax: HingeAxis) -> list:
+    """The ranges along ``ax`` (from its origin, mm) beyond its knuckle span that the slab
+    boxes ``sbs`` cover."""
+    lo, hi = -ax.span / 2, ax.span / 2
+    for sb in sbs:
+        mid = float(np.dot(sb.center - ax.origin, ax.direction))
+        half = 0.5 * float(np.sum(np.abs(sb.R.T @ ax.direction) * sb.size))
+        lo, hi = min(lo, mid - half), max(hi, mid + half)
+    return [(a0, a1) for a0, a1 in ((lo, -ax.span / 2), (ax.span / 2, hi)) if a1 - a0 > 1e-9]
+
+
+def _axis_extension(sbs, ax: HingeAxis, reach, t) -> list:
+    """Plates (slab boxes) that carry the slabs reaching ``ax`` along it beyond the knuckle
+    span, as far as the body's slabs go (:func:`_ext_ivs`)."""
+    ivs = _ext_ivs(sbs, ax)
+    return _yoke_plates(sbs, ax.origin, ax.direction, ivs, reach, t) if ivs else []
+
+
+def _bridge(ax: HingeAxis, bn, a0, a1, samples, state_T, t, prof, avoid=(), clear=None):
     """A plate carrying body ``bn`` around the other bodies' knuckles on ``[a0, a1]``:
-    in the direction (about the axis) farthest from every other body in every state."""
+    in the direction (about the axis) farthest from every other body in every state, and not
+    into a cylinder of ``avoid`` (``(origin, direction, s0, s1, radius)``: the body's other
+    trims, which would cut the plate away).  None if every direction runs into one.
+
+    ``clear`` (``(poses, gap)``: ``[{body: 4x4}]`` and mm): the plate's material beyond the trim
+    radius must also stay ``gap`` from every other body's mid-plane samples in each of those
+    poses (the dense paths: a bridge placed for the logic states alone was then trimmed in
+    motion); the best such direction of the 16 best by angle, else None."""
     far = 3 * ax.R + 2 * t + 0.5 * prof.sigma_mm
+    w = max(prof.min_wall, t)
     foreign = []
     for o in ax.bodies:
         if o == bn:
@@ -1546,14 +1776,53 @@ def _bridge(ax: HingeAxis, bn, a0, a1, samples, state_T, t, prof):
         score = np.abs(((cand[:, None] - fa[None, :]) + np.pi) % (2 * np.pi) - np.pi).min(axis=1)
     else:
         score = np.full_like(cand, np.pi)
-    th = float(cand[int(np.argmax(score))])
     E = _perp_frame(ax.direction)
-    e = np.cos(th) * E[:, 0] + np.sin(th) * E[:, 1]
-    w = max(prof.min_wall, t)
     reach = ax.rho + w
+    if avoid:
+        # the plate's material beyond the trim radius: along the axis, out to its end, across
+        a, r, f = np.meshgrid(np.linspace(a0 - w, a1 + w, 7), np.linspace(ax.rho, reach, 4),
+                              np.linspace(-0.5 * t, 0.5 * t, 3), indexing="ij")
+        a, r, f = a.reshape(-1, 1), r.reshape(-1, 1), f.reshape(-1, 1)
+        for i, th in enumerate(cand):
+            e = np.cos(th) * E[:, 0] + np.sin(th) * E[:, 1]
+            P = ax.origin + a * ax.direction + r * e + f * np.cross(ax.direction, e)
+            for o, d, s0, s1, rad in avoid:
+                sa, ra = _axis_coords(o, d, P)
+                if np.any((sa >= s0) & (sa <= s1) & (ra < rad)):
+                    score[i] = -1.0
+                    break
+        if score.max() < 0:
+            return None
+    k = int(np.argmax(score))
+    if clear is not None:
+        poses, gap = clear
+        lo, hi = a0 - w, a1 + w
+        A, X, Y = [], [], []        # other bodies' samples near the plate, in bn's frame, axis coords
+        for Ts in poses:
+            for o, pts in samples.items():
+                if o == bn or not len(pts):
+                    continue
+                rel = _in_frame_of(bn, o, pts, Ts) - ax.origin
+                aa, px, py = rel @ ax.direction, rel @ E[:, 0], rel @ E[:, 1]
+                rr = np.hypot(px, py)
+                m = (aa > lo - gap) & (aa < hi + gap) & (rr > ax.rho - gap) & (rr < reach + gap)
+                A.append(aa[m]), X.append(px[m]), Y.append(py[m])
+        A, X, Y = (np.concatenate(v) if v else np.zeros(0) for v in (A, X, Y))
+        da = np.maximum(0.0, np.maximum(lo - A, A - hi))
+        for k in [int(i) for i in np.argsort(-score, kind="stable")[:16] if score[i] >= 0]:
+            c_, s_ = np.cos(cand[k]), np.sin(cand[k])
+            x, y = X * c_ + Y * s_, -X * s_ + Y * c_
+            dist = np.sqrt(np.maximum(0.0, np.abs(y) - t / 2) ** 2
+                           + np.maximum(0.0, np.maximum(ax.rho - x, x - reach)) ** 2 + da ** 2)
+            if not len(dist) or dist.min() >= gap:
+                break
+        else:
+            return None
+    th = float(cand[k])
+    e = np.cos(th) * E[:, 0] + np.sin(th) * E[:, 1]
     Rm = np.column_stack([ax.direction, e, np.cross(ax.direction, e)])
     center = ax.origin + ax.direction * 0.5 * (a0 + a1) + e * reach / 2
-    return box(center, Rm, [a1 - a0 + 2 * w, reach, t]), float(score.max())
+    return box(center, Rm, [a1 - a0 + 2 * w, reach, t]), float(score[k])
 
 
 def _ext(intervals, span, t):
@@ -2405,11 +2674,13 @@ def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False):
             continue
         reach_b = min(reach, 2 * half)
         Rm = np.column_stack([d, w, np.cross(d, w)])
+        # a slab printed from one face (_offset_slabs): its plate too, flush with it
+        shift = 0.0 if rod else sb.offset * nrm
         for a0, a1 in intervals:
             if a1 - a0 <= 0:
                 continue
-            out.append(SlabBox(origin + d * 0.5 * (a0 + a1) + w * reach_b / 2, Rm,
-                               np.array([a1 - a0, reach_b, t]), 2))
+            out.append(SlabBox(origin + d * 0.5 * (a0 + a1) + w * reach_b / 2 + shift, Rm,
+                               np.array([a1 - a0, reach_b, t]), 2, sb.offset))
     return out
 
 
