@@ -386,9 +386,12 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
     R = max(R, t / 2 + prof.min_wall / 2)
     # a knuckle's length is a wall of the ring: at least the minimum wall as well as the
     # minimum feature (mjp's 0.5 mm knuckles measured 0.37 mm walls against 0.6, issue 13).
-    # Not yet where connectors branch: the longer stacks of a branch junction met its pages in
-    # every state, and the trims of that ran out of memory
-    kmin = prof.min_feature if _branch_groups(scene.joints(), scene) else max(prof.min_feature, prof.min_wall)
+    # Only for a mechanism of its own (not reuse: compiled circuits are unchanged) without
+    # connector branches: the longer stacks of a branch junction met its pages in every state,
+    # and the trims of that ran out of memory
+    own_mech = not (reuse if reuse is not None else reuses(scene))
+    kmin = (max(prof.min_feature, prof.min_wall) if own_mech and not _branch_groups(scene.joints(), scene)
+            else prof.min_feature)
     cones = prof.pin == "cone"
     r_cone = h_cone = 0.0
     if cones:
