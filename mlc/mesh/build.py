@@ -269,24 +269,18 @@ class Assembly:
 
     def body_transform(self, body_index: int, pos, quat) -> np.ndarray:
         """4x4 transform (mm) taking the rest pose of a body to the pose (pos, quat) in sigma."""
-        s = self.profile.sigma_mm
-        b = self.scene.bodies[body_index]
-        R0 = quat_to_matrix(b.orientation)
-        R1 = quat_to_matrix(quat)
-        Rr = R1 @ R0.T
-        T = np.eye(4)
-        T[:3, :3] = Rr
-        T[:3, 3] = s * np.asarray(pos, float) - Rr @ (s * np.asarray(b.position, float))
-        return T
+        return _body_T(self.scene.bodies[body_index], pos, quat, self.profile.sigma_mm)
 
-    def part_transforms(self, pos, quat) -> dict:
-        """Rest -> posed 4x4 transforms (mm) of every part for body poses (pos, quat)."""
+    def part_transforms(self, pos, quat, body_T: dict | None = None) -> dict:
+        """Rest -> posed 4x4 transforms (mm) of every part for body poses (pos, quat);
+        ``body_T``: the bodies' transforms for these poses when already computed
+        (:func:`_state_transforms`)."""
         idx = {b.name: i for i, b in enumerate(self.scene.bodies)}
         out = {}
         for p in self.parts:
             if p.kind == "body":
                 i = idx[p.name]
-                out[p.name] = self.body_transform(i, pos[i], quat[i])
+                out[p.name] = body_T[p.name] if body_T is not None else self.body_transform(i, pos[i], quat[i])
         for u in self.ujoints:
             if not u.primary:       # branch junction: the shared joint part is posed by its first page
                 continue
@@ -575,11 +569,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
                     uj.o_axis = compound["o_axis"]
             if best is not None and not (uj.rho[0] + uj.rho[1], modes != ("both", "both")) < best[0]:
                 continue     # its trim radii are at least these: it cannot beat the best layout
-            smp = {bn: base_samples[bn] for bn in uj.bodies}
-            for side, bn in enumerate(uj.bodies):
-                smp[bn] = np.concatenate([smp[bn], _slab_samples(
-                    _uj_plates(uj, side, slabs[bn], uj.rho[side] + reach, t), h)])
-            need = _ujoint_trim_memo(memo, uj, smp, state_T, t, c, h)
+            need = _ujoint_trim_memo(memo, uj, _uj_samples(uj, base_samples, slabs, reach, t, h), state_T, t, c, h)
             rho = (max(uj.rho[0], need[0]), max(uj.rho[1], need[1]))
             score = (rho[0] + rho[1], modes != ("both", "both"))
             if best is None or score < best[0]:
@@ -628,11 +618,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         if moved:     # the universal joints' trim radii, again for the slabs where they are now
             base_samples = {bn: _slab_samples(slabs[bn], h) for bn in slabs}
             for uj in ujoints:
-                smp = {bn: base_samples[bn] for bn in uj.bodies}
-                for side, bn in enumerate(uj.bodies):
-                    smp[bn] = np.concatenate([smp[bn], _slab_samples(
-                        _uj_plates(uj, side, slabs[bn], uj.rho[side] + reach, t), h)])
-                need = _ujoint_trim(uj, smp, state_T, t, c, h)
+                need = _ujoint_trim(uj, _uj_samples(uj, base_samples, slabs, reach, t, h), state_T, t, c, h)
                 uj.rho = (max(uj.rho[0], need[0]), max(uj.rho[1], need[1]))
 
     # -- yoke plates: widen slabs to the knuckle span near an axis ------------------
@@ -743,7 +729,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
                     notes.append(f"hinge {ax.name}: {bn}'s plate at the axis carried along it past the knuckles "
                                  f"({', '.join(f'{a0:.2f} to {a1:.2f}' for a0, a1 in _ext_ivs(slabs[bn], ax))} mm), "
                                  "where only a web thinner than the minimum wall was left")
-                if thin_at(ax):
+                if not ext or thin_at(ax):     # (without plates added, as just measured)
                     need[ax.name] = "thin"
         bridges, fins = [], []
         for ax in my_axes:
@@ -901,8 +887,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         if asm.cone_conflicts and resolve and not _CONE_PROBE[0]:
             _cone_refuse(asm, scene, prof, poses, r_cone, h_cone)
     # the part transforms of the dense poses: trimmed against, then kept clear by the ring lugs
-    motion_T = ([asm.part_transforms(*pq) for pq in motion_poses.values()]
-                if resolve and motion_poses and not reuse else [])
+    motion_T = [asm.part_transforms(*pq, body_T=Ts) for pq, (_, Ts) in zip((motion_poses or {}).values(), motion_ST)]
     if resolve:
         _resolve(asm, protected, soft, state_T, asm.congruence, fat_guard)
         if motion_T:
@@ -1000,20 +985,20 @@ def _state_transforms(scene, prof, poses):
     """[(state, {body: 4x4})] for the given poses (mm)."""
     if not poses:
         return []
-    s = prof.sigma_mm
-    out = []
-    for st, (pos, quat) in poses.items():
-        Ts = {}
-        for i, b in enumerate(scene.bodies):
-            R0 = quat_to_matrix(b.orientation)
-            R1 = quat_to_matrix(quat[i])
-            Rr = R1 @ R0.T
-            T = np.eye(4)
-            T[:3, :3] = Rr
-            T[:3, 3] = s * np.asarray(pos[i], float) - Rr @ (s * np.asarray(b.position, float))
-            Ts[b.name] = T
-        out.append((st, Ts))
-    return out
+    return [(st, {b.name: _body_T(b, pos[i], quat[i], prof.sigma_mm) for i, b in enumerate(scene.bodies)})
+            for st, (pos, quat) in poses.items()]
+
+
+def _body_T(b, pos, quat, s) -> np.ndarray:
+    """4x4 transform (mm) taking body ``b``'s rest pose to the pose (pos, quat) in sigma;
+    ``s``: mm per sigma."""
+    R0 = quat_to_matrix(b.orientation)
+    R1 = quat_to_matrix(quat)
+    Rr = R1 @ R0.T
+    T = np.eye(4)
+    T[:3, :3] = Rr
+    T[:3, 3] = s * np.asarray(pos, float) - Rr @ (s * np.asarray(b.position, float))
+    return T
 
 
 def _knuckle_samples(axes, ujoints, R, h) -> dict:
@@ -1642,10 +1627,7 @@ def _branch(members, S, joints, scene, bodies, axes, slabs, s, prof, R, r_pin, r
             uj.o_axis = comp["o_axis"]
         uj.primary = not out
         uj.mates = [p for p in side[sg] if p != pg]
-        smp = {bn: base_samples[bn] for bn in uj.bodies}
-        for k, bn in enumerate(uj.bodies):
-            smp[bn] = np.concatenate([smp[bn], _slab_samples(_uj_plates(uj, k, slabs[bn], uj.rho[k] + reach, t), h)])
-        need = _ujoint_trim_memo(memo, uj, smp, state_T, t, c, h)
+        need = _ujoint_trim_memo(memo, uj, _uj_samples(uj, base_samples, slabs, reach, t, h), state_T, t, c, h)
         uj.rho = (max(uj.rho[0], need[0]), max(uj.rho[1], need[1]))
         out.append(uj)
     return out, comp
@@ -2623,6 +2605,13 @@ def _hinge_dir(bn, axes, slabs, center) -> np.ndarray:
 def _extent_along(sbs, center, d) -> float:
     near = min(sbs, key=lambda sb: np.linalg.norm(sb.center - center))
     return float(np.sum(np.abs(near.R.T @ d) * near.size))
+
+
+def _uj_samples(uj: UJoint, base_samples, slabs, reach, t, h) -> dict:
+    """The sample points (mm) of a universal joint's two bodies for its trim radii: their slabs'
+    (``base_samples``) and the yoke plates that widen them to its knuckles (:func:`_uj_plates`)."""
+    return {bn: np.concatenate([base_samples[bn], _slab_samples(_uj_plates(uj, k, slabs[bn], uj.rho[k] + reach, t), h)])
+            for k, bn in enumerate(uj.bodies)}
 
 
 def _uj_plates(uj: UJoint, side: int, sbs, reach, t):
