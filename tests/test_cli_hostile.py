@@ -1330,7 +1330,14 @@ def test_ctrl_c_swallowed_by_a_callback_still_stops_the_command(monkeypatch, cap
         return 0
 
     monkeypatch.setattr(version, "run", swallowed_then_work)
-    code, _, err = run(capsys, "info")
+    import signal
+    # Ctrl-C handled as in a terminal (pytest-xdist's workers ignore SIGINT, and a process that
+    # ignores it is rightly not stopped)
+    old = signal.signal(signal.SIGINT, signal.default_int_handler)
+    try:
+        code, _, err = run(capsys, "info")
+    finally:
+        signal.signal(signal.SIGINT, old)
     assert code == 130 and err == "mlc: interrupted\n" and not finished, (code, err)
 
 
