@@ -1,16 +1,19 @@
 """Circuit back end: cost against circuit size, and dynamic verification per scheme.
 
-* Ripple-carry adders of growing width (1 to ``--max-width`` bits; 7 gates per full-adder
-  bit): netlist gates, scene bodies, build time (placement + routing + assembly), static
-  verification time of one row (the all-ones row: every muscle moves), the smallest slab
-  clearance and whether every probe read right.  Goals (issue 9): build of 200 gates
-  under 2 s, static verification of one row of a 200-gate circuit under 10 s, build cost
-  no worse than linear in bodies.
+* Ripple-carry adders of growing width (1 to 7 bits, 7 gates per full-adder bit; a scene
+  lists every row of its truth table, so at most 14 inputs) and array multipliers (2 to 6
+  bits: 6 x 6 is 222 gates on 12 inputs, the series past 200 gates): netlist gates, scene
+  bodies, build time (placement + routing + assembly), static verification time of one
+  row (the all-ones row: every muscle moves), the smallest slab clearance and whether
+  every probe read right.  Goals (issue 9): build of 200 gates under 2 s, static
+  verification of one row of a 200-gate circuit under 10 s, build cost no worse than
+  linear in bodies.
 * The full adder verified by Brownian dynamics on one row with each scheme: the cost of a
   t0 measured over a short run, times the row's floor (``dynamic_per_scheme``; Euler's row
   is ~2.5e8 steps, so it is never run whole).
 
-    python benchmarks/circuit_scaling.py [--max-width 30] [--skip-dynamic]
+    python benchmarks/circuit_scaling.py [--widths 1 2 3] [--skip-dynamic]   (adders; keeps the multipliers)
+    python benchmarks/circuit_scaling.py --multipliers 2 3 4 5 6     (merged into the JSON point by point)
     python benchmarks/circuit_scaling.py --dynamic-only     (the per-scheme part alone)
     python benchmarks/circuit_scaling.py --refit            (fit and goals from the JSON)
 
@@ -36,16 +39,23 @@ import numpy as np
 
 from mlc.circuit.build import build_circuit
 from mlc.io.atomic import atomic_path
-from mlc.logic.library import ripple_adder
+from mlc.logic.library import array_multiplier, ripple_adder
 from mlc.pipeline import compile_spec
 from mlc.verify.circuit import verify_static
 
 OUT = Path(__file__).resolve().parent / "results"
 
 
-def adder_point(w: int) -> dict:
-    spec = ripple_adder(w)
+def adder_point(w: int, family: str = "adder") -> dict:
+    """One circuit of the series: the ``w``-bit ripple-carry adder, or (``family`` "multiplier")
+    the ``w`` x ``w`` array multiplier (2w inputs: 6 bits are 222 gates on 12 inputs, the
+    series' point past 200 gates whose scene can still list every row).  The refusal of
+    netlists whose build estimate passes an hour (``MAX_GATES``) is lifted here: measuring
+    beyond it is the point."""
+    from mlc.circuit import build as cb
+    spec = ripple_adder(w) if family == "adder" else array_multiplier(w)
     c = compile_spec(spec, 2, "expand")
+    cb.MAX_GATES = max(cb.MAX_GATES, len(c.netlist.gates))
     from mlc.circuit import route
     hits0 = list(route.CACHE_HITS)
     load0 = os.getloadavg()[0]
@@ -55,7 +65,7 @@ def adder_point(w: int) -> dict:
     sc = circ.scene
     row = "1" * len(sc.inputs)
     rep = verify_static(sc, rows=[row])
-    return {"width": w, "gates": len(c.netlist.gates), "bodies": len(sc.bodies), "chains": circ.chains,
+    return {"family": family, "width": w, "gates": len(c.netlist.gates), "bodies": len(sc.bodies), "chains": circ.chains,
             "half_units": circ.half_units, "build_s": t_build, "build_cpu_s": c_build, "load": load0,
             "route_solves": route.CACHE_HITS[1] - hits0[1], "route_repeats": route.CACHE_HITS[0] - hits0[0],
             "tight_chains": sc.meta["connector"]["tight_chains"], "build_parts_s": circ.seconds,
@@ -135,27 +145,99 @@ def dynamic_per_scheme(row: str = "111", probe_t0: float = 2.0, euler_steps: int
     return out
 
 
+def refit(res: dict) -> dict:
+    """Fit (per family), goals and extrapolation of ``res`` from its points.  The goals are read
+    off the largest circuit of 200 gates or more when one was measured (the multipliers)."""
+    fams = {"adder": res.get("adders", []), "multiplier": res.get("multipliers", [])}
+    res["fit"], res["goals"], res["extrapolated_200_gates"] = fit_and_goals(fams["adder"])
+    res["fit_multipliers"] = fit_and_goals(fams["multiplier"])[0] if len(fams["multiplier"]) >= 3 else {}
+    big = [p for p in fams["adder"] + fams["multiplier"] if p["gates"] >= 200]
+    if big:
+        p = min(big, key=lambda p: p["gates"])
+        res["goals"] = {"circuit": f"{p.get('family', 'adder')} {p['width']} bits, {p['gates']} gates, "
+                                   f"{p['bodies']} bodies",
+                        "build_200_gates_under_2s": p["build_s"] < 2.0, "build_s": p["build_s"],
+                        "build_over_goal": p["build_s"] / 2.0,
+                        "verify_row_200_gates_under_10s": p["verify_row_s"] < 10.0,
+                        "verify_row_s": p["verify_row_s"], "verify_over_goal": p["verify_row_s"] / 10.0}
+    return res
+
+
+PNG = OUT / "circuit_scaling.png"
+
+
+def plot(res: dict) -> None:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
+    for fam, key, col in (("ripple-carry adders", "adders", "C0"), ("array multipliers", "multipliers", "C2")):
+        pts = res.get(key, [])
+        if not pts:
+            continue
+        g = [p["gates"] for p in pts]
+        b = [p["bodies"] for p in pts]
+        ax[0].loglog(g, b, "o-", color=col, label=fam)
+        ax[1].loglog(b, [p["build_s"] for p in pts], "o-", color=col, label=f"{fam}: build, wall")
+        ax[1].loglog(b, [p["build_cpu_s"] for p in pts], "o--", color=col, alpha=0.5, label=f"{fam}: build, CPU")
+        ax[1].loglog(b, [p["verify_row_s"] for p in pts], "s:", color=col, label=f"{fam}: static check, one row")
+    ax[0].set_xlabel("gates")
+    ax[0].set_ylabel("bodies in the scene")
+    ax[0].legend(fontsize=8)
+    ax[1].axhline(2.0, color="k", ls=":", lw=0.8)
+    ax[1].axhline(10.0, color="k", ls="-.", lw=0.8)
+    ax[1].set_xlabel("bodies")
+    ax[1].set_ylabel("time (s); goals for 200 gates: build 2 s, one row 10 s")
+    ax[1].legend(fontsize=7)
+    fig.tight_layout()
+    fig.savefig(PNG, dpi=110)
+
+
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--max-width", type=int, default=30)
+    ap.add_argument("--max-width", type=int, default=7)
     ap.add_argument("--widths", type=int, nargs="*")
+    ap.add_argument("--multipliers", type=int, nargs="*",
+                    help="measure these w x w array multipliers and merge them into the committed JSON "
+                         "(the adders and the dynamic part are kept)")
     ap.add_argument("--skip-dynamic", action="store_true")
     ap.add_argument("--budget", type=float, default=1800.0, help="stop growing after this many seconds")
     ap.add_argument("--dynamic-only", action="store_true",
                     help="only the full adder's per-scheme dynamic cost, into the committed JSON")
     ap.add_argument("--refit", action="store_true",
                     help="recompute fit, goals and extrapolation from the committed JSON's points; run nothing")
+    ap.add_argument("--json", type=Path, default=OUT / "circuit_scaling.json",
+                    help="results file read and written (another name lets two series run at once)")
     args = ap.parse_args()
-    if args.refit or args.dynamic_only:
-        res = json.loads((OUT / "circuit_scaling.json").read_text())
-        res["fit"], res["goals"], res["extrapolated_200_gates"] = fit_and_goals(res["adders"])
-        if args.dynamic_only:
-            res["dynamic_full_adder"] = dynamic_per_scheme()
-        with atomic_path(OUT / "circuit_scaling.json") as tmp:
+    path = args.json
+    old = json.loads(path.read_text()) if path.exists() else {}
+
+    def save(res):
+        refit(res)
+        OUT.mkdir(exist_ok=True)
+        with atomic_path(path) as tmp:
             tmp.write_text(json.dumps(res, indent=1))
-        print(json.dumps({k: res[k] for k in ("fit", "goals", "extrapolated_200_gates")}, indent=1))
+        if path == OUT / "circuit_scaling.json":
+            plot(res)
+        print(json.dumps({k: res.get(k) for k in ("fit", "fit_multipliers", "goals", "extrapolated_200_gates")},
+                         indent=1), flush=True)
+
+    if args.refit or args.dynamic_only:
+        if args.dynamic_only:
+            old["dynamic_full_adder"] = dynamic_per_scheme()
+        save(old)
         return
-    widths = args.widths or [w for w in (1, 2, 3, 4, 6, 8, 12, 16, 20, 25, 30) if w <= args.max_width]
+    if args.multipliers:
+        pts = {p["width"]: p for p in old.get("multipliers", [])}
+        for w in args.multipliers:
+            p = adder_point(w, "multiplier")
+            pts[w] = p
+            print(json.dumps({k: (round(v, 3) if isinstance(v, float) else v) for k, v in p.items()
+                              if k != "build_parts_s"}), flush=True)
+            old["multipliers"] = [pts[k] for k in sorted(pts)]
+            save(old)                                    # after every point: a long series keeps what it measured
+        return
+    widths = args.widths or [w for w in range(1, 8) if w <= args.max_width]
     points = []
     t_all = time.perf_counter()
     for w in widths:
@@ -167,37 +249,10 @@ def main():
             print(f"budget of {args.budget} s reached; stopping at width {w}")
             break
     dyn = [] if args.skip_dynamic else dynamic_per_scheme()
-    g = np.array([p["gates"] for p in points], float)
-    b = np.array([p["bodies"] for p in points], float)
-    tb = np.array([p["build_s"] for p in points])
-    tv = np.array([p["verify_row_s"] for p in points])
-    fit, goals, extra = fit_and_goals(points)
     res = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
                        "load": os.getloadavg()[0] if hasattr(os, "getloadavg") else None},
-           "adders": points, "dynamic_full_adder": dyn, "fit": fit, "goals": goals,
-           "extrapolated_200_gates": extra}
-    OUT.mkdir(exist_ok=True)
-    with atomic_path(OUT / "circuit_scaling.json") as tmp:
-        tmp.write_text(json.dumps(res, indent=1))
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
-    ax[0].loglog(g, b, "o-")
-    ax[0].set_xlabel("gates")
-    ax[0].set_ylabel("bodies in the scene")
-    ax[0].set_title("ripple-carry adders")
-    ax[1].loglog(b, tb, "o-", label="build (place + route + assemble), wall")
-    ax[1].loglog(b, [p["build_cpu_s"] for p in points], "o--", color="C0", alpha=0.5, label="build, CPU")
-    ax[1].loglog(b, tv, "s-", label="static verification, one row")
-    ax[1].axhline(2.0, color="C0", ls=":", lw=0.8)
-    ax[1].axhline(10.0, color="C1", ls=":", lw=0.8)
-    ax[1].set_xlabel("bodies")
-    ax[1].set_ylabel("wall time (s)")
-    ax[1].legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(OUT / "circuit_scaling.png", dpi=110)
-    print(json.dumps({"fit": fit, "goals": goals}))
+           "adders": points, "multipliers": old.get("multipliers", []), "dynamic_full_adder": dyn}
+    save(res)
 
 
 if __name__ == "__main__":

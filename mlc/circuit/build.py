@@ -7,13 +7,18 @@ Rules (docs/circuits.md):
   inversions).  The scene is built posed in the all-zero input row: each gate is posed
   in its own input state of that row (solved once per gate type and state).
 * **Placement.**  Gates stand upright (core plane horizontal, output lever up) in
-  levels along +z: logic level ``d`` at ``z = d * level_pitch``; a level's gates are
-  spread along x, ordered by the mean x of their drivers.  Circuit inputs that need a
-  source (fan-out, or an output) sit at level 0.
+  levels along +z: level ``d`` at ``z ~ d * level_pitch``.  The levels (``place_levels``)
+  keep every chain rising (a sink above its drivers) and make the chains' summed rise,
+  in levels, the least (a linear programme; ties go to the lowest levels): a gate whose
+  consumers sit far above it rises towards them, and a circuit input that needs a
+  source (fan-out, or an output) has its source one level below its lowest consumer.
+  A level's gates (and sources) are spread along x, ordered by the mean x of their
+  drivers.
 * **Inputs.**  One muscle per circuit input.  An input that feeds exactly one gate
   input drives that input lever directly (the library gate's own muscle); otherwise
-  the muscle spans the input diagonal of a *source* half unit at level 0, whose output
-  pair (carrying the inverted signal) is the tap of the wire.
+  the muscle spans the input diagonal of a *source* half unit (at level 0, or one level
+  below its lowest consumer), whose output pair (carrying the inverted signal) is the
+  tap of the wire.
 * **Taps and fan-out.**  A wire's tap is a gate's output pair (or a source's).  One
   consumer: a chain hangs on the tap.  Several: a branch: one half unit (a page) per
   consumer hangs on the tap, turned about the tap's axis, and each page's chain goes on.
@@ -161,6 +166,53 @@ def _wire_values(netlist, bits: dict) -> dict:
     return val
 
 
+def place_levels(netlist, sources) -> dict[tuple, int]:
+    """Level of every gate (``("gate", id)``) and of every input source (``("input", name)``
+    for the inputs in ``sources``; the other inputs drive one lever directly and have no place).
+
+    Every chain rises: a gate stands at least one level above each of its drivers (gates at
+    level 1 and up, sources at 0 and up).  Of those placements, the one whose chains rise the
+    least in all (the sum over chains of sink level minus driver level: a chain's length
+    grows with its rise) is found as a linear programme (scipy's HiGHS dual simplex; the
+    constraints are differences, so the optimal vertex is integral).  Among the least, the
+    lowest levels win (a term ``eps * sum(levels)`` with ``eps`` too small to trade one level
+    of rise).  A logic-depth placement (every gate at its depth, sources at 0) is a feasible
+    point, so the rise is never more than that placement's.  Returns ints; a result that
+    is not integral or breaks a constraint is an internal error."""
+    from scipy.optimize import linprog
+
+    from mlc.errors import InternalError
+    src_names = {w.name for w in sources}
+    nodes = [("input", w.name) for w in netlist.inputs if w.name in src_names] + [("gate", g.id) for g in netlist.gates]
+    ix = {n: i for i, n in enumerate(nodes)}
+    n = len(nodes)
+    if not netlist.gates:
+        return {v: 0 for v in nodes}
+    rows, rhs = [], []
+    cost = np.zeros(n)
+    for g in netlist.gates:
+        v = ix[("gate", g.id)]
+        for p in (g.a, g.b):
+            if p.src in ix:                              # a chain from a source or a gate
+                row = np.zeros(n)
+                row[ix[p.src]], row[v] = 1.0, -1.0       # l(src) - l(g) <= -1
+                rows.append(row)
+                rhs.append(-1.0)
+                cost[v] += 1.0
+                cost[ix[p.src]] -= 1.0
+    depth_max = max(g.depth for g in netlist.gates)
+    cost += 1.0 / (n * (depth_max + 1) + 1)
+    lo = [0.0 if v[0] == "input" else 1.0 for v in nodes]
+    res = linprog(cost, A_ub=np.array(rows) if rows else None, b_ub=rhs if rows else None,
+                  bounds=[(b, float(depth_max)) for b in lo], method="highs-ds")
+    if res.status != 0:
+        raise InternalError(f"placement levels: the linear programme failed ({res.message})")
+    lv = np.rint(res.x)
+    if np.max(np.abs(lv - res.x)) > 1e-6 or (rows and np.any(np.array(rows) @ lv > np.array(rhs) + 1e-9)):
+        raise InternalError("placement levels: the linear programme's optimum is not an integral placement")
+    return {v: int(lv[i]) for v, i in ix.items()}
+
+
 def _truth_table(spec, netlist) -> dict[str, str]:
     """Expected outputs of every row, from the specification (the user's intent)."""
     from mlc.logic.equiv import spec_tables
@@ -293,16 +345,23 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     direct = direct_nets(netlist, consumers, opt.direct_skip) if opt.direct else {}   # sink -> (driver, pin)
 
     # ---- placement -----------------------------------------------------------------
-    levels: dict[int, list] = {}
-    for g in netlist.gates:
-        if g.id not in direct:                   # a direct sink sits on its driver's unit
-            levels.setdefault(g.depth, []).append(g)
-    xpos: dict[tuple, float] = {}
     sources = [w for w in netlist.inputs
                if not (len(consumers.get(("input", w.name), [])) == 1
                        and consumers[("input", w.name)][0][0] == "pin")]
-    for i, w in enumerate(sources):
-        xpos[("input", w.name)] = (i - 0.5 * (len(sources) - 1)) * opt.gate_pitch
+    level = place_levels(netlist, sources)
+    lvl = {g.id: level[("gate", g.id)] for g in netlist.gates}
+    levels: dict[int, list] = {}
+    for g in netlist.gates:
+        if g.id not in direct:                   # a direct sink sits on its driver's unit
+            levels.setdefault(lvl[g.id], []).append(g)
+    xpos: dict[tuple, float] = {}
+    # sources at level 0 in a row of their own; higher ones take a place in their level's row
+    low = [w for w in sources if level[("input", w.name)] == 0]
+    for i, w in enumerate(low):
+        xpos[("input", w.name)] = (i - 0.5 * (len(low) - 1)) * opt.gate_pitch
+    for w in sources:
+        if level[("input", w.name)] > 0:
+            levels.setdefault(level[("input", w.name)], []).append(w)
     for w in netlist.inputs:
         xpos.setdefault(("input", w.name), 0.0)
     # routes arriving at each level: each gets its own horizontal layer in the gap below it
@@ -311,10 +370,20 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         for pin, p in (("a", g.a), ("b", g.b)):
             if not (p.src[0] == "input" and len(consumers.get(p.src, [])) == 1) and direct.get(g.id) != (
                     p.src[1], pin):
-                arriving[g.depth] = arriving.get(g.depth, 0) + 1
+                arriving[lvl[g.id]] = arriving.get(lvl[g.id], 0) + 1
     zlevel = {0: 0.0}
-    for d in range(1, max((g.depth for g in netlist.gates), default=0) + 1):
+    for d in range(1, max(level.values(), default=0) + 1):
         zlevel[d] = zlevel[d - 1] + opt.level_pitch + LAYER_PITCH * arriving.get(d, 0)
+    src_level = {w.name: level[("input", w.name)] for w in sources}
+
+    def row_key(it):
+        """A gate: the mean x of its drivers; a source: of its consumers' other drivers placed so far."""
+        if not hasattr(it, "id"):
+            xs = [xpos[p.src] for g in netlist.gates for p in (g.a, g.b)
+                  if ("input", it.name) in (g.a.src, g.b.src) and p.src != ("input", it.name) and p.src in xpos]
+            return (float(np.mean(xs)) if xs else 0.0, 1, it.name)
+        return (0.5 * (xpos.get(it.a.src, 0.0) + xpos.get(it.b.src, 0.0)), 0, it.id)
+
     origin: dict[str, np.ndarray] = {}
     for d in sorted(levels):
         for _ in direct:                         # a direct sink stands over its driver; repeated
@@ -322,9 +391,12 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                 if ("gate", drv) in xpos:
                     xpos[("gate", s_)] = xpos[("gate", drv)]
         gs = levels[d]
-        gs.sort(key=lambda g: (0.5 * (xpos.get(g.a.src, 0.0) + xpos.get(g.b.src, 0.0)), g.id))
+        gs.sort(key=row_key)
         for i, g in enumerate(gs):
             x = (i - 0.5 * (len(gs) - 1) + 0.5 * (d % 2)) * opt.gate_pitch
+            if not hasattr(g, "id"):
+                xpos[("input", g.name)] = x
+                continue
             xpos[("gate", g.id)] = x
             origin[g.id] = np.array([x, 0.0, zlevel[d]])
     layer_next = {d: 0 for d in zlevel}
@@ -351,7 +423,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     n_direct_half = 0
     gate_owned: list[tuple[list[Body], frozenset]] = []   # bodies of each gate (and direct unit), their owners
     for g in [g for g in netlist.gates if g.id not in direct] + sorted(
-            (g for g in netlist.gates if g.id in direct), key=lambda g: g.depth):
+            (g for g in netlist.gates if g.id in direct), key=lambda g: lvl[g.id]):
         state = f"{zero[g.a.src]}{zero[g.b.src]}"
         sc, pos, quat = _posed_gate(g.type, signal, state)
         if g.id in direct:
@@ -379,11 +451,13 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     taps: dict[tuple, tuple[Pair, int]] = {}     # wire -> (tap pair, its polarity: 1 = carries NOT wire)
     for w in sources:
         src = ("input", w.name)
-        c = np.array([xpos[src], 0.0, 0.0])
+        c = np.array([xpos[src], 0.0, zlevel[src_level[w.name]]])
         parts, pin, pout = half_unit_parts(f"src_{w.name}", c, np.array([0.0, 1.0, 0]), np.array([0, 0, 1.0]),
                                            zero[src], geo)
         parts.muscles.append(Muscle(f"muscle_{w.name}", w.name, pin.lo, pin.hi, geo.L0, geo.L1, k_muscle))
         add(parts)
+        if src_level[w.name] > 0:                # among a level's gates: the other chains keep from it
+            gate_owned.append((parts.bodies, frozenset((f"src:{w.name}",))))
         taps[src] = (pout, 1)
         if not consumers.get(src):
             taps[src] = (pin, 0)
@@ -400,7 +474,6 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     tight: list = []                        # chains that could not be kept apart by the lanes
     routed: dict[str, _Chain] = {}         # chain tag -> its route and what assembling it needs
     deferred: list = []                     # pages and stubs (Parts) and chain tags, in routing order
-    depth_of = {g.id: g.depth for g in netlist.gates}
     if direct:                                  # the direct nets need no chain
         consumers = {w: c for w, c in consumers_all.items()
                      if not (w[0] == "gate" and len(c) == 1 and c[0][0] == "pin"
@@ -482,7 +555,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             target = _pair(by_name, f"{gid}_{pin_name}_lo.in", f"{gid}_{pin_name}_hi.in")
             ext = TERMINAL_POST - 0.5 * geo.gap
             app = np.array([0.0, 0.0, 1.0])
-            d_sink = depth_of[gid]
+            d_sink = lvl[gid]
             k_layer = layer_next[d_sink]
             layer_next[d_sink] += 1
             z_run = zlevel[d_sink - 1] + RUN_BASE + LAYER_PITCH * k_layer
@@ -503,7 +576,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             skip = BRANCH_LAYERS if start is not tap else 0
             # the gates this chain may touch: its driver's and its sink's (with their direct units)
             others = [p for p, owners in gate_pts
-                      if gid not in owners and not (wire[0] == "gate" and wname in owners)]
+                      if gid not in owners and not (wire[0] == "gate" and wname in owners)
+                      and not (wire[0] == "input" and f"src:{wname}" in owners)]
             others = np.concatenate(others) if others else np.zeros((0, 3))
             others_tree = cKDTree(others) if len(others) else None
             route_kw = dict(tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
