@@ -199,18 +199,19 @@ def test_five_way_branch_pages_clear_each_other():
 
 
 def test_rip_up_reroutes_a_chain_and_the_one_it_presses_into(monkeypatch):
-    """Routed with wires g1 and g2 first, the full adder's chain w_g3_1 comes 0.99 sigma
-    from w_g3_0, routed before it, which could not make room (layer centres; 1.8 keeps
-    them apart by the sphere bound).  The rip-up routes w_g3_0 again around it, then
-    w_g3_1, and keeps the two new routes only if they are farther apart."""
+    """Routed with wires g4 and g5 first, the full adder's chain w_g5_0 comes 1.30 sigma
+    from w_g4_1, routed before it, which could not make room (layer centres; 1.8 keeps
+    them apart by the sphere bound).  With the rip-up's threshold at 1.4 sigma (1.2 by
+    default, which leaves this pair alone), w_g4_1 is routed again around it, then w_g5_0,
+    and the two new routes are kept only if they are farther apart."""
     from mlc.circuit import build as B
     spec = load("examples/full_adder.tt", None)
     c = compile_spec(spec)
     opt = B.CircuitOptions()
     monkeypatch.setattr(B, "RIP_GAP", 0.0)              # no rip-up
-    plain = B._build_circuit(c.netlist, spec, opt, first_wires=("g1", "g2"))
-    monkeypatch.undo()
-    ripped = B._build_circuit(c.netlist, spec, opt, first_wires=("g1", "g2"))
+    plain = B._build_circuit(c.netlist, spec, opt, first_wires=("g4", "g5"))
+    monkeypatch.setattr(B, "RIP_GAP", 1.4)
+    ripped = B._build_circuit(c.netlist, spec, opt, first_wires=("g4", "g5"))
     assert plain.closest < B.RIP_GAP and "rerouted" not in plain.scene.meta["connector"]
     assert ripped.scene.meta["connector"]["rerouted"], "no chain was routed again"
     assert ripped.closest > plain.closest, (plain.closest, ripped.closest)
@@ -232,7 +233,7 @@ def test_build_time_estimate_follows_the_measured_circuits():
     from mlc.circuit import build as cb
     res = json.loads((Path(__file__).resolve().parents[1] / "benchmarks" / "results" /
                       "circuit_scaling.json").read_text())
-    pts = [a for a in res["adders"] + res.get("multipliers", []) if a["gates"] >= 10]
+    pts = [a for a in res["adders"] + res.get("multipliers", []) if a["gates"] >= 10 and "build_cpu_s" in a]
     assert len(pts) >= 4
     for a in pts:
         ratio = cb.build_cpu_estimate(a["gates"]) / a["build_cpu_s"]
@@ -336,3 +337,28 @@ def test_a_source_above_level_0_stands_in_its_levels_row_and_the_circuit_compute
     rep = verify_static(sc, rows=["000", "100"])
     assert rep.ok, format_report(rep)
     assert min(r["clearance"] for r in rep.rows) > 0
+
+
+def test_a_wire_longer_than_any_chain_is_refused_before_routing(monkeypatch):
+    """A 4 x 4 array multiplier's input a0 feeds a gate 532 sigma from its source, beyond the
+    400 half units (1 sigma each) of the longest chain the router tries.  Before, each such
+    chain was tried plane by plane (17 minutes on the 6 x 6 multiplier) and then refused;
+    now the build refuses it before routing any chain, naming the wire, the sink, the
+    distance and the fix."""
+    from mlc.circuit import build as cb
+    from mlc.errors import MlcError
+    from mlc.logic.library import array_multiplier
+
+    def never(*a, **k):
+        raise AssertionError("a chain was routed")
+    monkeypatch.setattr(cb, "_route_chain", never)
+    spec = array_multiplier(4)
+    c = compile_spec(spec, 2, "expand")
+    assert len(c.netlist.gates) <= cb.MAX_GATES
+    with pytest.raises(MlcError) as e:
+        build_circuit(c.netlist, spec)
+    msg = str(e.value)
+    assert "cannot route input a0 to g" in msg and "beyond the longest connector chain" in msg, msg
+    assert "--no-circuit" in msg
+    d = float(msg.split("stands ")[1].split(" sigma")[0])
+    assert d > 400

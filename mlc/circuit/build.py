@@ -46,12 +46,13 @@ from mlc.gates.connector import (POST_WIDTH, Pair, Parts, branch_angles, chain_p
 from mlc.gates.parts import slab_body
 from mlc.scene.model import Body, Bond, Muscle, Probe, Scene
 
-# Build CPU grows as gates^2.75 (bodies ~ gates^1.32, routing CPU ~ bodies^2.09; the 1- to 3-bit
-# adders in benchmarks/results/circuit_scaling.json: 0.9, 27.6, 103 s for 3, 10, 17 gates): larger
-# netlists are refused before the work, with the estimate (a 84-AND circuit routed for 45 min unasked).
-BUILD_CPU_REF = (17, 103.0)      # (gates, CPU s) of the 3-bit adder's build
-BUILD_CPU_EXPONENT = 2.75        # in gates
-MAX_BUILD_CPU = 3600.0           # s: about 60 gates
+# Build CPU grows as gates^2.18 (least-rise levels, session 23: bodies ~ gates^1.17, build CPU
+# ~ bodies^1.78, more re-routes as the circuit gets denser; the 2- to 7-bit adders in
+# benchmarks/results/circuit_scaling.json, 14 to 352 s for 10 to 45 gates): larger netlists
+# are refused before the work, with the estimate (a 84-AND circuit routed for 45 min unasked).
+BUILD_CPU_REF = (45, 347.0)      # (gates, CPU s) of the fit at the 7-bit adder
+BUILD_CPU_EXPONENT = 2.18        # in gates
+MAX_BUILD_CPU = 3600.0           # s: about 130 gates
 MAX_GATES = int(BUILD_CPU_REF[0] * (MAX_BUILD_CPU / BUILD_CPU_REF[1]) ** (1 / BUILD_CPU_EXPONENT))
 
 
@@ -479,6 +480,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                      if not (w[0] == "gate" and len(c) == 1 and c[0][0] == "pin"
                              and direct.get(c[0][1], (None,))[0] == w[1])}
     n_half += n_direct_half
+    _check_reach(netlist, taps, consumers, by_name, level, geo)
     wires = [w for w in taps if consumers.get(w)]
     wires.sort(key=lambda w: w[1] not in first_wires)          # stable: the rest keep their order
     for wi, wire in enumerate(wires):
@@ -670,6 +672,29 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                    {"place": t_route - t_start, "route": t_rip - t_route, "rip_up": t_done - t_rip,
                     "assemble": t_end - t_done},
                    min((g for _, g in tight), default=float("inf")))
+
+
+def _check_reach(netlist, taps, consumers, by_name, level, geo) -> None:
+    """Refuse, before any routing, a wire whose sink is farther from its tap in a straight line
+    than the longest chain the router tries (``route.MAX_HALF`` half units of ``geo.pitch``):
+    no route can close it (a route is never shorter than the straight line), and finding
+    that out chain by chain took 17 minutes on a 6 x 6 multiplier (sigma)."""
+    from mlc.circuit.route import MAX_HALF
+    reach = MAX_HALF * geo.pitch
+    for wire, (tap, _) in taps.items():
+        for c in consumers.get(wire, []):
+            if c[0] != "pin":
+                continue
+            target = _pair(by_name, f"{c[1]}_{c[2]}_lo.in", f"{c[1]}_{c[2]}_hi.in")
+            d = float(np.linalg.norm(target.centre - tap.centre))
+            if d > reach:
+                src = "input" if wire[0] == "input" else "gate"
+                rise = level[("gate", c[1])] - level.get(wire, 0)
+                raise MlcError(f"cannot route {src} {wire[1]} to {c[1]}.{c[2]}: the sink stands {d:.0f} sigma from "
+                               f"the wire's tap ({rise} levels up), beyond the longest connector chain the router "
+                               f"closes ({MAX_HALF} half units, {reach:.0f} sigma)", netlist.source,
+                               "split the design into smaller circuits, or compile with --no-circuit for the "
+                               "netlist alone")
 
 
 @dataclass

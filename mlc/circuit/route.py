@@ -39,6 +39,7 @@ STATS = None               # a list to collect (n, pass, evaluations, status, cl
 AVOID_WEIGHT = 30.0        # weight of the keep-away terms (``avoid``) against the waypoints' 1
 EARLY_CLOSE = True         # the closing passes stop at the first evaluation that closes to CLOSE_MARGIN * EXACT
 CLOSE_MARGIN = 0.1
+MAX_HALF = 400             # half units of the longest chain tried (the steered guess is cut there)
 
 
 @dataclass
@@ -226,7 +227,7 @@ def solve_route(*args, **kw) -> Route | None:
 
 def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int, *,
                 tangent=None, free_start: bool = True, approach=None, waypoints=(),
-                min_half: int = 2, max_half: int = 400, bend_max: float | None = None,
+                min_half: int = 2, max_half: int = MAX_HALF, bend_max: float | None = None,
                 last_pitch: float | None = None, start_bend_max: float = math.radians(50.0),
                 extras=(0, 2, 4, 8, 12, 16, 24), end_bends: tuple[int, float] | None = None,
                  wp_weight: float = 0.3, avoid=(), avoid_from: int = 0) -> Route | None:
