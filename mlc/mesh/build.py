@@ -2730,50 +2730,10 @@ def _orientation(asm: Assembly) -> np.ndarray:
 
 
 def _best_rotation(asm: Assembly) -> np.ndarray:
-    """``orient: auto``: of the candidate "up" directions -- the world axes, the normals of every
-    slab (laid flat) and the hinge-axes-flat direction, both signs -- the one whose print needs
-    the least support (none resting on a part first), then has the most bed contact
-    (:func:`mlc.mesh.printability.bed_stats` on a coarse grid)."""
-    from mlc.geometry.rotation import rotation_between
-    from mlc.mesh.checks import BED_CONTACT_MIN, OVERHANG_DEG, SUPPORT_MAX
-    from mlc.mesh.printability import bed_stats
-
-    cands = [np.array(v, float) for v in np.eye(3)]
-    for b in asm.scene.bodies:
-        Rb = quat_to_matrix(b.orientation)
-        for bx in b.boxes:
-            R = Rb @ quat_to_matrix(bx.orientation)
-            cands.append(R[:, int(np.argmin(bx.size))])
-    uniq = []
-    for c in cands:
-        for sg in (1.0, -1.0):
-            v = sg * c / np.linalg.norm(c)
-            if all(np.dot(v, u) < 1 - 1e-6 for u in uniq):
-                uniq.append(v)
-    ext = max(float(np.max(np.asarray(p.solid.bounding_box())[3:] - np.asarray(p.solid.bounding_box())[:3]))
-              for p in asm.parts if not p.solid.is_empty())
-    h = max(ext / 60, 0.05)
-    best = None
-    for up in uniq:
-        R = rotation_between(up, [0, 0, 1.0])
-        solids = []
-        zmin = np.inf
-        for p in asm.parts:
-            if p.solid.is_empty():
-                continue
-            sp = transform_solid(p.solid, _h(R, np.zeros(3)))
-            zmin = min(zmin, float(np.asarray(sp.bounding_box())[2]))
-            solids.append((p.name, sp))
-        solids = [(n, x.translate([0, 0, -zmin])) for n, x in solids]
-        st = bed_stats(solids, OVERHANG_DEG, h, first_layer=min(0.2, asm.profile.min_wall / 2))
-        bad = (st.support_inside_mm3 > 1e-6) + (st.support_fraction > SUPPORT_MAX) + \
-              (st.contact_fraction < BED_CONTACT_MIN)
-        key = (bad, round(st.support_fraction - st.contact_fraction, 6))
-        if best is None or key < best[0]:
-            best = (key, R, up)
-    asm.notes.append(f"orientation: up is the model's ({best[2][0]:.3g}, {best[2][1]:.3g}, {best[2][2]:.3g}), "
-                     f"the best bed of {len(uniq)} candidates (least support, then most bed contact)")
-    return best[1]
+    """``orient: auto``: the up direction with the best bed, searched over the sphere
+    (:func:`mlc.mesh.pose.best_rotation`)."""
+    from mlc.mesh.pose import best_rotation
+    return best_rotation(asm)
 
 
 def _h(R, t) -> np.ndarray:

@@ -25,7 +25,9 @@ Checks (each one can fail; a failed check makes ``mlc stl`` exit non-zero unless
                  the bed (mlc.mesh.printability)
 ``supports``     the overhangs (faces flatter than ``OVERHANG_DEG`` from the bed, not on it)
                  need at most ``SUPPORT_MAX`` of the part volume in support, none of it resting
-                 on a part (inside the mechanism)
+                 on another part (inside the mechanism; support inside a hole of one part counts
+                 in the volume only); each island (a point of a part in mid-air, lower than
+                 the surface around it) needs a column ``ISLAND_FEATURES`` x min_feature a side
 """
 from __future__ import annotations
 
@@ -46,6 +48,7 @@ GAP_EPS = 1e-6    # mm
 BED_CONTACT_MIN = 0.20     # first-layer area / footprint
 SUPPORT_MAX = 0.10         # support volume / part volume
 OVERHANG_DEG = 45.0        # faces steeper than this from vertical need support (FDM rule of thumb)
+ISLAND_FEATURES = 3.0      # an island's support column: a square of this many min_feature a side
 APART = True               # large assemblies: states and min_gap prove pairs apart from their triangles first (mlc.mesh.apart)
 
 
@@ -382,6 +385,11 @@ def wall_check(asm: Assembly) -> Check:
                  "wall_thickness" not in NON_BLOCKING)
 
 
+def island_side(profile) -> float:
+    """The side (mm) of the support column under an island (mlc.mesh.printability)."""
+    return ISLAND_FEATURES * profile.min_feature
+
+
 def bed_checks(asm: Assembly, stats=None) -> list:
     """``bed_contact`` and ``supports`` of the assembly in its print frame."""
     from mlc.mesh.printability import bed_stats
@@ -389,7 +397,8 @@ def bed_checks(asm: Assembly, stats=None) -> list:
         solids = [(p.name, transform_solid(p.solid, asm.orient)) for p in asm.parts]
         size = print_size(asm) or [1.0]
         h = max(0.05, min(asm.profile.min_wall, max(size) / 150))
-        stats = bed_stats(solids, OVERHANG_DEG, h, first_layer=min(0.2, asm.profile.min_wall / 2))
+        stats = bed_stats(solids, OVERHANG_DEG, h, first_layer=min(0.2, asm.profile.min_wall / 2),
+                          island_mm=island_side(asm.profile))
     asm.bed = stats
     cf = stats.contact_fraction
     floating = sorted(n for n, z in stats.lowest_mm.items() if z > 0.5 * min(0.2, asm.profile.min_wall / 2))
@@ -406,13 +415,15 @@ def bed_checks(asm: Assembly, stats=None) -> list:
         fails.append(f"support {stats.support_mm3:.1f} mm^3 = {100 * sf:.1f} % of the part volume "
                      f"> {100 * SUPPORT_MAX:g} %")
     if stats.support_inside_mm3 > VOL_EPS:
-        fails.append(f"{stats.support_inside_mm3:.1f} mm^3 of support rests on parts (inside the mechanism)")
-    fails += [f"{n}: overhang {o:.1f} mm^2, support {v:.1f} mm^3 ({i:.1f} on parts)"
+        fails.append(f"{stats.support_inside_mm3:.1f} mm^3 of support rests on another part (inside the mechanism)")
+    fails += [f"{n}: overhang {o:.1f} mm^2, support {v:.1f} mm^3 ({i:.1f} on other parts)"
               for n, (o, v, i) in sorted(stats.per_part.items(), key=lambda x: -x[1][1]) if v > 0][:8 if fails else 0]
     sc = Check("supports", ok, round(sf, 4), SUPPORT_MAX,
                f"overhangs {stats.overhang_mm2:.1f} mm^2 (flatter than {OVERHANG_DEG:g} degrees from vertical); "
                f"support {stats.support_mm3:.1f} mm^3 = {100 * sf:.1f} % of {stats.part_volume_mm3:.1f} mm^3, "
-               f"{stats.support_inside_mm3:.1f} mm^3 of it inside the mechanism (grid {stats.grid_mm:.3g} mm)", fails)
+               f"{stats.support_inside_mm3:.1f} mm^3 of it inside the mechanism (between parts), "
+               f"{stats.support_self_mm3:.1f} mm^3 in holes and recesses of one part, {stats.islands} islands "
+               f"(grid {stats.grid_mm:.3g} mm)", fails)
     bc.blocking = "bed_contact" not in NON_BLOCKING
     sc.blocking = "supports" not in NON_BLOCKING
     return [bc, sc]

@@ -1,0 +1,285 @@
+"""The print pose of an assembly: which way is up on the bed (issue 13, item 1).
+
+All lengths in mm (the parts' meshes); directions are unit vectors of the model frame.
+
+The print pose is the rest configuration of the mechanism (the parts as built), rotated so
+that a chosen "up" direction of the model points along +z, then centred on the bed and put on
+z = 0 (``mlc.mesh.build._orientation``).  Other configurations (folding the levers) are not
+searched: the parts' meshes, the report's other checks and the STL/3MF writer all use the rest
+configuration with one rigid transform of the whole assembly (``Assembly.orient``).
+
+``orient: auto`` chooses up by :func:`search_up`:
+
+1. *candidates*: :data:`SPHERE_DIRS` directions spread evenly over the sphere (a Fibonacci
+   lattice, about 10 degrees apart at 400), the world axes and every slab's normal (both signs:
+   the candidates of the first search, session 20);
+2. each is scored by :func:`mlc.mesh.printability.quick_stats` on a coarse grid (the longest
+   side of the assembly / :data:`COARSE_CELLS`): the support volume (overhangs and islands)
+   exactly as the report computes it, bed contact and footprint from the grid columns;
+3. the :data:`REFINE_STARTS` best (at least :data:`START_APART_DEG` apart) are refined by a
+   pattern search on the sphere (8 directions at each of :data:`REFINE_STEPS_DEG` degrees,
+   moving while the score falls by at least :data:`MIN_GAIN`);
+4. the :data:`FINAL` best distinct directions, and the best of the step-1 axis and normal
+   candidates, are measured with :func:`mlc.mesh.printability.bed_stats` on the report's own
+   grid (``mlc.mesh.checks.bed_checks``); the :data:`EXACT_STARTS` best are refined again by
+   the same pattern search on that grid (:data:`EXACT_STEPS_DEG`, at most :data:`EXACT_MAX`
+   measurements: near the overhang limit a small tilt decides whether a column of support
+   rests on a part), and the best by :func:`pose_key` is kept.
+
+The score (:func:`pose_key`): first the number of the bed goals a pose fails (support resting on
+a part, support over ``SUPPORT_MAX`` of the part volume, bed contact under ``BED_CONTACT_MIN``
+of the footprint), then support fraction + inside-support fraction - contact fraction (support
+between parts counted twice: it cannot be removed without freeing the joints).
+
+The search costs about ``(SPHERE_DIRS + ~50 x REFINE_STARTS)`` coarse evaluations; an assembly
+of more than :data:`SEARCH_TRIANGLES` triangle-evaluations (a compiled circuit) gets fewer
+sphere directions, and none past that, so it keeps the axis and normal candidates only.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from mlc.geometry.rotation import quat_to_matrix, rotation_between
+
+#: directions of the Fibonacci lattice in the global stage
+SPHERE_DIRS = 400
+#: the assembly's longest side over this: the grid spacing (mm) of the coarse stage
+COARSE_CELLS = 40
+#: best coarse candidates refined by the pattern search
+REFINE_STARTS = 4
+#: the pattern search's steps (degrees), each kept while it improves the score
+REFINE_STEPS_DEG = (8.0, 4.0, 2.0, 1.0, 0.5)
+#: refined starts at least this far apart (degrees)
+START_APART_DEG = 15.0
+#: best distinct directions measured exactly at the end
+FINAL = 6
+#: of those, the best refined again on the report's own grid (exact bed_stats), by these steps
+EXACT_STARTS = 2
+EXACT_STEPS_DEG = (2.0, 1.0, 0.5, 0.25)
+#: at most this many exact measurements in all
+EXACT_MAX = 120
+#: a refinement step is taken only if it lowers the score by this much (a fraction of the part
+#: volume) or fails fewer goals
+MIN_GAIN = 0.01
+#: at most this many triangle evaluations (triangles x coarse directions) in the global stage
+SEARCH_TRIANGLES = 4.0e7
+
+
+def fibonacci_sphere(n: int) -> np.ndarray:
+    """``n`` unit vectors spread evenly over the sphere (deterministic)."""
+    if n <= 0:
+        return np.zeros((0, 3))
+    i = np.arange(n) + 0.5
+    phi = np.arccos(1 - 2 * i / n)
+    th = np.pi * (1 + 5 ** 0.5) * i
+    return np.stack([np.cos(th) * np.sin(phi), np.sin(th) * np.sin(phi), np.cos(phi)], 1)
+
+
+def structural_ups(scene) -> list:
+    """The world axes and every slab's normal (the thinnest side of each box), both signs,
+    without repeats: the candidates of the first ``orient: auto`` (session 20)."""
+    cands = [np.array(v, float) for v in np.eye(3)]
+    for b in scene.bodies:
+        Rb = quat_to_matrix(b.orientation)
+        for bx in b.boxes:
+            R = Rb @ quat_to_matrix(bx.orientation)
+            cands.append(R[:, int(np.argmin(bx.size))])
+    return _unique([sg * c / np.linalg.norm(c) for c in cands for sg in (1.0, -1.0)])
+
+
+def hinge_ups(directions) -> list:
+    """Up directions at 45 degrees from two hinge directions at once (both signs): a hinge axis
+    at 45 degrees prints its knuckle ends and its bore each at the overhang limit.  For every
+    pair of distinct lines among ``directions`` (unit vectors), the solutions of
+    |u . d1| = |u . d2| = cos 45 degrees, |u| = 1; for a single line, the ups at 45 degrees from
+    it in the planes of the world axes."""
+    ds = _unique([np.asarray(d, float) / np.linalg.norm(d) for d in directions], tol=1e-6)
+    lines = []
+    for d in ds:
+        if all(abs(np.dot(d, e)) < 1 - 1e-6 for e in lines):
+            lines.append(d)
+    c = np.cos(np.radians(45.0))
+    out = []
+    for i, d1 in enumerate(lines):
+        for w in np.eye(3):
+            p = w - np.dot(w, d1) * d1
+            if np.linalg.norm(p) > 1e-6:
+                p /= np.linalg.norm(p)
+                out += [c * d1 + c * p, c * d1 - c * p, -c * d1 + c * p, -c * d1 - c * p]
+        for d2 in lines[i + 1:]:
+            g = float(np.dot(d1, d2))
+            n = np.cross(d1, d2)
+            n /= np.linalg.norm(n)
+            G = np.array([[1.0, g], [g, 1.0]])
+            for s1 in (1.0, -1.0):
+                for s2 in (1.0, -1.0):
+                    a, b = np.linalg.solve(G, [s1 * c, s2 * c])
+                    r = 1.0 - (a * a + b * b + 2 * a * b * g)
+                    if r >= 0:
+                        for sg in (1.0, -1.0):
+                            out.append(a * d1 + b * d2 + sg * np.sqrt(r) * n)
+    return _unique([u / np.linalg.norm(u) for u in out])
+
+
+def _unique(vs, tol=1e-6) -> list:
+    out = []
+    for v in vs:
+        if all(np.dot(v, u) < 1 - tol for u in out):
+            out.append(np.asarray(v, float))
+    return out
+
+
+def pose_key(support_fraction: float, inside_fraction: float, contact_fraction: float) -> tuple:
+    """The order of print poses (smaller is better): the number of bed goals failed, then
+    support + inside support - bed contact (fractions of the part volume and footprint)."""
+    from mlc.mesh.checks import BED_CONTACT_MIN, SUPPORT_MAX
+    bad = int(inside_fraction > 1e-9) + int(support_fraction > SUPPORT_MAX) + int(contact_fraction < BED_CONTACT_MIN)
+    return (bad, round(support_fraction + inside_fraction - contact_fraction, 6))
+
+
+def _better(a: tuple, b: tuple) -> bool:
+    """Key ``a`` beats ``b``: fewer goals failed, or the score lower by at least :data:`MIN_GAIN`
+    (smaller differences are the grid's noise, not a better print)."""
+    return a[0] < b[0] or (a[0] == b[0] and a[1] < b[1] - MIN_GAIN)
+
+
+def _frame(u):
+    a = np.eye(3)[int(np.argmin(np.abs(u)))]
+    e1 = np.cross(u, a)
+    e1 /= np.linalg.norm(e1)
+    return e1, np.cross(u, e1)
+
+
+def search_up(V, F, part_volume: float, extra_ups=(), overhang_deg: float = 45.0, first_layer: float = 0.2,
+              exact=None, seeds=(), own=None, island_mm: float = 0.0) -> dict:
+    """The up direction of the print: vertices ``V`` (mm, model frame) and triangles ``F`` of
+    all parts, ``own`` the part of each triangle, their total volume (mm^3); ``extra_ups``: candidate directions always tried
+    (the structural ones); ``seeds``: more candidates of the global stage (:func:`hinge_ups`).
+    ``exact(up) -> BedStats``, when given, measures the final
+    candidates on the report's grid.  Returns ``{"up", "key", "stats", "evaluated"}``."""
+    from mlc.mesh.printability import quick_stats
+    V = np.asarray(V, float)
+    F = np.asarray(F, np.int64)
+    ext = float(np.max(V.max(0) - V.min(0)))
+    h = max(ext / COARSE_CELLS, 0.05)
+    n_sphere = int(min(SPHERE_DIRS, SEARCH_TRIANGLES // max(len(F), 1)))
+    vol = max(part_volume, 1e-12)
+    cache: dict = {}
+
+    def score(u):
+        k = tuple(np.round(u, 9))
+        if k not in cache:
+            R = rotation_between(u, [0, 0, 1.0])
+            q = quick_stats(V @ R.T, F, h, overhang_deg, first_layer, own, island_mm)
+            cf = q["contact_mm2"] / q["footprint_mm2"] if q["footprint_mm2"] > 0 else 0.0
+            cache[k] = pose_key(q["support_mm3"] / vol, q["support_inside_mm3"] / vol, cf)
+        return cache[k]
+
+    extra = _unique([np.asarray(u, float) / np.linalg.norm(u) for u in extra_ups])
+    sphere = (list(fibonacci_sphere(n_sphere)) + [np.asarray(u, float) / np.linalg.norm(u) for u in seeds]
+              if n_sphere else [])
+    scored = sorted(((score(u), i, u) for i, u in enumerate(extra + sphere)), key=lambda x: (x[0], x[1]))
+    starts = []
+    for key, _, u in scored:
+        if len(starts) >= (REFINE_STARTS if n_sphere else 0):
+            break
+        if all(np.dot(u, v) < np.cos(np.radians(START_APART_DEG)) for _, v in starts):
+            starts.append((key, u))
+    refined = []
+    for key, u in starts:
+        for step in REFINE_STEPS_DEG:
+            s, c = np.sin(np.radians(step)), np.cos(np.radians(step))
+            while True:
+                e1, e2 = _frame(u)
+                ring = [c * u + s * (np.cos(a) * e1 + np.sin(a) * e2) for a in np.radians(np.arange(0, 360, 45))]
+                best = min(ring, key=score)
+                if _better(score(best), key):
+                    u, key = best / np.linalg.norm(best), score(best)
+                else:
+                    break
+        refined.append((key, u))
+    pool = sorted(refined + [(k, u) for k, _, u in scored], key=lambda x: x[0])
+    final = _unique([u for _, u in pool], tol=1e-4)[:FINAL]
+    best_extra = next((u for k, _, u in scored if any(np.allclose(u, e) for e in extra)), None)
+    if best_extra is not None and all(not np.allclose(best_extra, u) for u in final):
+        final.append(best_extra)
+    if exact is None:
+        u = final[0]
+        return {"up": u, "key": score(u), "stats": None, "evaluated": len(cache), "grid_mm": h}
+    memo: dict = {}
+
+    def exact_key(u):
+        k = tuple(np.round(u, 9))
+        if k not in memo:
+            st = exact(u)
+            memo[k] = (pose_key(st.support_fraction, st.support_inside_mm3 / max(st.part_volume_mm3, 1e-12),
+                                st.contact_fraction), st)
+        return memo[k][0]
+
+    ranked = sorted(((exact_key(u), i, u) for i, u in enumerate(final)), key=lambda x: (x[0], x[1]))
+    # the report's own grid decides near the overhang limit: refine the best few on it
+    best = (ranked[0][0], ranked[0][2])
+    for key, _, u in ranked[:EXACT_STARTS]:
+        for step in EXACT_STEPS_DEG:
+            s, c = np.sin(np.radians(step)), np.cos(np.radians(step))
+            while len(memo) < EXACT_MAX:
+                e1, e2 = _frame(u)
+                ring = [c * u + s * (np.cos(a) * e1 + np.sin(a) * e2) for a in np.radians(np.arange(0, 360, 45))]
+                nxt = min(ring, key=exact_key)
+                if _better(exact_key(nxt), key):
+                    u, key = nxt / np.linalg.norm(nxt), exact_key(nxt)
+                else:
+                    break
+        if key < best[0]:
+            best = (key, u)
+    u = best[1]
+    return {"up": u, "key": best[0], "stats": memo[tuple(np.round(u, 9))][1], "evaluated": len(cache),
+            "exact_evaluated": len(memo), "grid_mm": h}
+
+
+def report_grid(size_mm, min_wall: float) -> float:
+    """The grid spacing (mm) of the report's bed check for a print of extent ``size_mm``."""
+    return max(0.05, min(min_wall, max(size_mm) / 150))
+
+
+def best_rotation(asm) -> np.ndarray:
+    """``orient: auto``: the rotation (3 x 3, model -> print frame) taking the best "up" of
+    :func:`search_up` to +z; a note says which and how it scored."""
+    from mlc.mesh.build import _h, transform_solid
+    from mlc.mesh.checks import OVERHANG_DEG, island_side
+    from mlc.mesh.printability import _mesh_arrays, bed_stats
+
+    solids = [(p.name, p.solid) for p in asm.parts if not p.solid.is_empty()]
+    Vs, Fs, Os, off = [], [], [], 0
+    for k, (_, s) in enumerate(solids):
+        V, F = _mesh_arrays(s)
+        Vs.append(V)
+        Fs.append(F + off)
+        Os.append(np.full(len(F), k))
+        off += len(V)
+    V, F, own = np.concatenate(Vs), np.concatenate(Fs), np.concatenate(Os)
+    first_layer = min(0.2, asm.profile.min_wall / 2)
+    part_volume = float(sum(s.volume() for _, s in solids))
+
+    def exact(u):
+        R = rotation_between(u, [0, 0, 1.0])
+        posed = [(n, transform_solid(s, _h(R, np.zeros(3)))) for n, s in solids]
+        lo = np.min([np.asarray(s.bounding_box())[:3] for _, s in posed], axis=0)
+        hi = np.max([np.asarray(s.bounding_box())[3:] for _, s in posed], axis=0)
+        posed = [(n, s.translate([0, 0, -float(lo[2])])) for n, s in posed]
+        return bed_stats(posed, OVERHANG_DEG, report_grid(hi - lo, asm.profile.min_wall), first_layer=first_layer,
+                         island_mm=island_side(asm.profile))
+
+    dirs = [ax.direction for ax in asm.axes] + [a for uj in asm.ujoints for a in uj.axes]
+    res = search_up(V, F, part_volume, structural_ups(asm.scene), OVERHANG_DEG, first_layer, exact=exact,
+                    seeds=hinge_ups(dirs), own=own, island_mm=island_side(asm.profile))
+    u, st = res["up"], res["stats"]
+    asm.notes.append(
+        f"orientation: up is the model's ({u[0]:.3g}, {u[1]:.3g}, {u[2]:.3g}), the best bed of "
+        f"{res['evaluated']} directions searched (sphere, axes and slab normals, refined; least support "
+        f"resting on parts, support and bed contact goals): support {100 * st.support_fraction:.1f} % of the "
+        f"part volume ({st.support_inside_mm3:.1f} mm^3 between parts), bed contact {100 * st.contact_fraction:.1f} %")
+    return rotation_between(u, [0, 0, 1.0])
+
+
+__all__ = ["best_rotation", "fibonacci_sphere", "hinge_ups", "pose_key", "search_up", "structural_ups"]
