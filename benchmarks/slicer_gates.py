@@ -4,13 +4,27 @@
 
 For each gate and profile: build the printable assembly with ``export_assembly``, exactly as
 ``mlc stl`` does (posed in every logic state and on the way to them, the dense paths and their
-motion trims, the printability report), write the 3MF (one object, the parts as volumes), ask
-``prusa-slicer --info`` how many objects and parts it sees, then slice it twice -- without and
-with supports (``--support-material``) -- and read the G-code's own summary: layers
-(``;LAYER_CHANGE``), estimated time, filament volume.  The support volume is the difference of
-the two filament volumes.  Also records mlc's own bed statistics (mlc.mesh.printability).
-Results: benchmarks/results/slicer_gates.json.  Needs ``prusa-slicer`` on PATH (Debian:
-``apt-get install prusa-slicer``); without it the script says so and exits 1.
+motion trims, the printability report), with ``orient: auto`` (``--orient auto``; the fdm
+default, mjp and sla default to the model's z).  Two print poses of the same parts are then
+compared (issue 13, item 1):
+
+* ``before``: the model's z up, the rest configuration as modelled: what the first
+  ``orient: auto`` (session 20, axes and slab normals only) chose for every library gate in fdm
+  (its note: "up is the model's (0, 0, 1)"), and the mjp and sla default (``as_is``);
+* ``after``: the pose ``mlc stl`` writes now (``mlc.mesh.pose``: the sphere, the hinge-45-degree
+  directions, refined; ``asm.orient``).
+
+For each pose: mlc's own bed statistics on the report's grid (``mlc.mesh.printability``), the
+3MF (one object, the parts as volumes), ``prusa-slicer --info`` (objects, parts), and three
+slices -- without supports, with supports (``--support-material``), and with supports on the
+build plate only (``--support-material-buildplate-only``) -- read from the G-code's own
+summary: layers (``;LAYER_CHANGE``), estimated time, filament volume, and the filament of the
+first layer without the skirt (mm^3, from the E moves; over the first layer height it is about
+the area the first layer prints, to compare with mlc's bed contact).  Support volume = filament with supports - without;
+support on the print (PrusaSlicer's counterpart of mlc's support on parts) = with supports
+everywhere - build plate only.  Results: benchmarks/results/slicer_gates.json.  Needs
+``prusa-slicer`` on PATH (Debian: ``apt-get install prusa-slicer``); without it the script says
+so and exits 1.
 """
 from __future__ import annotations
 
@@ -25,18 +39,23 @@ import tempfile
 import time
 from pathlib import Path
 
+import numpy as np
+
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 from mlc.gates.library import GATE_NAMES, gate_scene  # noqa: E402
-from mlc.mesh.build import transform_solid  # noqa: E402
-from mlc.mesh.checks import OVERHANG_DEG  # noqa: E402
-from mlc.mesh.export import part_meshes, threemf_bytes  # noqa: E402
+from mlc.geometry.rotation import rotation_between  # noqa: E402
+from mlc.mesh.build import _h, transform_solid  # noqa: E402
+from mlc.mesh.checks import OVERHANG_DEG, island_side  # noqa: E402
+from mlc.mesh.export import threemf_bytes, to_trimesh  # noqa: E402
 from mlc.mesh.pipeline import export_assembly  # noqa: E402
+from mlc.mesh.pose import report_grid  # noqa: E402
 from mlc.mesh.printability import bed_stats  # noqa: E402
 from mlc.mesh.profiles import load_profile  # noqa: E402
 
 LAYER = {"mjp": 0.1, "sla": 0.1, "fdm": 0.2}
+FIRST_LAYER = 0.2      # PrusaSlicer's first layer height here (mm)
 
 
 def _time_s(txt: str) -> float | None:
@@ -49,12 +68,48 @@ def _time_s(txt: str) -> float | None:
     return float(tot)
 
 
-def slice_once(exe, path: Path, layer: float, supports: bool) -> dict:
-    out = path.with_suffix(".sup.gcode" if supports else ".gcode")
-    cmd = [exe, "--export-gcode", "--layer-height", str(layer), "--first-layer-height", str(max(layer, 0.2)),
+def _first_layer_mm3(txt: str, mm3_per_mm: float) -> float | None:
+    """Filament extruded in the first layer (mm^3), the skirt left out: the E moves between the
+    first and the second ``;LAYER_CHANGE`` (absolute or relative E, G92 resets followed)."""
+    parts = txt.split(";LAYER_CHANGE")
+    if len(parts) < 2:
+        return None
+    rel = bool(re.search(r"^M83", txt, re.M))
+    e = 0.0
+    tot = 0.0
+    for line in parts[0].splitlines():         # the E position when the first layer starts
+        m = re.match(r"G92 E([-\d.]+)", line)
+        if m:
+            e = float(m.group(1))
+        m = re.match(r"G[01] .*E([-\d.]+)", line)
+        if m and not rel:
+            e = float(m.group(1))
+    skirt = False
+    for line in parts[1].splitlines():
+        if line.startswith(";TYPE:"):
+            skirt = "skirt" in line.lower()
+        m = re.match(r"G92 E([-\d.]+)", line)
+        if m:
+            e = float(m.group(1))
+            continue
+        m = re.match(r"G[01] .*E([-\d.]+)", line)
+        if m:
+            v = float(m.group(1))
+            d = v if rel else v - e
+            if not rel:
+                e = v
+            if not skirt:
+                tot += d
+    return round(tot * mm3_per_mm, 2)
+
+
+def slice_once(exe, path: Path, layer: float, supports: str) -> dict:
+    """``supports``: "none", "all" or "buildplate"."""
+    out = path.with_suffix(f".{supports}.gcode")
+    cmd = [exe, "--export-gcode", "--layer-height", str(layer), "--first-layer-height", str(FIRST_LAYER),
            "-o", str(out), str(path)]
-    if supports:
-        cmd.insert(1, "--support-material")
+    if supports != "none":
+        cmd[1:1] = ["--support-material"] + (["--support-material-buildplate-only"] if supports == "buildplate" else [])
     t0 = time.perf_counter()
     r = subprocess.run(cmd, capture_output=True, text=True)
     dt = time.perf_counter() - t0
@@ -62,8 +117,14 @@ def slice_once(exe, path: Path, layer: float, supports: bool) -> dict:
         return {"ok": False, "error": (r.stderr or r.stdout)[-400:], "slice_s": round(dt, 2)}
     txt = out.read_text(errors="replace")
     cm3 = re.search(r"; filament used \[cm3\] = ([\d.]+)", txt)
+    mm = re.search(r"; filament used \[mm\] = ([\d.]+)", txt)
+    ratio = float(cm3.group(1)) * 1000 / float(mm.group(1)) if cm3 and mm and float(mm.group(1)) > 0 else None
+    fl = _first_layer_mm3(txt, ratio) if ratio else None
+    out.unlink()
     return {"ok": True, "layers": txt.count(";LAYER_CHANGE"), "print_time_s": _time_s(txt),
-            "filament_mm3": round(float(cm3.group(1)) * 1000, 1) if cm3 else None, "slice_s": round(dt, 2)}
+            "filament_mm3": round(float(cm3.group(1)) * 1000, 1) if cm3 else None,
+            "first_layer_mm3": fl, "first_layer_mm2": round(fl / FIRST_LAYER, 1) if fl is not None else None,
+            "slice_s": round(dt, 2)}
 
 
 def info(exe, path: Path) -> dict:
@@ -75,12 +136,45 @@ def info(exe, path: Path) -> dict:
             "size": [[float(x) for x in m] for m in re.findall(r"size_x = ([\d.]+)\s+size_y = ([\d.]+)\s+size_z = ([\d.]+)", txt)]}
 
 
+def posed_solids(asm, R):
+    """The parts rotated by ``R`` (model -> print), centred on the bed and resting on z = 0."""
+    sol = [(p.name, transform_solid(p.solid, _h(R, np.zeros(3)))) for p in asm.parts if not p.solid.is_empty()]
+    lo = np.min([np.asarray(s.bounding_box())[:3] for _, s in sol], axis=0)
+    hi = np.max([np.asarray(s.bounding_box())[3:] for _, s in sol], axis=0)
+    sh = [-(lo[0] + hi[0]) / 2, -(lo[1] + hi[1]) / 2, -lo[2]]
+    return [(n, s.translate(sh)) for n, s in sol], hi - lo
+
+
+def stats(asm, R):
+    sol, size = posed_solids(asm, R)
+    mw = asm.profile.min_wall
+    return sol, bed_stats(sol, OVERHANG_DEG, report_grid(size, mw), first_layer=min(0.2, mw / 2),
+                          island_mm=island_side(asm.profile))
+
+
+def pose_row(exe, asm, R, up, f: Path, title: str, layer: float) -> dict:
+    sol, bs = stats(asm, R)
+    f.write_bytes(threemf_bytes([(n, to_trimesh(s)) for n, s in sol], title))
+    row = {"up": [round(float(x), 4) for x in up], "mlc_bed": bs.to_dict(),
+           "mlc_parts_off_bed": sum(1 for z in bs.lowest_mm.values() if z > 0.05),
+           "prusa_info": info(exe, f)}
+    for k in ("none", "all", "buildplate"):
+        row[k] = slice_once(exe, f, layer, k)
+    n, s, b = row["none"], row["all"], row["buildplate"]
+    if all(x.get("ok") and x.get("filament_mm3") is not None for x in (n, s, b)):
+        row["prusa_support_mm3"] = round(s["filament_mm3"] - n["filament_mm3"], 1)
+        row["prusa_support_on_print_mm3"] = round(s["filament_mm3"] - b["filament_mm3"], 1)
+        row["prusa_support_fraction"] = round(row["prusa_support_mm3"] / max(n["filament_mm3"], 1e-9), 3)
+    return row
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--signal", default="expand")
     ap.add_argument("--gates", default=",".join(GATE_NAMES))
     ap.add_argument("--profiles", default="mjp,sla,fdm")
     ap.add_argument("-o", "--out", default=str(ROOT / "benchmarks/results/slicer_gates.json"))
+    ap.add_argument("--append", action="store_true", help="keep the rows already in --out (other gates/profiles)")
     a = ap.parse_args()
     exe = shutil.which("prusa-slicer")
     if not exe:
@@ -88,38 +182,44 @@ def main() -> int:
         return 1
     ver = subprocess.run([exe, "--help"], capture_output=True, text=True).stdout.split("\n")
     ver = next((x for x in ver if x.startswith("PrusaSlicer")), "?")
+    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
+                            text=True).stdout.strip()
     rows = []
+    if a.append and Path(a.out).exists():
+        rows = json.loads(Path(a.out).read_text()).get("rows", [])
     tmp = Path(tempfile.mkdtemp(prefix="mlc_slicer_"))
     for g in a.gates.split(","):
         scene = gate_scene(g, a.signal)
         for pn in a.profiles.split(","):
-            prof = load_profile(pn)
+            rows = [r for r in rows if not (r["gate"] == g and r["profile"] == pn and r["signal"] == a.signal)]
+            prof = load_profile(pn, {"orient": "auto"})
             t0 = time.perf_counter()
             asm, rep = export_assembly(scene, prof)
             t_build = time.perf_counter() - t0
-            f = tmp / f"{g}_{a.signal}_{pn}.3mf"
-            f.write_bytes(threemf_bytes(part_meshes(asm), f"{g}_{a.signal}"))
-            solids = [(p.name, transform_solid(p.solid, asm.orient)) for p in asm.parts]
-            bs = bed_stats(solids, OVERHANG_DEG, 0.25 if pn == "fdm" else 0.05,
-                           first_layer=min(0.2, prof.min_wall / 2))
-            row = {"gate": g, "signal": a.signal, "profile": pn, "orient": prof.orient, "layer_mm": LAYER[pn],
+            row = {"gate": g, "signal": a.signal, "profile": pn, "orient": "auto", "layer_mm": LAYER[pn],
                    "parts": len(asm.parts), "part_volume_mm3": round(sum(float(p.solid.volume()) for p in asm.parts), 1),
                    "export_s": round(t_build, 2), "report_ok": rep.ok,
                    "goals_not_met": sorted(c.name for c in rep.checks if not c.ok and not c.blocking),
-                   "motion_trims": len(asm.motion_trims), "mlc_bed": bs.to_dict(),
-                   "prusa_info": info(exe, f),
-                   "no_supports": slice_once(exe, f, LAYER[pn], False),
-                   "supports": slice_once(exe, f, LAYER[pn], True)}
-            n, s = row["no_supports"], row["supports"]
-            if n.get("ok") and s.get("ok") and n["filament_mm3"] is not None and s["filament_mm3"] is not None:
-                row["support_mm3"] = round(s["filament_mm3"] - n["filament_mm3"], 1)
-                row["support_fraction"] = round(row["support_mm3"] / max(n["filament_mm3"], 1e-9), 3)
+                   "report_bed": {c.name: {"ok": c.ok, "value": c.value} for c in rep.checks
+                                  if c.name in ("bed_contact", "supports")},
+                   "motion_trims": len(asm.motion_trims)}
+            u0 = np.array([0.0, 0.0, 1.0])
+            row["before"] = pose_row(exe, asm, rotation_between(u0, [0, 0, 1.0]), u0, tmp / f"{g}_{pn}_before.3mf",
+                                     f"{g}_{a.signal}", LAYER[pn])
+            R = asm.orient[:3, :3]
+            row["after"] = pose_row(exe, asm, R, R[2], tmp / f"{g}_{pn}_after.3mf", f"{g}_{a.signal}", LAYER[pn])
             rows.append(row)
-            print(f"{g:8s} {pn}: parts {row['prusa_info']['parts']}, layers {n.get('layers')}/{s.get('layers')}, "
-                  f"filament {n.get('filament_mm3')}/{s.get('filament_mm3')} mm3, time {n.get('print_time_s')}/"
-                  f"{s.get('print_time_s')} s, contact {bs.contact_fraction:.3f}", flush=True)
-            Path(a.out).write_text(json.dumps({"slicer": ver, "machine": platform.platform(),
-                                               "note": "support_mm3 = filament with supports - without",
+            for k in ("before", "after"):
+                r, b = row[k], row[k]["mlc_bed"]
+                print(f"{g:8s} {pn} {k:6s}: up {r['up']}, mlc contact {100 * b['contact_fraction']:.2f} % "
+                      f"support {100 * b['support_fraction']:.1f} % ({b['support_inside_mm3']:.1f} mm3 between parts); "
+                      f"prusa first layer {r['none'].get('first_layer_mm2')} mm2, support {r.get('prusa_support_mm3')} mm3 "
+                      f"({r.get('prusa_support_on_print_mm3')} on the print), filament {r['none'].get('filament_mm3')}",
+                      flush=True)
+            Path(a.out).write_text(json.dumps({"slicer": ver, "machine": platform.platform(), "commit": commit,
+                                               "note": "per pose: support_mm3 = filament with supports - without; "
+                                                       "support_on_print = with supports - build plate only; "
+                                                       "first_layer_mm2 = first-layer filament / 0.2 mm",
                                                "rows": rows}, indent=1) + "\n")
     return 0
 

@@ -165,3 +165,23 @@ def test_the_pose_written_is_the_pose_searched_and_checked(nor_fdm):
     # and up is where the rotation sends +z
     u = asm.orient[2, :3]
     assert abs(np.linalg.norm(u) - 1) < 1e-9
+
+
+def test_a_large_assembly_keeps_the_axis_candidates(monkeypatch):
+    """Over the triangle budget (a compiled circuit) the lattice and the refinements are
+    skipped: only the given candidates are measured."""
+    from mlc.mesh import pose
+    parts = _table()
+    V, F, off = [], [], 0
+    for _, s in parts:
+        v, f = _mesh_arrays(s)
+        V.append(v)
+        F.append(f + off)
+        off += len(v)
+    V, F = np.concatenate(V), np.concatenate(F)
+    axes = [sg * e for e in np.eye(3) for sg in (1.0, -1.0)]
+    full = pose.search_up(V, F, 960.0, axes, island_mm=2)
+    monkeypatch.setattr(pose, "SEARCH_TRIANGLES", len(F) * 10)
+    small = pose.search_up(V, F, 960.0, axes, island_mm=2)
+    assert small["evaluated"] == 6 < full["evaluated"]
+    assert small["up"] @ np.array([1.0, 0, 0]) > 0.99

@@ -31,9 +31,10 @@ a part, support over ``SUPPORT_MAX`` of the part volume, bed contact under ``BED
 of the footprint), then support fraction + inside-support fraction - contact fraction (support
 between parts counted twice: it cannot be removed without freeing the joints).
 
-The search costs about ``(SPHERE_DIRS + ~50 x REFINE_STARTS)`` coarse evaluations; an assembly
-of more than :data:`SEARCH_TRIANGLES` triangle-evaluations (a compiled circuit) gets fewer
-sphere directions, and none past that, so it keeps the axis and normal candidates only.
+The search costs about ``SPHERE_DIRS + 50 x REFINE_STARTS`` coarse evaluations (about 700 for a
+library gate) and up to :data:`EXACT_MAX` exact ones; an assembly for which that many coarse
+evaluations exceed :data:`SEARCH_TRIANGLES` triangle-evaluations (over about 67 000 triangles: a
+compiled circuit) keeps the axis and slab-normal candidates, unrefined (the session-20 search).
 """
 from __future__ import annotations
 
@@ -61,7 +62,7 @@ EXACT_MAX = 120
 #: a refinement step is taken only if it lowers the score by this much (a fraction of the part
 #: volume) or fails fewer goals
 MIN_GAIN = 0.01
-#: at most this many triangle evaluations (triangles x coarse directions) in the global stage
+#: the lattice and refinements only if triangles x (SPHERE_DIRS + 50 REFINE_STARTS) stays under this
 SEARCH_TRIANGLES = 4.0e7
 
 
@@ -162,7 +163,9 @@ def search_up(V, F, part_volume: float, extra_ups=(), overhang_deg: float = 45.0
     F = np.asarray(F, np.int64)
     ext = float(np.max(V.max(0) - V.min(0)))
     h = max(ext / COARSE_CELLS, 0.05)
-    n_sphere = int(min(SPHERE_DIRS, SEARCH_TRIANGLES // max(len(F), 1)))
+    # the lattice and the refinements only where they fit the budget (a library gate: ~10^4
+    # triangles); a compiled circuit keeps the given candidates, unrefined
+    n_sphere = SPHERE_DIRS if len(F) * (SPHERE_DIRS + 50 * REFINE_STARTS) <= SEARCH_TRIANGLES else 0
     vol = max(part_volume, 1e-12)
     cache: dict = {}
 
@@ -219,7 +222,7 @@ def search_up(V, F, part_volume: float, extra_ups=(), overhang_deg: float = 45.0
     ranked = sorted(((exact_key(u), i, u) for i, u in enumerate(final)), key=lambda x: (x[0], x[1]))
     # the report's own grid decides near the overhang limit: refine the best few on it
     best = (ranked[0][0], ranked[0][2])
-    for key, _, u in ranked[:EXACT_STARTS]:
+    for key, _, u in ranked[:EXACT_STARTS if n_sphere else 0]:
         for step in EXACT_STEPS_DEG:
             s, c = np.sin(np.radians(step)), np.cos(np.radians(step))
             while len(memo) < EXACT_MAX:
