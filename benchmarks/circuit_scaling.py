@@ -77,6 +77,9 @@ def adder_point(w: int, family: str = "adder") -> dict:
             "half_units": circ.half_units, "build_s": t_build, "build_cpu_s": c_build, "load": load0,
             "route_solves": route.CACHE_HITS[1] - hits0[1], "route_repeats": route.CACHE_HITS[0] - hits0[0],
             "tight_chains": sc.meta["connector"]["tight_chains"], "build_parts_s": circ.seconds,
+            "state_contacts": sc.meta["connector"].get("state_contacts", []),
+            "rerouted_contacts": sc.meta["connector"].get("rerouted_contacts", []),
+            "contact_min": min((k.clearance for k in circ.contacts), default=None),
             "verify_row_s": rep.rows[0]["seconds"], "row": row, "ok": rep.ok,
             "clearance": rep.rows[0].get("clearance"), "joint_stretch": rep.rows[0]["joint_stretch"]}
 
@@ -215,7 +218,9 @@ def plot(res: dict) -> None:
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--max-width", type=int, default=7)
-    ap.add_argument("--widths", type=int, nargs="*")
+    ap.add_argument("--widths", type=int, nargs="*",
+                    help="measure these adder widths and merge them into the committed series (the other widths "
+                         "are kept; with --skip-dynamic so is the dynamic part)")
     ap.add_argument("--multipliers", type=int, nargs="*",
                     help="measure these w x w array multipliers and merge them into the committed JSON "
                          "(the adders and the dynamic part are kept)")
@@ -267,7 +272,11 @@ def main():
         if time.perf_counter() - t_all > args.budget:
             print(f"budget of {args.budget} s reached; stopping at width {w}")
             break
-    dyn = [] if args.skip_dynamic else dynamic_per_scheme()
+    if args.widths:         # merged into the committed series: the other widths are kept
+        keep = {p["width"]: p for p in old.get("adders", [])}
+        keep.update({p["width"]: p for p in points})
+        points = [keep[w] for w in sorted(keep)]
+    dyn = old.get("dynamic_full_adder", []) if args.skip_dynamic else dynamic_per_scheme()
     res = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
                        "load": os.getloadavg()[0] if hasattr(os, "getloadavg") else None},
            "adders": points, "multipliers": old.get("multipliers", []), "dynamic_full_adder": dyn}

@@ -198,6 +198,12 @@ def test_five_way_branch_pages_clear_each_other():
     assert rep.min_clearance > 0.0, rep.pair
 
 
+def _no_contact_rip_up(routed, lanes, space, space_clear, geo):
+    """build._rip_up_contacts that only measures."""
+    from mlc.circuit import build as B
+    return [], B._state_contacts(routed, geo)
+
+
 def test_rip_up_reroutes_a_chain_and_the_one_it_presses_into(monkeypatch):
     """Routed with wires g4 and g5 first, the full adder's chain w_g5_0 comes 1.30 sigma
     from w_g4_1, routed before it, which could not make room (layer centres; 1.8 keeps
@@ -208,6 +214,8 @@ def test_rip_up_reroutes_a_chain_and_the_one_it_presses_into(monkeypatch):
     spec = load("examples/full_adder.tt", None)
     c = compile_spec(spec)
     opt = B.CircuitOptions()
+    # this rip-up alone: the contact rip-up (_rip_up_contacts) takes this pair apart too
+    monkeypatch.setattr(B, "_rip_up_contacts", _no_contact_rip_up)
     monkeypatch.setattr(B, "RIP_GAP", 0.0)              # no rip-up
     plain = B._build_circuit(c.netlist, spec, opt, first_wires=("g4", "g5"))
     monkeypatch.setattr(B, "RIP_GAP", 1.4)
@@ -218,6 +226,36 @@ def test_rip_up_reroutes_a_chain_and_the_one_it_presses_into(monkeypatch):
     ripped.scene.check()
     # the untouched chains are the same, body for body
     moved = {t for pair in ripped.scene.meta["connector"]["rerouted"] for t in pair}
+    keep = lambda sc: {b.name: tuple(b.position) for b in sc.bodies if not any(b.name.startswith(t + "_") for t in moved)}
+    assert keep(plain.scene) == keep(ripped.scene)
+
+
+def test_contact_rip_up_reroutes_chains_whose_layers_would_touch_when_a_wire_switches(monkeypatch):
+    """With the contact margin raised to 0.6 sigma (0.05 by default), chain pairs of the
+    full adder (wires g4 and g5 routed first) whose layers, as rigid rhombi in any state of
+    their wires, clear each other by less are routed again (the one routed earlier first);
+    each pair re-routed clears by more than before, and every other chain keeps its bodies."""
+    from mlc.circuit import build as B
+    spec = load("examples/full_adder.tt", None)
+    c = compile_spec(spec)
+    opt = B.CircuitOptions()
+    monkeypatch.setattr(B, "RIP_GAP", 0.0)
+    monkeypatch.setattr(B, "CONTACT_MARGIN", 0.6)
+    real = B._rip_up_contacts
+    monkeypatch.setattr(B, "_rip_up_contacts", _no_contact_rip_up)
+    plain = B._build_circuit(c.netlist, spec, opt, first_wires=("g4", "g5"))
+    monkeypatch.setattr(B, "_rip_up_contacts", real)
+    ripped = B._build_circuit(c.netlist, spec, opt, first_wires=("g4", "g5"))
+    pairs = ripped.scene.meta["connector"].get("rerouted_contacts")
+    assert pairs, "no chain was routed again"
+    assert "rerouted_contacts" not in plain.scene.meta["connector"]
+
+    def worst(circ, tags):
+        return min(k.clearance for k in circ.contacts if k.a in tags or k.b in tags)
+    for a, b in pairs:
+        assert worst(ripped, {a, b}) > worst(plain, {a, b}), (a, b)
+    ripped.scene.check()
+    moved = {t for pair in pairs for t in pair}
     keep = lambda sc: {b.name: tuple(b.position) for b in sc.bodies if not any(b.name.startswith(t + "_") for t in moved)}
     assert keep(plain.scene) == keep(ripped.scene)
 

@@ -60,5 +60,6 @@ def test_every_example_becomes_a_circuit_that_verifies(example, tmp_path, capsys
     assert got == sorted(rows or (format(i, f"0{n_inputs}b") for i in range(2 ** n_inputs)))   # each row asked for, once
     for row in rep["rows"]:
         assert row["joint_stretch"] < 1e-3                  # no gate strained by its wiring
+        assert row["clearance"] > 0, (row["state"], row["clearance_pair"])   # no two slabs interpenetrate
         assert row["ok"], row["state"]
     assert rep["entries"] and all(e["ok"] for e in rep["entries"])   # every output bit of every row

@@ -75,6 +75,7 @@ WAYPOINT_STEP = 2.0         # sigma between the lane points a chain is pulled to
 WAYPOINT_WEIGHT = 1.0       # their weight in the inverse kinematics
 END_JUNCTIONS, END_BEND = 4, 0.2   # the 4 junctions at either end bend at most 0.2 of the largest (lever travel)
 LANE_EXTRAS = (0, 4, 8)     # chain lengths (half units beyond the steered guess) tried in a plane before the next
+CONTACT_MARGIN = 0.05       # sigma: layers of two chains must clear each other by this in every state of their wires
 RIP_GAP = 1.2               # sigma: a chain this much closer to another is routed again with it (_rip_up);
                             # measured: chains 1.29 sigma apart and more were clear in every row of every
                             # example, one 0.93 apart (3-bit adder) overlapped by 0.23 sigma
@@ -120,6 +121,7 @@ class Circuit:
     half_units: int = 0
     seconds: dict = field(default_factory=dict)
     closest: float = float("inf")    # sigma: smallest layer-centre distance of a tight chain to another chain
+    contacts: list = field(default_factory=list)   # contact.Contact of the chains' close layers, smallest first
 
 
 @lru_cache(maxsize=None)
@@ -288,8 +290,9 @@ def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pro
 def _build_routed(netlist, spec, options: CircuitOptions, progress) -> Circuit:
     """One build, or two: when the router leaves chains it could not keep apart
     (``tight_chains``), the wires they belong to are routed again first, in a second
-    build (once); the build whose tight chains come closest to another chain by the
-    larger distance is kept (the first on a tie): one chain pressed into another is
+    build (once); the build kept is the one whose chains' layers would touch in no row
+    (or less deeply), then whose tight chains come closest to another chain by the larger
+    distance (:func:`_merit`; the first on a tie): one chain pressed into another is
     worse than several just inside the keep-apart distance."""
     first = _build_circuit(netlist, spec, options, progress)
     tight = first.scene.meta["connector"]["tight_chains"]
@@ -297,11 +300,19 @@ def _build_routed(netlist, spec, options: CircuitOptions, progress) -> Circuit:
         return first
     wires = tuple(dict.fromkeys(t[2:].rsplit("_", 1)[0] for t in tight))
     second = _build_circuit(netlist, spec, options, progress, first_wires=wires)
-    if second.closest > first.closest:
+    if _merit(second) > _merit(first):
         second.seconds["first_build"] = sum(first.seconds.values())
         return second
     first.seconds["second_build"] = sum(second.seconds.values())
     return first
+
+
+def _merit(c: Circuit) -> tuple:
+    """How well a build keeps its chains apart, larger is better: the smallest clearance of
+    two chains' layers over the wires' states (up to ``CONTACT_MARGIN``: beyond it they
+    are clear), then the smallest layer-centre distance of a tight chain (sigma)."""
+    m = min((k.clearance for k in c.contacts), default=math.inf)
+    return (min(m, CONTACT_MARGIN), c.closest)
 
 
 def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, progress=None,
@@ -598,6 +609,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             deferred.append(tag)
     t_rip = time.perf_counter()
     rip_ups = _rip_up(routed, lanes, space, space_clear)
+    contact_rips, contacts = _rip_up_contacts(routed, lanes, space, space_clear, geo)
     t_done = time.perf_counter()
     # ---- assembly, in routing order (pages and stubs where they were made) --------------
     for item in deferred:
@@ -609,20 +621,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             tight.append((tag, round(float(ch.gap), 3)))
         wire, start, tap, spol, sstate, stop_at_tap, t_up, target, ext = ch.ctx
         route = ch.route
-        parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, sstate, geo,
-                                   in_stop=stop_at_tap if start is tap else POST_WIDTH, stops=True)
-        # the last half unit's output post is longer so its layer clears the lever plane:
-        last = len(route.bends) - 1
-        for b in list(parts.bodies):
-            if b.name.startswith(f"{tag}_{last}_"):
-                parts.bodies.remove(b)
-        parts.bonds = [bd for bd in parts.bonds if not bd.name.startswith(f"{tag}_{last}_")]
-        cs_in = pairs[-2]
-        t_last = (pairs[-1].centre - cs_in.centre) / np.linalg.norm(pairs[-1].centre - cs_in.centre)
-        lp, lin, lout = half_unit_parts(f"{tag}_{last}", cs_in.centre, cs_in.axis, t_last,
-                                        sstate ^ (last % 2), geo, out_post=0.5 * geo.gap + ext,
-                                        out_stop=LEVER_STOP)
-        parts.add(lp)
+        parts, pairs, lout = _chain_parts(ch, geo)
         parts.bonds += join(f"{tag}_j0", start, pairs[0], geo.k)
         if start is not tap and half_unit_prefix(start):     # the junction after a branch page
             parts.bonds += junction_stops(f"{tag}_s0", half_unit_prefix(start), f"{tag}_0", geo, geo.k)
@@ -664,6 +663,11 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                                       "tight_chains": [t for t, _ in tight]}})
     if rip_ups:
         scene.meta["connector"]["rerouted"] = [list(p) for p in rip_ups]
+    if contact_rips:
+        scene.meta["connector"]["rerouted_contacts"] = [list(p) for p in contact_rips]
+    touching = [k for k in contacts if k.clearance < CONTACT_MARGIN]
+    if touching:        # layers that may touch in some row: named, with their clearance (sigma)
+        scene.meta["connector"]["state_contacts"] = [[k.a, k.i, k.b, k.j, round(k.clearance, 4)] for k in touching]
     if opt.direct:
         scene.meta["connector"]["direct"] = [[d, s, p] for s, (d, p) in direct.items()]
     scene.check()
@@ -671,7 +675,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     return Circuit(scene, origin, n_chains, n_half,
                    {"place": t_route - t_start, "route": t_rip - t_route, "rip_up": t_done - t_rip,
                     "assemble": t_end - t_done},
-                   min((g for _, g in tight), default=float("inf")))
+                   min((g for _, g in tight), default=float("inf")), contacts)
 
 
 def _check_reach(netlist, taps, consumers, by_name, level, geo) -> None:
@@ -724,6 +728,50 @@ class _Chain:
     def layers(self, route=None) -> np.ndarray:
         """Layer centres of ``route`` (default the chain's own) as this chain's layers."""
         return _layers(self.route if route is None else route, *self.geo_ext)
+
+
+def _chain_parts(ch: _Chain, geo, flip: int = 0):
+    """The half units of routed chain ``ch`` as assembled (bodies posed as built, the
+    junction bonds and stops), each layer in its state of the all-zero row, or with
+    ``flip`` in the other one (every layer of a chain flips when its wire does).  The last
+    half unit's output post is longer, so that its layer clears the lever plane.
+    Returns (parts, pairs, the last half unit's output pair)."""
+    tag = ch.tag
+    _, start, tap, _, sstate, stop_at_tap, _, _, ext = ch.ctx
+    route = ch.route
+    state = sstate ^ flip
+    parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, state, geo,
+                               in_stop=stop_at_tap if start is tap else POST_WIDTH, stops=True)
+    last = len(route.bends) - 1
+    for b in list(parts.bodies):
+        if b.name.startswith(f"{tag}_{last}_"):
+            parts.bodies.remove(b)
+    parts.bonds = [bd for bd in parts.bonds if not bd.name.startswith(f"{tag}_{last}_")]
+    cs_in = pairs[-2]
+    t_last = (pairs[-1].centre - cs_in.centre) / np.linalg.norm(pairs[-1].centre - cs_in.centre)
+    lp, lin, lout = half_unit_parts(f"{tag}_{last}", cs_in.centre, cs_in.axis, t_last,
+                                    state ^ (last % 2), geo, out_post=0.5 * geo.gap + ext,
+                                    out_stop=LEVER_STOP)
+    parts.add(lp)
+    return parts, pairs, lout
+
+
+def _state_contacts(routed: dict, geo, tags=None) -> list:
+    """:func:`mlc.circuit.contact.state_contacts` of the routed chains (of those involving a
+    chain of ``tags`` when given): every pair of layers of two chains within two bounding
+    radii plus ``CONTACT_MARGIN``, tested as rigid layers in every state of their wires."""
+    from mlc.circuit.contact import candidate_pairs, layer_boxes, state_contacts
+    centres = {t: ch.layers() for t, ch in routed.items() if ch.route is not None}
+    pairs = candidate_pairs(centres, 2.0 * LAYER_RADIUS + CONTACT_MARGIN)
+    if tags is not None:
+        pairs = [p for p in pairs if p[0] in tags or p[2] in tags]
+    cache: dict = {}
+
+    def boxes(tag, flip):
+        if (tag, flip) not in cache:
+            cache[(tag, flip)] = layer_boxes(_chain_parts(routed[tag], geo, flip)[0].bodies, tag)
+        return cache[(tag, flip)]
+    return state_contacts(pairs, boxes, {t: routed[t].ctx[0] for t in centres})
 
 
 def _layers(route, geo, ext: float) -> np.ndarray:
@@ -831,6 +879,50 @@ def _rip_up(routed: dict, lanes, space, space_clear: float) -> list:
             lanes.take(c.lane, plane)
             space.add(c.layers(route), c.tag)
     return done
+
+
+def _rip_up_contacts(routed: dict, lanes, space, space_clear: float, geo) -> tuple[list, list]:
+    """Chains whose layers would touch in some input row (:func:`_state_contacts` below
+    ``CONTACT_MARGIN``): for each such pair of chains (closest first), the one routed
+    earlier, which did not see the other, is taken out and routed again with every other
+    chain in place, then the other one; the new routes are kept if the pair's smallest
+    clearance (each chain against every chain, in every state) grew, else the old ones are
+    put back.  Returns (the pairs re-routed, the contacts left, smallest first)."""
+    contacts = _state_contacts(routed, geo)
+    order = {t: k for k, t in enumerate(routed)}
+    done, seen = [], set()
+    for k in list(contacts):
+        if k.clearance >= CONTACT_MARGIN:
+            break
+        if (k.a, k.b) in seen:
+            continue
+        seen.add((k.a, k.b))
+        tags = {k.a, k.b}
+        old_score = min(c.clearance for c in _state_contacts(routed, geo, tags))
+        if old_score >= CONTACT_MARGIN:          # an earlier re-route settled it
+            continue
+        pair = sorted((routed[k.a], routed[k.b]), key=lambda c: order[c.tag])
+        old = [(c.route, c.gap, c.plane) for c in pair]
+        for c in pair:
+            _unplace(c, lanes, space)
+            _route_chain(c, lanes, space, space_clear)
+            if c.route is None:
+                break
+        if all(c.route is not None for c in pair):
+            new_score = min((c.clearance for c in _state_contacts(routed, geo, tags)), default=math.inf)
+            if new_score > old_score:
+                for c in pair:
+                    c.gap = c.gap_of(c.route)
+                done.append((k.a, k.b))
+                continue
+        for c, (route, gap, plane) in zip(pair, old):
+            _unplace(c, lanes, space)
+            c.route, c.gap, c.plane = route, gap, plane
+            lanes.take(c.lane, plane)
+            space.add(c.layers(route), c.tag)
+    if done:
+        contacts = _state_contacts(routed, geo)
+    return done, contacts
 
 
 def _slab_points(bodies: list[Body]) -> np.ndarray:

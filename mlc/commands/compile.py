@@ -180,7 +180,7 @@ def summary(c, written: list[str], level: int) -> dict:
         "circuit": None if c.circuit is None else {
             "bodies": len(c.circuit.scene.bodies), "chains": c.circuit.chains, "half_units": c.circuit.half_units,
             "seconds": {k: round(v, 3) for k, v in c.circuit.seconds.items()},
-            **{k: c.circuit.scene.meta["connector"][k] for k in ("direct", "direct_dropped")
+            **{k: c.circuit.scene.meta["connector"][k] for k in ("direct", "direct_dropped", "state_contacts")
                if k in c.circuit.scene.meta["connector"]}},
     }
 
@@ -207,6 +207,11 @@ def format_summary(d: dict) -> str:
                          + "".join(f", {d} -> {s}.{p}" for d, s, p in ci["direct"])
                          + (f"; chained instead, as a chain crossed their column: {', '.join(ci['direct_dropped'])}"
                             if ci.get("direct_dropped") else ""))
+        if ci.get("state_contacts"):
+            a, i, b, j, cl = ci["state_contacts"][0]
+            lines.append(f"warning: {len(ci['state_contacts'])} pair(s) of chain layers may touch in a row where their "
+                         f"wires switch (closest: {a} half unit {i} and {b} half unit {j}, {cl:+.3f} sigma as rigid "
+                         f"layers; scene meta connector.state_contacts); mlc verify reports the clearance of every row")
     if d.get("verification"):
         v = d["verification"]
         lines.append(f"verification ({v['mode']}): {'all ' + str(v['rows']) + ' rows correct' if v['ok'] else 'FAILED'}"
