@@ -5,14 +5,17 @@
 For each gate and profile: build the printable assembly with ``export_assembly``, exactly as
 ``mlc stl`` does (posed in every logic state and on the way to them, the dense paths and their
 motion trims, the printability report), with ``orient: auto`` (``--orient auto``; the fdm
-default, mjp and sla default to the model's z).  Two print poses of the same parts are then
+default, mjp and sla default to the model's z).  Three print poses of the same parts are then
 compared (issue 13, item 1):
 
 * ``before``: the model's z up, the rest configuration as modelled: what the first
   ``orient: auto`` (session 20, axes and slab normals only) chose for every library gate in fdm
   (its note: "up is the model's (0, 0, 1)"), and the mjp and sla default (``as_is``);
-* ``after``: the pose ``mlc stl`` writes now (``mlc.mesh.pose``: the sphere, the hinge-45-degree
-  directions, refined; ``asm.orient``).
+* ``estimate``: the best up by mlc's support estimate alone (``mlc.mesh.pose.search_up``: the
+  sphere, the hinge-45-degree directions, the axes and slab normals, refined), before the guard
+  that keeps the best axis or slab normal unless another up meets more bed goals;
+* ``after``: the pose ``mlc stl`` writes now (``asm.orient``).  A pose equal to an earlier one
+  is not sliced again (its figures are copied).
 
 For each pose: mlc's own bed statistics on the report's grid (``mlc.mesh.printability``), the
 3MF (one object, the parts as volumes), ``prusa-slicer --info`` (objects, parts), and three
@@ -206,10 +209,17 @@ def main() -> int:
             u0 = np.array([0.0, 0.0, 1.0])
             row["before"] = pose_row(exe, asm, rotation_between(u0, [0, 0, 1.0]), u0, tmp / f"{g}_{pn}_before.3mf",
                                      f"{g}_{a.signal}", LAYER[pn])
+            ue = np.asarray(asm.pose_search["estimate_up"], float)
+            row["estimate"] = (dict(row["before"], up=[round(float(x), 4) for x in ue]) if np.allclose(ue, u0) else
+                               pose_row(exe, asm, rotation_between(ue, [0, 0, 1.0]), ue,
+                                        tmp / f"{g}_{pn}_estimate.3mf", f"{g}_{a.signal}", LAYER[pn]))
             R = asm.orient[:3, :3]
-            row["after"] = pose_row(exe, asm, R, R[2], tmp / f"{g}_{pn}_after.3mf", f"{g}_{a.signal}", LAYER[pn])
+            ua = R[2]
+            row["after"] = (dict(row["before"], up=[round(float(x), 4) for x in ua]) if np.allclose(ua, u0) else
+                            dict(row["estimate"], up=[round(float(x), 4) for x in ua]) if np.allclose(ua, ue) else
+                            pose_row(exe, asm, R, ua, tmp / f"{g}_{pn}_after.3mf", f"{g}_{a.signal}", LAYER[pn]))
             rows.append(row)
-            for k in ("before", "after"):
+            for k in ("before", "estimate", "after"):
                 r, b = row[k], row[k]["mlc_bed"]
                 print(f"{g:8s} {pn} {k:6s}: up {r['up']}, mlc contact {100 * b['contact_fraction']:.2f} % "
                       f"support {100 * b['support_fraction']:.1f} % ({b['support_inside_mm3']:.1f} mm3 between parts); "

@@ -138,35 +138,29 @@ def nor_fdm():
 
 def test_the_pose_written_is_the_pose_searched_and_checked(nor_fdm):
     """NOR (fdm, orient auto): the report's bed checks are measured in ``asm.orient``, the pose the
-    STL/3MF are written in (mlc.mesh.export.part_meshes); the chosen up is better than the
-    model's z (the session-20 choice) by the report's own measure."""
-    from mlc.mesh.build import _h, transform_solid
-    from mlc.mesh.checks import ISLAND_FEATURES, OVERHANG_DEG
+    STL/3MF are written in (mlc.mesh.export.part_meshes).  The estimate alone prefers a tilted up
+    (by mlc's figures much less support than the model's z), which PrusaSlicer did not confirm
+    (benchmarks/results/slicer_gates.json): it meets no more bed goals, so the best axis or slab
+    normal is kept and a note says so."""
+    import re
     from mlc.mesh.export import part_meshes
-    from mlc.mesh.pose import report_grid
+    from mlc.mesh.pose import structural_ups
     asm = nor_fdm
     note = next(n for n in asm.notes if n.startswith("orientation: up is"))
     bc, sc = bed_checks(asm)
     st = asm.bed
-    import re
     noted = float(re.search(r"support ([\d.]+) % of the part volume", note).group(1))
     assert abs(noted - 100 * st.support_fraction) < 0.2
-    # the meshes written: the parts in asm.orient, on the bed
     meshes = part_meshes(asm)
     assert abs(min(m.vertices[:, 2].min() for _, m in meshes)) < 1e-6
-    # the model's z, measured the same way
-    sol = [(p.name, transform_solid(p.solid, _h(np.eye(3), np.zeros(3)))) for p in asm.parts]
-    zmin = min(float(np.asarray(s.bounding_box())[2]) for _, s in sol)
-    sol = [(n, s.translate([0, 0, -zmin])) for n, s in sol]
-    size = np.max([np.asarray(s.bounding_box())[3:] for _, s in sol], 0) - \
-        np.min([np.asarray(s.bounding_box())[:3] for _, s in sol], 0)
-    z = bed_stats(sol, OVERHANG_DEG, report_grid(size, asm.profile.min_wall), first_layer=0.2,
-                  island_mm=ISLAND_FEATURES * asm.profile.min_feature)
-    assert st.support_mm3 < 0.7 * z.support_mm3
-    assert st.support_inside_mm3 < 0.5 * z.support_inside_mm3
-    # and up is where the rotation sends +z
-    u = asm.orient[2, :3]
-    assert abs(np.linalg.norm(u) - 1) < 1e-9
+    res = asm.pose_search
+    up = asm.orient[2, :3]                                    # the model direction sent to +z
+    assert np.allclose(up, res["up"], atol=1e-9)
+    assert any(np.allclose(up, u, atol=1e-9) for u in structural_ups(asm.scene))
+    # the estimate's own best: less support by the estimate, as many goals failed
+    assert res["estimate_stats"].support_mm3 < 0.8 * st.support_mm3
+    assert res["estimate_key"][0] >= res["key"][0]
+    assert any("was not kept" in n for n in asm.notes)
 
 
 def test_a_large_assembly_keeps_the_axis_candidates(monkeypatch):
