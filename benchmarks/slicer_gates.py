@@ -199,7 +199,7 @@ def main() -> int:
             t0 = time.perf_counter()
             asm, rep = export_assembly(scene, prof)
             t_build = time.perf_counter() - t0
-            row = {"gate": g, "signal": a.signal, "profile": pn, "orient": "auto", "layer_mm": LAYER[pn],
+            row = {"gate": g, "signal": a.signal, "profile": pn, "orient": "auto", "layer_mm": LAYER[pn], "commit": commit,
                    "parts": len(asm.parts), "part_volume_mm3": round(sum(float(p.solid.volume()) for p in asm.parts), 1),
                    "export_s": round(t_build, 2), "report_ok": rep.ok,
                    "goals_not_met": sorted(c.name for c in rep.checks if not c.ok and not c.blocking),

@@ -161,6 +161,18 @@ def test_the_pose_written_is_the_pose_searched_and_checked(nor_fdm):
     assert res["estimate_stats"].support_mm3 < 0.8 * st.support_mm3
     assert res["estimate_key"][0] >= res["key"][0]
     assert any("was not kept" in n for n in asm.notes)
+    # the kept up is the best of the axes and slab normals by the report's measure: no worse than z
+    from mlc.mesh.build import _h, transform_solid
+    from mlc.mesh.checks import ISLAND_FEATURES, OVERHANG_DEG
+    from mlc.mesh.pose import report_grid
+    sol = [(p.name, transform_solid(p.solid, _h(np.eye(3), np.zeros(3)))) for p in asm.parts]
+    lo = np.min([np.asarray(x.bounding_box())[:3] for _, x in sol], 0)
+    hi = np.max([np.asarray(x.bounding_box())[3:] for _, x in sol], 0)
+    sol = [(n, x.translate([-(lo[0] + hi[0]) / 2, -(lo[1] + hi[1]) / 2, -lo[2]])) for n, x in sol]
+    z = bed_stats(sol, OVERHANG_DEG, report_grid(hi - lo, asm.profile.min_wall), first_layer=0.2,
+                  island_mm=ISLAND_FEATURES * asm.profile.min_feature)
+    zk = pose_key(z.support_fraction, z.support_inside_mm3 / z.part_volume_mm3, z.contact_fraction)
+    assert res["key"] <= zk
 
 
 def test_a_large_assembly_keeps_the_axis_candidates(monkeypatch):

@@ -19,8 +19,8 @@ configuration with one rigid transform of the whole assembly (``Assembly.orient`
 3. the :data:`REFINE_STARTS` best (at least :data:`START_APART_DEG` apart) are refined by a
    pattern search on the sphere (8 directions at each of :data:`REFINE_STEPS_DEG` degrees,
    moving while the score falls by at least :data:`MIN_GAIN`);
-4. the :data:`FINAL` best distinct directions, and the best of the step-1 axis and normal
-   candidates, are measured with :func:`mlc.mesh.printability.bed_stats` on the report's own
+4. the :data:`FINAL` best distinct directions, and the :data:`EXTRA_EXACT` best of the step-1
+   axis and normal candidates, are measured with :func:`mlc.mesh.printability.bed_stats` on the report's own
    grid (``mlc.mesh.checks.bed_checks``); the :data:`EXACT_STARTS` best are refined again by
    the same pattern search on that grid (:data:`EXACT_STEPS_DEG`, at most :data:`EXACT_MAX`
    measurements: near the overhang limit a small tilt decides whether a column of support
@@ -54,6 +54,8 @@ COARSE_CELLS = 40
 REFINE_STARTS = 4
 #: the pattern search's steps (degrees), each kept while it improves the score
 REFINE_STEPS_DEG = (8.0, 4.0, 2.0, 1.0, 0.5)
+#: the given candidates (axes, slab normals) best on the coarse grid also measured exactly
+EXTRA_EXACT = 4
 #: refined starts at least this far apart (degrees)
 START_APART_DEG = 15.0
 #: best distinct directions measured exactly at the end
@@ -214,9 +216,13 @@ def search_up(V, F, part_volume: float, extra_ups=(), overhang_deg: float = 45.0
         refined.append((key, u))
     pool = sorted(refined + [(k, u) for k, _, u in scored], key=lambda x: x[0])
     final = _unique([u for _, u in pool], tol=1e-4)[:FINAL]
-    best_extra = next((u for k, _, u in scored if any(np.allclose(u, e) for e in extra)), None)
-    if best_extra is not None and all(not np.allclose(best_extra, u) for u in final):
-        final.append(best_extra)
+    # the given candidates (axes, slab normals) best on the coarse grid, measured exactly too: the
+    # best of them by the report's own measure is the one the guard keeps
+    top_extra = [u for k, _, u in scored if any(np.allclose(u, e) for e in extra)][:EXTRA_EXACT]
+    for u in top_extra:
+        if all(not np.allclose(u, v) for v in final):
+            final.append(u)
+    best_extra = top_extra[0] if top_extra else None
     if exact is None:
         u = final[0]
         return {"up": u, "key": score(u), "stats": None, "evaluated": len(cache), "grid_mm": h}
@@ -231,6 +237,8 @@ def search_up(V, F, part_volume: float, extra_ups=(), overhang_deg: float = 45.0
         return memo[k][0]
 
     ranked = sorted(((exact_key(u), i, u) for i, u in enumerate(final)), key=lambda x: (x[0], x[1]))
+    if top_extra:
+        best_extra = min(top_extra, key=exact_key)
     # the report's own grid decides near the overhang limit: refine the best few on it
     best = (ranked[0][0], ranked[0][2])
     for key, _, u in ranked[:EXACT_STARTS if n_sphere else 0]:
