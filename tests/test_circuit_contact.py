@@ -94,3 +94,20 @@ def test_far_layers_clear_in_every_state(d):
 def test_candidate_pairs_leave_out_a_chains_own_layers():
     c = {"a": np.array([[0, 0, 0], [0, 0, 1.0]]), "b": np.array([[0.5, 0, 0], [9, 9, 9]])}
     assert candidate_pairs(c, 1.2) == [("a", 0, "b", 0), ("a", 1, "b", 0)]
+
+
+def test_mlc_compile_warns_of_layers_left_touching(tmp_path, capsys):
+    """The summary names the closest pair that the builder left (scene meta
+    connector.state_contacts); Tetris has none, so its summary has no warning."""
+    import json
+    from pathlib import Path
+
+    from mlc.cli import main
+    from mlc.commands.compile import format_summary
+    root = Path(__file__).resolve().parents[1]
+    assert main(["compile", str(root / "examples" / "tetris.tt"), "-o", str(tmp_path / "out"), "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert "state_contacts" not in d["circuit"] and "warning" not in format_summary(d)
+    d["circuit"]["state_contacts"] = [["w_a_0", 3, "w_b_1", 7, -0.0312], ["w_a_0", 4, "w_b_1", 7, 0.01]]
+    text = format_summary(d)
+    assert "warning: 2 pair(s)" in text and "w_a_0 half unit 3 and w_b_1 half unit 7, -0.031 sigma" in text
