@@ -8,7 +8,7 @@ import pytest
 from mlc.geometry.rotation import rotation_between
 from mlc.mesh.checks import BED_CONTACT_MIN, bed_checks
 from mlc.mesh.pose import fibonacci_sphere, hinge_ups, pose_key, search_up
-from mlc.mesh.printability import _mesh_arrays, bed_stats
+from mlc.mesh.printability import _mesh_arrays, bed_stats, merged_mesh
 
 
 def _box(size, centre):
@@ -89,14 +89,7 @@ def _table():
 
 def test_search_finds_the_table_on_its_top_and_a_bad_pose_fails_the_bed_goals():
     parts = _table()
-    V, F, own, off = [], [], [], 0
-    for k, (_, s) in enumerate(parts):
-        v, f = _mesh_arrays(s)
-        V.append(v)
-        F.append(f + off)
-        own.append(np.full(len(f), k))
-        off += len(v)
-    V, F, own = np.concatenate(V), np.concatenate(F), np.concatenate(own)
+    V, F, own = merged_mesh(parts)
     vol = sum(s.volume() for _, s in parts)
 
     def posed(u):

@@ -157,6 +157,12 @@ def _better(a: tuple, b: tuple) -> bool:
     return a[0] < b[0] or (a[0] == b[0] and a[1] < b[1] - MIN_GAIN)
 
 
+def _ring(u, s: float, c: float) -> list:
+    """The 8 directions a step (sine ``s``, cosine ``c``) from ``u``, 45 degrees apart around it."""
+    e1, e2 = _frame(u)
+    return [c * u + s * (np.cos(a) * e1 + np.sin(a) * e2) for a in np.radians(np.arange(0, 360, 45))]
+
+
 def _frame(u):
     a = np.eye(3)[int(np.argmin(np.abs(u)))]
     e1 = np.cross(u, a)
@@ -206,9 +212,7 @@ def search_up(V, F, part_volume: float, extra_ups=(), overhang_deg: float = 45.0
         for step in REFINE_STEPS_DEG:
             s, c = np.sin(np.radians(step)), np.cos(np.radians(step))
             while True:
-                e1, e2 = _frame(u)
-                ring = [c * u + s * (np.cos(a) * e1 + np.sin(a) * e2) for a in np.radians(np.arange(0, 360, 45))]
-                best = min(ring, key=score)
+                best = min(_ring(u, s, c), key=score)
                 if _better(score(best), key):
                     u, key = best / np.linalg.norm(best), score(best)
                 else:
@@ -245,9 +249,7 @@ def search_up(V, F, part_volume: float, extra_ups=(), overhang_deg: float = 45.0
         for step in EXACT_STEPS_DEG:
             s, c = np.sin(np.radians(step)), np.cos(np.radians(step))
             while len(memo) < EXACT_MAX:
-                e1, e2 = _frame(u)
-                ring = [c * u + s * (np.cos(a) * e1 + np.sin(a) * e2) for a in np.radians(np.arange(0, 360, 45))]
-                nxt = min(ring, key=exact_key)
+                nxt = min(_ring(u, s, c), key=exact_key)
                 if _better(exact_key(nxt), key):
                     u, key = nxt / np.linalg.norm(nxt), exact_key(nxt)
                 else:
@@ -279,17 +281,10 @@ def best_rotation(asm) -> np.ndarray:
     :func:`search_up` to +z; a note says which and how it scored."""
     from mlc.mesh.build import _h, transform_solid
     from mlc.mesh.checks import OVERHANG_DEG, island_side
-    from mlc.mesh.printability import _mesh_arrays, bed_stats
+    from mlc.mesh.printability import bed_stats, merged_mesh
 
     solids = [(p.name, p.solid) for p in asm.parts if not p.solid.is_empty()]
-    Vs, Fs, Os, off = [], [], [], 0
-    for k, (_, s) in enumerate(solids):
-        V, F = _mesh_arrays(s)
-        Vs.append(V)
-        Fs.append(F + off)
-        Os.append(np.full(len(F), k))
-        off += len(V)
-    V, F, own = np.concatenate(Vs), np.concatenate(Fs), np.concatenate(Os)
+    V, F, own = merged_mesh(solids)
     first_layer = min(0.2, asm.profile.min_wall / 2)
     part_volume = float(sum(s.volume() for _, s in solids))
 

@@ -67,6 +67,19 @@ def _mesh_arrays(solid):
     return np.asarray(m.vert_properties, float)[:, :3], np.asarray(m.tri_verts, np.int64)
 
 
+def merged_mesh(named_solids):
+    """One triangle soup of ``(name, solid)`` pairs: vertices (n,3) mm, faces (m,3) indexing
+    them, and each face's owner (the solid's index in ``named_solids``)."""
+    Vs, Fs, Os, off = [], [], [], 0
+    for k, (_, s) in enumerate(named_solids):
+        V, F = _mesh_arrays(s)
+        Vs.append(V)
+        Fs.append(F + off)
+        Os.append(np.full(len(F), k))
+        off += len(V)
+    return np.concatenate(Vs), np.concatenate(Fs), np.concatenate(Os)
+
+
 def bed_stats(named_solids, overhang_deg: float = 45.0, h: float = 0.5, first_layer: float = 0.2,
               island_mm: float = 0.0) -> BedStats:
     """Bed contact, overhang and support volume of print-frame solids ``[(name, manifold)]``
@@ -84,17 +97,7 @@ def bed_stats(named_solids, overhang_deg: float = 45.0, h: float = 0.5, first_la
     contact = mf.CrossSection.batch_boolean(sections, mf.OpType.Add).area()
     lowest = {n: float(np.asarray(s.bounding_box())[2]) for n, s in named_solids}
 
-    allV, allF, owner = [], [], []
-    off = 0
-    for k, (_, s) in enumerate(named_solids):
-        V, F = _mesh_arrays(s)
-        allV.append(V)
-        allF.append(F + off)
-        owner.append(np.full(len(F), k))
-        off += len(V)
-    V = np.concatenate(allV)
-    F = np.concatenate(allF)
-    own = np.concatenate(owner)
+    V, F, own = merged_mesh(named_solids)
     c = _columns(V, F, h, overhang_deg, z0, own, island_mm)
     overhang_area = c["overhang_area"]
     per_over = np.bincount(own[c["over_idx"]], weights=overhang_area, minlength=len(named_solids))
