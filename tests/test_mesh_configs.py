@@ -1,0 +1,124 @@
+"""Issue 13, item 1: the configurations a printed mechanism reaches (mlc.mesh.configs).
+Lengths in mm, angles in degrees."""
+import types
+
+import numpy as np
+import pytest
+
+from mlc.mesh.configs import Clearance, Evaluator, Kinematics, angle_targets, input_axes, scan
+
+
+def _linkage(points, closed: bool):
+    """A planar chain of rigid links joined by hinges along z at ``points`` (mm), the last link
+    hinged back to the first when ``closed``: an assembly with only what Kinematics reads."""
+    n = len(points) - (0 if closed else 1)
+    names = [f"l{i}" for i in range(n if closed else n + 1)]
+    axes = []
+    for k, p in enumerate(points):
+        if closed:
+            pair = [names[k - 1], names[k]]
+        elif k == 0:
+            continue
+        else:
+            pair = [names[k - 1], names[k]]
+        axes.append(types.SimpleNamespace(name=f"h{k}", bodies=pair, origin=np.array(p, float),
+                                          direction=np.array([0, 0, 1.0]), span=10.0))
+    scene = types.SimpleNamespace(bodies=[types.SimpleNamespace(name=x) for x in names], muscles=[])
+    return types.SimpleNamespace(scene=scene, axes=axes, ujoints=[])
+
+
+def test_freedoms_of_known_linkages():
+    # an open chain of 3 links on 2 hinges: 2 freedoms; a planar four-bar: 1; a triangle: rigid
+    assert Kinematics(_linkage([[0, 0, 0], [10, 0, 0], [20, 0, 0]], closed=False)).freedoms() == 2
+    four = _linkage([[0, 0, 0], [0, 10, 0], [30, 10, 0], [30, 0, 0]], closed=True)
+    assert Kinematics(four).freedoms() == 1
+    assert Kinematics(_linkage([[0, 0, 0], [10, 0, 0], [0, 10, 0]], closed=True)).freedoms() == 0
+
+
+def test_a_parallelogram_turns_both_cranks_alike():
+    """Crank the parallelogram four-bar by 25 degrees: the joints close, and the other crank
+    turns by the same angle (the coupler translates)."""
+    four = _linkage([[0, 0, 0], [0, 10, 0], [30, 10, 0], [30, 0, 0]], closed=True)
+    kin = Kinematics(four)
+    # links: l0 the crank (h0 -> h1), l1 the coupler, l2 the rocker, l3 the ground (h3 -> h0)
+    T, e = angle_targets(kin, kin.rest(), {"h0:l0": 25.0})
+    assert e < 1e-7
+    ang = kin.hinge_angles(T)
+    assert abs(ang["h0:l0"] - 25.0) < 1e-6
+    assert abs(ang["h3:l3"] + 25.0) < 1e-5          # the ground seen from the rocker: -25
+    R_coupler = T[kin.index["l1"]][:3, :3] @ T[kin.index["l3"]][:3, :3].T
+    assert np.allclose(R_coupler, np.eye(3), atol=1e-7)
+
+
+@pytest.fixture(scope="module")
+def nand_fdm():
+    from mlc.gates.library import gate_scene
+    from mlc.mesh.build import build_assembly
+    from mlc.mesh.profiles import load_profile
+    asm = build_assembly(gate_scene("NAND", "expand"), load_profile("fdm", {"orient": "as_is"}))
+    kin = Kinematics(asm)
+    return asm, kin, Clearance(asm, kin)
+
+
+def test_a_gate_has_its_two_input_levers_as_freedoms(nand_fdm):
+    asm, kin, _ = nand_fdm
+    assert np.max(np.abs(kin.residual(kin.rest()))) == 0
+    assert kin.freedoms() == 2
+    assert input_axes(kin) == ["pivot_a:a_hi", "pivot_b:b_hi"]
+    T, e = angle_targets(kin, kin.rest(), {"pivot_a:a_hi": 20.0, "pivot_b:b_hi": -10.0})
+    assert e < 1e-7
+    ang = kin.hinge_angles(T)
+    assert abs(ang["pivot_a:a_hi"] - 20) < 1e-5 and abs(ang["pivot_b:b_hi"] + 10) < 1e-5
+    assert kin.freedoms(T) == 2
+    # the lever loop's hinges all stay along z (the loop is planar) and the output lever's along x:
+    # no configuration turns a slab of the loop out of the vertical planes
+    zs = [ax for ax in asm.axes if abs(ax.direction[2]) > 0.99]
+    assert len(zs) == 5
+    for ax in asm.axes:
+        i = kin.index[ax.bodies[0]]
+        assert abs(abs((T[i][:3, :3] @ ax.direction) @ ax.direction) - 1) < 1e-9
+
+
+def test_the_clearance_refuses_parts_that_meet(nand_fdm):
+    asm, kin, clear = nand_fdm
+    assert clear.ok(kin.rest())[0]
+    T, e = angle_targets(kin, kin.rest(), {"pivot_a:a_hi": 10.0, "pivot_b:b_hi": 0.0})
+    assert e < 1e-7 and clear.ok(T)[0]
+    # pivot b closed by 60 degrees (in steps, the joints followed): lever b_lo runs into core_cd
+    T = kin.rest()
+    for a in range(-10, -61, -10):
+        T, e = angle_targets(kin, T, {"pivot_a:a_hi": 0.0, "pivot_b:b_hi": float(a)})
+    ok, bad = clear.ok(T)
+    assert not ok
+    names = {asm.parts[i].name + "/" + asm.parts[j].name for i, j in bad}
+    assert "core_cd/b_lo" in names
+
+
+def test_scan_floods_from_rest_and_stops_at_collisions(nand_fdm):
+    asm, kin, clear = nand_fdm
+    sc = scan(kin, clear, step_deg=15.0, limit_deg=45.0)
+    assert (0, 0) in sc["reached"] and sc["refused"]
+    assert all(abs(x) <= 3 for n in sc["reached"] for x in n)
+    for n, T in sc["reached"].items():
+        ang = kin.hinge_angles(T)
+        assert abs(ang["pivot_a:a_hi"] - 15 * n[0]) < 1e-4 and abs(ang["pivot_b:b_hi"] - 15 * n[1]) < 1e-4
+        assert clear.ok(T)[0]
+    # every reached node has a reached neighbour nearer rest (connected to rest)
+    for n in sc["reached"]:
+        if n != (0, 0):
+            assert any(tuple(x - (np.sign(x) if q == d else 0) for q, x in enumerate(n)) in sc["reached"]
+                       for d in range(2) if n[d] != 0)
+
+
+def test_the_evaluator_measures_what_the_report_measures(nand_fdm):
+    """At rest with up = z, the evaluator's exact figures are bed_stats of the parts as the
+    report poses them (the same transform, the same grid)."""
+    from mlc.mesh.checks import bed_checks
+    from mlc.mesh.build import _orientation
+    asm, kin, clear = nand_fdm
+    r = Evaluator(asm, clear)(kin.rest(), ups=[np.array([0, 0, 1.0])])
+    asm.orient = _orientation(asm)                    # as_is: the model's z, centred, on the bed
+    bed_checks(asm)
+    assert abs(r["stats"].contact_fraction - asm.bed.contact_fraction) < 1e-9
+    # (the same grid; the vertices moved by other floating-point steps: 0.4 of 5300 mm^3)
+    assert abs(r["stats"].support_mm3 - asm.bed.support_mm3) < 1e-3 * asm.bed.support_mm3
