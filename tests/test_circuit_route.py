@@ -85,3 +85,45 @@ def test_avoid_pushes_the_layers_from_the_points_and_still_closes():
     n = len(pushed.bends)
     late = R.solve_route(*args, avoid=((pts, D),), avoid_from=n, **kw)
     assert late.bends == plain.bends
+
+
+def test_polish_closes_a_near_miss_with_bends_on_their_bounds():
+    """``_polish``: a chain 2e-5 sigma short of its target, half its bends pinned on their
+    bounds (where the trust region stalls), is closed below EXACT by the free bends
+    alone; no bend leaves its bounds and the pinned ones do not move."""
+    args, kw = _args()
+    c0, u0, P, a, geo, _ = args
+    r = R.solve_route(*args, **kw)
+    x = np.array(r.bends)
+    n = len(x)
+    pitches = np.full(n, geo.pitch)
+    pinned = np.arange(n) % 2 == 1
+    lo = np.where(pinned, x, x - 0.2)
+    hi = np.where(pinned, x + 0.3, x + 0.2)
+    e1, e2 = R._perp_basis(a / np.linalg.norm(a))
+    target = P + np.array([2e-5, -1e-5, 1e-5])
+
+    def err(b):
+        cs, us, _ = R._fk(c0, u0, r.tangent, b, pitches)
+        return max(np.linalg.norm(cs[-1] - target), abs(us[-1] @ e1), abs(us[-1] @ e2))
+    assert err(x) > 1e-5
+    y = R._polish(x.copy(), lo, hi, c0, u0, r.tangent, pitches, target, e1, e2)
+    assert err(y) < R.EXACT
+    assert np.all(y >= lo) and np.all(y <= hi)
+    assert np.array_equal(y[pinned], x[pinned])
+    # with every bend pinned there is nothing to move: returned unchanged
+    z = R._polish(x.copy(), x.copy(), x + 0.1, c0, u0, r.tangent, pitches, target, e1, e2)
+    assert np.array_equal(z, x)
+
+
+def test_polish_leaves_a_route_that_closes_without_it_as_it_is():
+    """``polish`` acts only where no length closes: a solve that closes gives the same bends
+    with and without it."""
+    args, kw = _args()
+    size, R.CACHE_SIZE = R.CACHE_SIZE, 0
+    try:
+        a = R.solve_route(*args, polish=True, **kw)
+        b = R.solve_route(*args, polish=False, **kw)
+    finally:
+        R.CACHE_SIZE = size
+    assert a is not None and a.bends == b.bends

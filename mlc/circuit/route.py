@@ -40,6 +40,8 @@ AVOID_WEIGHT = 30.0        # weight of the keep-away terms (``avoid``) against t
 EARLY_CLOSE = True         # the closing passes stop at the first evaluation that closes to CLOSE_MARGIN * EXACT
 CLOSE_MARGIN = 0.1
 MAX_HALF = 400             # half units of the longest chain tried (the steered guess is cut there)
+POLISH_FROM = 1e-3         # sigma: when no length closes, those whose passes ended this close are polished
+POLISH_STEPS = 12          # Newton steps of _polish at most
 
 
 @dataclass
@@ -230,7 +232,7 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
                 min_half: int = 2, max_half: int = MAX_HALF, bend_max: float | None = None,
                 last_pitch: float | None = None, start_bend_max: float = math.radians(50.0),
                 extras=(0, 2, 4, 8, 12, 16, 24), end_bends: tuple[int, float] | None = None,
-                 wp_weight: float = 0.3, avoid=(), avoid_from: int = 0) -> Route | None:
+                 wp_weight: float = 0.3, avoid=(), avoid_from: int = 0, polish: bool = True) -> Route | None:
     """A chain from pair (c0, u0) to pair (target_c, +-target_a) with ``n % 2 == parity``
     half units; None when no chain closes.
 
@@ -248,7 +250,10 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
     ``avoid``: ``(points, distance)`` sets (sigma): the soft passes push every layer
     centre from the ``avoid_from``-th on (see ``lanes.layer_centres``) towards at least
     ``distance`` from each set's points (a one-sided term of weight ``AVOID_WEIGHT``,
-    scaled like the waypoints: the closing passes keep the shape but do not enforce it)."""
+    scaled like the waypoints: the closing passes keep the shape but do not enforce it).
+    ``polish``: when no length closes, the lengths whose passes ended within ``POLISH_FROM``
+    of closing (approach kept) are closed by :func:`_polish`, shortest first; a route that
+    closes without it is the same with or without it."""
     c0, u0 = np.asarray(c0, float), np.asarray(u0, float) / np.linalg.norm(u0)
     P, a = np.asarray(target_c, float), np.asarray(target_a, float) / np.linalg.norm(target_a)
     e1, e2 = _perp_basis(a)
@@ -261,7 +266,7 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
     app = None if approach is None else np.asarray(approach, float) / np.linalg.norm(approach)
     guide = _guide(c0, t0, waypoints, P, app)
     guess = _steer(c0, u0, t0, guide, geo.pitch, bmax, free_start and start_bend_max, max_half)
-    best = None
+    near = []                   # (n, pitches, route) of the lengths that nearly closed
     for extra in extras:
         n = max(min_half, len(guess) + extra)
         if n % 2 != parity:
@@ -282,9 +287,77 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
             print("len", n, "error", r.error, "approach", r.approach_error)
         if r.error < EXACT and r.approach_error < 0.5:
             return r
-        if best is None or r.error < best.error:
-            best = r
+        if polish and r.error < POLISH_FROM and r.approach_error < 0.5:
+            near.append((n, pitches, r))
+    for n, pitches, r in near:
+        lo, hi = _bounds(n, bmax, free_start and start_bend_max, end_bends)
+        x = _polish(np.array(r.bends), lo, hi, c0, u0, t0, pitches, P, e1, e2)
+        cs, us, ts = _fk(c0, u0, t0, x, pitches)
+        err = float(max(np.linalg.norm(cs[-1] - P), abs(us[-1] @ e1), abs(us[-1] @ e2)))
+        aerr = 0.0 if app is None else float(np.linalg.norm(ts[-1] - app))
+        if DEBUG:
+            print("polished", n, "error", r.error, "->", err, "approach", aerr)
+        if err < EXACT and aerr < 0.5:
+            return Route(c0, u0, t0, [float(v) for v in x], err, aerr)
     return None
+
+
+def _bounds(n: int, bmax: float, free_start, end_bends) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper bounds of the ``n`` bends (rad): ``bmax``; the ``end_bends = (m, b)``
+    junctions after the first and the last ``m`` at most ``b``; the first bend (the turn
+    about the tap's axis) at most ``free_start`` (rad), or fixed when it is False."""
+    lo = np.full(n, -bmax)
+    hi = np.full(n, bmax)
+    if end_bends is not None:                  # (count, bound): the first and last junctions bend less
+        m, eb = end_bends
+        lo[-m:], hi[-m:] = -eb, eb
+        lo[1:1 + m], hi[1:1 + m] = -eb, eb
+    lim0 = float(free_start) if free_start else 1e-12      # free_start: the first bend's bound (rad)
+    lo[0], hi[0] = -lim0, lim0
+    return lo, hi
+
+
+def _polish(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, margin: float = 1e-9) -> np.ndarray:
+    """Close a nearly closed chain exactly.  The passes of :func:`_solve_n` can stall a
+    little short of ``EXACT`` (5e-7 sigma, say) with bends on their bounds: the trust
+    region's steps shrink to nothing there.  Gauss-Newton on the five closure equations
+    alone (the last pair's position, its axis across the target's), over the bends not on
+    a bound: each step the smallest that solves the linearised equations (least squares),
+    halved until it stays within the bounds and lowers the closure error.  Returns the
+    bends (rad), unchanged if no step helps."""
+    n = x.shape[0]
+    cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
+    J = np.empty((5 + (n - 1), n))
+    no_wp = np.zeros(0, dtype=np.int64)
+
+    def error(b) -> float:
+        _fk_kernel(c0, u0, t0, b, pitches, cs, us, ts)
+        return float(max(np.linalg.norm(cs[-1] - P), abs(us[-1] @ e1), abs(us[-1] @ e2)))
+
+    x = np.clip(np.ascontiguousarray(x, dtype=np.float64), lo, hi)
+    err = error(x)
+    for _ in range(POLISH_STEPS):
+        if err < EXACT:
+            break
+        error(x)                                 # frames of x
+        _jac_kernel(cs, us, ts, e1, e2, False, no_wp, 0.0, 0.0, J)
+        r = 10.0 * np.array([*(cs[-1] - P), us[-1] @ e1, us[-1] @ e2])
+        free = (x > lo + margin) & (x < hi - margin)
+        if not free.any():
+            break
+        step = np.zeros(n)
+        step[free] = np.linalg.lstsq(J[:5, free], -r, rcond=None)[0]
+        t = 1.0
+        while t > 1e-3:
+            x_new = np.clip(x + t * step, lo, hi)
+            e_new = error(x_new)
+            if e_new < err:
+                break
+            t *= 0.5
+        else:
+            break
+        x, err = x_new, e_new
+    return x
 
 
 def _guide(c0, t0, waypoints, P, app) -> np.ndarray:
@@ -354,14 +427,7 @@ def _fk(c0, u0, t0, b, pitch):
 
 def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=(), end_bends=None,
              wp_weight=0.3, avoid=(), avoid_from=0) -> Route:
-    lo = np.full(n, -bmax)
-    hi = np.full(n, bmax)
-    if end_bends is not None:                  # (count, bound): the first and last junctions bend less
-        m, eb = end_bends
-        lo[-m:], hi[-m:] = -eb, eb
-        lo[1:1 + m], hi[1:1 + m] = -eb, eb
-    lim0 = float(free_start) if free_start else 1e-12      # free_start: the first bend's bound (rad)
-    lo[0], hi[0] = -lim0, lim0
+    lo, hi = _bounds(n, bmax, free_start, end_bends)
 
     wp_k = np.array([k for k, _ in wps], dtype=np.int64)
     wp_p = np.array([p for _, p in wps], dtype=float).reshape(-1, 3)
