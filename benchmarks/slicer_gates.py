@@ -17,6 +17,12 @@ compared (issue 13, item 1):
 * ``after``: the pose ``mlc stl`` writes now (``asm.orient``).  A pose equal to an earlier one
   is not sliced again (its figures are copied).
 
+With ``--orient auto_config`` (rows with ``"orient": "auto_config"``, kept beside the ``auto``
+rows) the parts are printed in the configuration of the mechanism ``mlc stl`` chooses
+(``asm.print_pose``, ``mlc.mesh.configs``; the row's ``configuration``: the input levers' hinge
+angles from rest, degrees): ``estimate`` and ``after`` are in that configuration, ``before``
+stays the rest configuration with the model's z up.
+
 For each pose: mlc's own bed statistics on the report's grid (``mlc.mesh.printability``), the
 3MF (one object, the parts as volumes), ``prusa-slicer --info`` (objects, parts), and three
 slices -- without supports, with supports (``--support-material``), and with supports on the
@@ -139,26 +145,31 @@ def info(exe, path: Path) -> dict:
             "size": [[float(x) for x in m] for m in re.findall(r"size_x = ([\d.]+)\s+size_y = ([\d.]+)\s+size_z = ([\d.]+)", txt)]}
 
 
-def posed_solids(asm, R):
-    """The parts rotated by ``R`` (model -> print), centred on the bed and resting on z = 0."""
-    sol = [(p.name, transform_solid(p.solid, _h(R, np.zeros(3)))) for p in asm.parts if not p.solid.is_empty()]
+def posed_solids(asm, R, config: bool = False):
+    """The parts rotated by ``R`` (model -> print), centred on the bed and resting on z = 0;
+    ``config``: each part first moved into the printed configuration (``asm.print_pose``,
+    ``orient: auto_config``), else the rest configuration."""
+    pose = getattr(asm, "print_pose", {}) if config else {}
+    sol = [(p.name, transform_solid(p.solid, _h(R, np.zeros(3)) @ pose.get(p.name, np.eye(4))))
+           for p in asm.parts if not p.solid.is_empty()]
     lo = np.min([np.asarray(s.bounding_box())[:3] for _, s in sol], axis=0)
     hi = np.max([np.asarray(s.bounding_box())[3:] for _, s in sol], axis=0)
     sh = [-(lo[0] + hi[0]) / 2, -(lo[1] + hi[1]) / 2, -lo[2]]
     return [(n, s.translate(sh)) for n, s in sol], hi - lo
 
 
-def stats(asm, R):
-    sol, size = posed_solids(asm, R)
+def stats(asm, R, config: bool = False):
+    sol, size = posed_solids(asm, R, config)
     mw = asm.profile.min_wall
     return sol, bed_stats(sol, OVERHANG_DEG, report_grid(size, mw), first_layer=min(0.2, mw / 2),
                           island_mm=island_side(asm.profile))
 
 
-def pose_row(exe, asm, R, up, f: Path, title: str, layer: float) -> dict:
-    sol, bs = stats(asm, R)
+def pose_row(exe, asm, R, up, f: Path, title: str, layer: float, config: bool = False) -> dict:
+    sol, bs = stats(asm, R, config)
     f.write_bytes(threemf_bytes([(n, to_trimesh(s)) for n, s in sol], title))
     row = {"up": [round(float(x), 4) for x in up], "mlc_bed": bs.to_dict(),
+           "configuration": dict(getattr(asm, "print_config", {})) if config else {},
            "mlc_parts_off_bed": sum(1 for z in bs.lowest_mm.values() if z > 0.05),
            "prusa_info": info(exe, f)}
     for k in ("none", "all", "buildplate"):
@@ -178,6 +189,8 @@ def main() -> int:
     ap.add_argument("--profiles", default="mjp,sla,fdm")
     ap.add_argument("-o", "--out", default=str(ROOT / "benchmarks/results/slicer_gates.json"))
     ap.add_argument("--append", action="store_true", help="keep the rows already in --out (other gates/profiles)")
+    ap.add_argument("--orient", default="auto", choices=("auto", "auto_config"),
+                    help="auto_config: 'estimate' and 'after' in the configuration mlc stl chooses")
     a = ap.parse_args()
     exe = shutil.which("prusa-slicer")
     if not exe:
@@ -194,12 +207,15 @@ def main() -> int:
     for g in a.gates.split(","):
         scene = gate_scene(g, a.signal)
         for pn in a.profiles.split(","):
-            rows = [r for r in rows if not (r["gate"] == g and r["profile"] == pn and r["signal"] == a.signal)]
-            prof = load_profile(pn, {"orient": "auto"})
+            rows = [r for r in rows if not (r["gate"] == g and r["profile"] == pn and r["signal"] == a.signal
+                                            and r.get("orient", "auto") == a.orient)]
+            prof = load_profile(pn, {"orient": a.orient})
             t0 = time.perf_counter()
             asm, rep = export_assembly(scene, prof)
             t_build = time.perf_counter() - t0
-            row = {"gate": g, "signal": a.signal, "profile": pn, "orient": "auto", "layer_mm": LAYER[pn], "commit": commit,
+            cfg = bool(getattr(asm, "print_pose", {}))
+            row = {"gate": g, "signal": a.signal, "profile": pn, "orient": a.orient, "layer_mm": LAYER[pn], "commit": commit,
+                   "configuration": dict(getattr(asm, "print_config", {})),
                    "parts": len(asm.parts), "part_volume_mm3": round(sum(float(p.solid.volume()) for p in asm.parts), 1),
                    "export_s": round(t_build, 2), "report_ok": rep.ok,
                    "goals_not_met": sorted(c.name for c in rep.checks if not c.ok and not c.blocking),
@@ -210,14 +226,14 @@ def main() -> int:
             row["before"] = pose_row(exe, asm, rotation_between(u0, [0, 0, 1.0]), u0, tmp / f"{g}_{pn}_before.3mf",
                                      f"{g}_{a.signal}", LAYER[pn])
             ue = np.asarray(asm.pose_search["estimate_up"], float)
-            row["estimate"] = (dict(row["before"], up=[round(float(x), 4) for x in ue]) if np.allclose(ue, u0) else
-                               pose_row(exe, asm, rotation_between(ue, [0, 0, 1.0]), ue,
-                                        tmp / f"{g}_{pn}_estimate.3mf", f"{g}_{a.signal}", LAYER[pn]))
+            row["estimate"] = (dict(row["before"], up=[round(float(x), 4) for x in ue]) if np.allclose(ue, u0) and not cfg
+                               else pose_row(exe, asm, rotation_between(ue, [0, 0, 1.0]), ue,
+                                             tmp / f"{g}_{pn}_estimate.3mf", f"{g}_{a.signal}", LAYER[pn], cfg))
             R = asm.orient[:3, :3]
             ua = R[2]
-            row["after"] = (dict(row["before"], up=[round(float(x), 4) for x in ua]) if np.allclose(ua, u0) else
+            row["after"] = (dict(row["before"], up=[round(float(x), 4) for x in ua]) if np.allclose(ua, u0) and not cfg else
                             dict(row["estimate"], up=[round(float(x), 4) for x in ua]) if np.allclose(ua, ue) else
-                            pose_row(exe, asm, R, ua, tmp / f"{g}_{pn}_after.3mf", f"{g}_{a.signal}", LAYER[pn]))
+                            pose_row(exe, asm, R, ua, tmp / f"{g}_{pn}_after.3mf", f"{g}_{a.signal}", LAYER[pn], cfg))
             rows.append(row)
             for k in ("before", "estimate", "after"):
                 r, b = row[k], row[k]["mlc_bed"]

@@ -122,3 +122,122 @@ def test_the_evaluator_measures_what_the_report_measures(nand_fdm):
     assert abs(r["stats"].contact_fraction - asm.bed.contact_fraction) < 1e-9
     # (the same grid; the vertices moved by other floating-point steps: 0.4 of 5300 mm^3)
     assert abs(r["stats"].support_mm3 - asm.bed.support_mm3) < 1e-3 * asm.bed.support_mm3
+
+
+def _nor_at(asm, kin, a, b, step=10.0):
+    """NOR's configuration with the input levers' hinges at ``a`` and ``b`` degrees, reached from
+    rest in steps (the joints followed)."""
+    T = kin.rest()
+    n = int(max(abs(a), abs(b)) / step)
+    for k in range(1, n + 1):
+        T, e = angle_targets(kin, T, {"pivot_a:a_hi": a * k / n, "pivot_b:b_hi": b * k / n})
+        assert e < 1e-7
+    return T
+
+
+@pytest.fixture(scope="module")
+def nor_fdm():
+    from mlc.gates.library import gate_scene
+    from mlc.mesh.build import build_assembly
+    from mlc.mesh.profiles import load_profile
+    asm = build_assembly(gate_scene("NOR", "expand"), load_profile("fdm", {"orient": "as_is"}))
+    kin = Kinematics(asm)
+    return asm, kin, Clearance(asm, kin)
+
+
+def test_the_writers_and_the_bed_check_print_the_configuration(nor_fdm):
+    """With a print pose set, the STL/3MF meshes, the print size and the bed checks are the
+    parts moved into that configuration, then oriented; without one, the rest configuration."""
+    import manifold3d as mf
+    from mlc.mesh.build import _orientation, transform_solid
+    from mlc.mesh.checks import bed_checks, print_size
+    from mlc.mesh.export import part_meshes
+    from mlc.mesh.printability import bed_stats
+    asm, kin, clear = nor_fdm
+    T = _nor_at(asm, kin, -60.0, 60.0)
+    assert clear.ok(T)[0]
+    rest_size = print_size(asm)
+    asm.print_pose = {p.name: P for p, P in zip(asm.parts, clear.part_T(T))}
+    try:
+        asm.orient = _orientation(asm)               # as_is: z up, centred, on the bed
+        meshes = dict(part_meshes(asm))
+        for p in asm.parts:
+            posed = transform_solid(p.solid, asm.orient @ asm.print_pose[p.name])
+            lo = np.asarray(posed.bounding_box())[:3]
+            assert np.allclose(meshes[p.name].bounds[0], lo, atol=1e-6)
+        assert min(float(m.bounds[0][2]) for m in meshes.values()) == pytest.approx(0.0, abs=1e-6)
+        assert print_size(asm) != rest_size
+        bed_checks(asm)
+        st = bed_stats([(p.name, transform_solid(p.solid, asm.orient @ asm.print_pose[p.name])) for p in asm.parts],
+                       h=asm.bed.grid_mm, first_layer=0.2, island_mm=6.0)
+        assert st.support_mm3 == pytest.approx(asm.bed.support_mm3, rel=1e-9)
+        # the parts as printed keep the clearance (min_gap of every pair of distinct parts)
+        solids = [transform_solid(p.solid, asm.orient @ asm.print_pose[p.name]) for p in asm.parts]
+        gaps = [solids[i].min_gap(solids[j], 1.0) for i in range(len(solids)) for j in range(i + 1, len(solids))]
+        assert min(gaps) >= asm.profile.clearance - 1e-4
+    finally:
+        asm.print_pose = {}
+        asm.orient = _orientation(asm)
+    del mf
+
+
+def test_best_configuration_beats_rest_by_its_own_measure(nor_fdm, monkeypatch):
+    """NOR fdm on a 30-degree grid: a configuration other than rest, reached with the
+    clearance kept, whose bed the evaluator scores better than rest's."""
+    from mlc.mesh import configs
+    asm, kin, clear = nor_fdm
+    monkeypatch.setattr(configs, "SCAN_STEP_DEG", 30.0)
+    monkeypatch.setattr(configs, "SCAN_LIMIT_DEG", 60.0)
+    monkeypatch.setattr(configs, "EVAL_EVERY", 1)
+    monkeypatch.setattr(configs, "REFINE", 0)
+    assert configs.applicable(asm) is None
+    cfg = configs.best_configuration(asm)
+    assert cfg is not None and any(v != 0 for v in cfg["angles_deg"].values())
+    assert clear.ok(cfg["T"])[0] and np.max(np.abs(kin.residual(cfg["T"]))) < 1e-6
+    ang = kin.hinge_angles(cfg["T"])
+    assert all(abs(ang[k] - v) < 1e-4 for k, v in cfg["angles_deg"].items())
+    rest = Evaluator(asm, clear)(kin.rest())
+    assert cfg["key"] < rest["key"]
+
+
+def test_auto_config_prints_another_configuration_only_when_it_is_better(nor_fdm, monkeypatch):
+    from mlc.mesh import configs, pose
+    from mlc.mesh.build import _orientation
+    from dataclasses import replace
+    asm, kin, clear = nor_fdm
+    for k, v in (("SCAN_STEP_DEG", 30.0), ("SCAN_LIMIT_DEG", 60.0), ("EVAL_EVERY", 1), ("REFINE", 0)):
+        monkeypatch.setattr(configs, k, v)
+    prof0 = asm.profile
+    try:
+        asm.profile = replace(prof0, orient="auto_config")
+        n0 = len(asm.notes)
+        asm.orient = _orientation(asm)
+        assert asm.print_pose and set(asm.print_pose) == {p.name for p in asm.parts}
+        assert any(v != 0 for v in asm.print_config.values())
+        assert any(x.startswith("configuration: printed with") for x in asm.notes[n0:])
+        # the same search when nothing may beat rest: rest is printed, and the note says why
+        monkeypatch.setattr(pose, "MIN_GAIN", 100.0)
+        monkeypatch.setattr(pose, "GOALS_TO_LEAVE", True)
+        n0 = len(asm.notes)
+        asm.orient = _orientation(asm)
+        assert asm.print_pose == {} and any("is not 100 of the part volume better" in x for x in asm.notes[n0:])
+    finally:
+        asm.profile = prof0
+        asm.print_pose = {}
+        asm.orient = _orientation(asm)
+
+
+def test_auto_config_searches_only_a_small_mechanism_driven_by_its_levers(nand_fdm):
+    """The configuration search is refused (rest printed) for an assembly of 64 parts or more
+    (a compiled circuit) and for a mechanism no muscle drives; a gate is searched."""
+    import copy
+    from mlc.mesh import configs
+    asm, _, _ = nand_fdm
+    assert configs.applicable(asm) is None
+    big = copy.copy(asm)
+    big.parts = asm.parts * 8
+    assert "parts" in configs.applicable(big)
+    loose = copy.copy(asm)
+    loose.scene = copy.copy(asm.scene)
+    loose.scene.muscles = []
+    assert configs.applicable(loose) == "no muscle drives a hinge"

@@ -38,8 +38,9 @@ def register(sub):
     g.add_argument("--min-feature", type=float, help="minimum feature (knuckle length, holes)")
     g.add_argument("--pin-diameter", type=float, help="hinge pin diameter")
     g.add_argument("--segments", dest="circular_segments", type=int, help="polygon segments per circle")
-    g.add_argument("--orient", choices=("as_is", "axes_flat", "auto"),
-                   help="print orientation (auto: least support, then most bed contact)")
+    g.add_argument("--orient", choices=("as_is", "axes_flat", "auto", "auto_config"),
+                   help="print orientation (auto: least support, then most bed contact; auto_config: "
+                        "also the configuration of the mechanism)")
     g.add_argument("--pin", choices=("pin", "cone"), help="hinge pins: a straight pin or 45 degree cone pins")
     p.set_defaults(func=run)
 

@@ -260,6 +260,17 @@ class Assembly:
     # the motion trims (_clear_motion): {"part", "clear_of", "poses" (dense pose names where the
     # pair was closer than the clearance before the trim), "removed_mm3", "settled"}
     motion_trims: list = field(default_factory=list)
+    # orient: auto_config (mlc.mesh.configs): the configuration printed, {part: 4x4 rest -> posed
+    # (mm, model frame)}; empty: the rest configuration.  The print frame of a part is
+    # orient @ print_pose[part] (print_T)
+    print_pose: dict = field(default_factory=dict)
+    print_config: dict = field(default_factory=dict)   # {input lever hinge: degrees from rest} printed
+
+    def print_T(self, name: str) -> np.ndarray:
+        """Model rest frame -> print frame (4x4, mm) of part ``name``: its configuration, then
+        the orientation on the bed."""
+        P = self.print_pose.get(name)
+        return self.orient if P is None else self.orient @ P
 
     def part(self, name: str) -> Part:
         for p in self.parts:
@@ -2711,7 +2722,7 @@ def _orientation(asm: Assembly) -> np.ndarray:
         best = min(cands, key=lambda z: (round(sum(abs(float(np.dot(z, d))) for d in dirs), 6)))
         from mlc.geometry.rotation import rotation_between
         Rm = rotation_between(best, [0, 0, 1.0])
-    if asm.profile.orient == "auto" and asm.parts:
+    if asm.profile.orient in ("auto", "auto_config") and asm.parts:
         Rm = _best_rotation(asm)
     lo = np.full(3, np.inf)
     hi = np.full(3, -np.inf)
@@ -2719,8 +2730,8 @@ def _orientation(asm: Assembly) -> np.ndarray:
         if p.solid.is_empty():
             continue
         # (no transform when the rotation is the identity: the same box, without copying the mesh)
-        bb = np.asarray((p.solid if np.array_equal(Rm, np.eye(3)) else
-                         transform_solid(p.solid, _h(Rm, np.zeros(3)))).bounding_box())
+        T = _h(Rm, np.zeros(3)) @ asm.print_pose.get(p.name, np.eye(4))
+        bb = np.asarray((p.solid if np.array_equal(T, np.eye(4)) else transform_solid(p.solid, T)).bounding_box())
         lo = np.minimum(lo, bb[:3])
         hi = np.maximum(hi, bb[3:])
     if not np.all(np.isfinite(lo)):

@@ -394,7 +394,7 @@ def bed_checks(asm: Assembly, stats=None) -> list:
     """``bed_contact`` and ``supports`` of the assembly in its print frame."""
     from mlc.mesh.printability import bed_stats
     if stats is None:
-        solids = [(p.name, transform_solid(p.solid, asm.orient)) for p in asm.parts]
+        solids = [(p.name, transform_solid(p.solid, asm.print_T(p.name))) for p in asm.parts]
         size = print_size(asm) or [1.0]
         h = max(0.05, min(asm.profile.min_wall, max(size) / 150))
         stats = bed_stats(solids, OVERHANG_DEG, h, first_layer=min(0.2, asm.profile.min_wall / 2),
@@ -431,7 +431,7 @@ def bed_checks(asm: Assembly, stats=None) -> list:
 
 def print_size(asm: Assembly) -> list | None:
     """Extent (mm) of the whole assembly in the print frame."""
-    boxes = [_bbox(p.solid, asm.orient) for p in asm.parts if not p.solid.is_empty()]
+    boxes = [_bbox(p.solid, asm.print_T(p.name)) for p in asm.parts if not p.solid.is_empty()]
     if not boxes:
         return None
     lo = np.min([b[0] for b in boxes], axis=0)

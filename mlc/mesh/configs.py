@@ -390,4 +390,79 @@ class Evaluator:
         return best
 
 
-__all__ = ["Clearance", "Evaluator", "Kinematics", "angle_targets", "input_axes", "scan", "slab_normals"]
+#: orient: auto_config: the grid of the input levers' hinge angles (degrees), its reach from rest
+SCAN_STEP_DEG = 5.0
+SCAN_LIMIT_DEG = 90.0
+#: ... every EVAL_EVERY-th grid node is evaluated (10 degrees apart), then the SCAN_STEP_DEG
+#: neighbours of the REFINE best
+EVAL_EVERY = 2
+REFINE = 3
+
+
+def applicable(asm) -> str | None:
+    """Why ``orient: auto_config`` cannot search this assembly's configurations (None: it can):
+    one mechanism of fewer than REUSE_MIN_PARTS parts, driven by muscles, whose every freedom is
+    an input lever's hinge."""
+    from mlc.mesh.build import REUSE_MIN_PARTS
+    from mlc.mesh.pipeline import split_mechanisms
+    if len(asm.parts) >= REUSE_MIN_PARTS:
+        return f"{len(asm.parts)} parts (a configuration search is for fewer than {REUSE_MIN_PARTS})"
+    if len(split_mechanisms(asm.scene)) != 1:
+        return "several mechanisms"
+    kin = Kinematics(asm)
+    keys = input_axes(kin)
+    if not keys:
+        return "no muscle drives a hinge"
+    f = kin.freedoms()
+    if f != len(keys):
+        return f"{f} freedoms, {len(keys)} of them input levers' hinges"
+    return None
+
+
+def best_configuration(asm) -> dict | None:
+    """The reachable configuration other than rest with the best bed by :class:`Evaluator`
+    (:func:`scan` on the SCAN_STEP_DEG grid, every EVAL_EVERY-th node evaluated, then the
+    neighbours of the REFINE best).  Returns ``{"T" (body transforms), "part_T" ({part: 4x4}),
+    "angles_deg" ({hinge: degrees}), "key", "reached", "evaluated"}``, or None when no node but
+    rest is reached."""
+    kin = Kinematics(asm)
+    clear = Clearance(asm, kin)
+    sc = scan(kin, clear, step_deg=SCAN_STEP_DEG, limit_deg=SCAN_LIMIT_DEG)
+    reached = sc["reached"]
+    rest = tuple([0] * len(sc["keys"]))
+    if len(reached) < 2:
+        return None
+    ev = Evaluator(asm, clear)
+    res = {n: ev(T) for n, T in reached.items() if n != rest and all(x % EVAL_EVERY == 0 for x in n)}
+    for n, _ in sorted(res.items(), key=lambda x: x[1]["key"])[:REFINE]:
+        for d in range(len(n)):
+            for sg in (-1, 1):
+                nb = tuple(x + (sg if q == d else 0) for q, x in enumerate(n))
+                if nb in reached and nb != rest and nb not in res:
+                    res[nb] = ev(reached[nb])
+    if not res:
+        return None
+    n = min(res, key=lambda m: (res[m]["key"], m))
+    T = reached[n]
+    return {"T": T, "part_T": {p.name: P for p, P in zip(asm.parts, clear.part_T(T))},
+            "angles_deg": {k: SCAN_STEP_DEG * x for k, x in zip(sc["keys"], n)}, "key": res[n]["key"],
+            "reached": len(reached), "evaluated": len(res), "kin": kin}
+
+
+def posed_directions(asm, kin: Kinematics, T) -> tuple[list, list]:
+    """The candidate ups of :func:`mlc.mesh.pose.search_up` in configuration ``T``: the world
+    axes and every posed slab normal (both signs), and the posed hinge and pin directions."""
+    from mlc.mesh.pose import _unique
+    c = [np.array(v, float) for v in np.eye(3)] + slab_normals(kin, T)
+    ups = _unique([s * v / np.linalg.norm(v) for v in c for s in (1.0, -1.0)])
+    dirs = [T[kin.index[ax.bodies[0]]][:3, :3] @ np.asarray(ax.direction, float) for ax in asm.axes
+            if ax.bodies[0] in kin.index]
+    for u in asm.ujoints:
+        if u.bodies[0] in kin.index and u.bodies[1] in kin.index:
+            dirs += [T[kin.index[u.bodies[0]]][:3, :3] @ np.asarray(u.axes[0], float),
+                     T[kin.index[u.bodies[1]]][:3, :3] @ np.asarray(u.axes[1], float)]
+    return ups, dirs
+
+
+__all__ = ["Clearance", "Evaluator", "Kinematics", "angle_targets", "applicable", "best_configuration",
+           "input_axes", "posed_directions", "scan", "slab_normals"]

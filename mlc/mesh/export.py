@@ -34,9 +34,9 @@ def to_trimesh(solid, T=None) -> trimesh.Trimesh:
 
 
 def part_meshes(asm, oriented: bool = True) -> list[tuple[str, trimesh.Trimesh]]:
-    """``[(part name, mesh)]`` in the print frame (mm) when ``oriented``, else the model frame."""
-    T = asm.orient if oriented else None
-    return [(p.name, to_trimesh(p.solid, T)) for p in asm.parts]
+    """``[(part name, mesh)]`` in the print frame (mm) when ``oriented`` (each part in the printed
+    configuration, ``asm.print_T``), else the model frame (rest)."""
+    return [(p.name, to_trimesh(p.solid, asm.print_T(p.name) if oriented else None)) for p in asm.parts]
 
 
 def stl_bytes(meshes) -> bytes:

@@ -2,11 +2,17 @@
 
 All lengths in mm (the parts' meshes); directions are unit vectors of the model frame.
 
-The print pose is the rest configuration of the mechanism (the parts as built), rotated so
-that a chosen "up" direction of the model points along +z, then centred on the bed and put on
-z = 0 (``mlc.mesh.build._orientation``).  Other configurations (folding the levers) are not
-searched: the parts' meshes, the report's other checks and the STL/3MF writer all use the rest
-configuration with one rigid transform of the whole assembly (``Assembly.orient``).
+The print pose is a configuration of the mechanism, rotated so that a chosen "up" direction of
+the model points along +z, then centred on the bed and put on z = 0
+(``mlc.mesh.build._orientation``).  With ``orient: auto`` (and ``as_is``, ``axes_flat``) the
+configuration is rest (the parts as built); with ``orient: auto_config`` the configurations the
+printed joints reach are searched too (:func:`best_rotation`, :mod:`mlc.mesh.configs`) and each
+part is first moved into the chosen one (``Assembly.print_pose``).  The STL/3MF writer, the
+print size and the bed checks use ``Assembly.print_T`` (the configuration, then
+``Assembly.orient``); the other checks stay in the model's rest frame (the states and motion
+checks pose the parts themselves; retention and walls do not change under the joints' motion,
+and the configuration search keeps every pair of parts at least the clearance apart, or no closer
+than at rest, which the report's ``min_gap`` checks).
 
 ``orient: auto`` chooses up by :func:`search_up`:
 
@@ -276,14 +282,15 @@ def report_grid(size_mm, min_wall: float) -> float:
     return max(0.05, min(min_wall, max(size_mm) / 150))
 
 
-def best_rotation(asm) -> np.ndarray:
-    """``orient: auto``: the rotation (3 x 3, model -> print frame) taking the best "up" of
-    :func:`search_up` to +z; a note says which and how it scored."""
+def _search_pose(asm, part_T: dict, ups, dirs) -> dict:
+    """:func:`search_up` on the parts of ``asm`` moved by ``part_T`` ({part: 4x4}, missing: rest),
+    the exact measure on the report's grid, centred on the bed as ``_orientation`` puts it."""
     from mlc.mesh.build import _h, transform_solid
     from mlc.mesh.checks import OVERHANG_DEG, island_side
     from mlc.mesh.printability import bed_stats, merged_mesh
 
-    solids = [(p.name, p.solid) for p in asm.parts if not p.solid.is_empty()]
+    solids = [(p.name, p.solid if p.name not in part_T else transform_solid(p.solid, part_T[p.name]))
+              for p in asm.parts if not p.solid.is_empty()]
     V, F, own = merged_mesh(solids)
     first_layer = min(0.2, asm.profile.min_wall / 2)
     part_volume = float(sum(s.volume() for _, s in solids))
@@ -299,9 +306,49 @@ def best_rotation(asm) -> np.ndarray:
         return bed_stats(posed, OVERHANG_DEG, report_grid(hi - lo, asm.profile.min_wall), first_layer=first_layer,
                          island_mm=island_side(asm.profile))
 
+    return search_up(V, F, part_volume, ups, OVERHANG_DEG, first_layer, exact=exact,
+                     seeds=hinge_ups(dirs), own=own, island_mm=island_side(asm.profile))
+
+
+def best_rotation(asm) -> np.ndarray:
+    """``orient: auto``: the rotation (3 x 3, model -> print frame) taking the best "up" of
+    :func:`search_up` to +z; a note says which and how it scored.
+
+    ``orient: auto_config`` also searches the configurations of the mechanism
+    (:func:`mlc.mesh.configs.best_configuration`: the input levers' hinge angles its printed joints
+    reach with every part at least the clearance apart) and prints the best other configuration
+    in its best up (``asm.print_pose``) when that up beats the rest configuration's best by the
+    same rule as an up beats the best axis or slab normal (:func:`_better` on the report's own
+    measure: fewer goals failed, or :data:`MIN_GAIN` of the part volume less)."""
     dirs = [ax.direction for ax in asm.axes] + [a for uj in asm.ujoints for a in uj.axes]
-    res = search_up(V, F, part_volume, structural_ups(asm.scene), OVERHANG_DEG, first_layer, exact=exact,
-                    seeds=hinge_ups(dirs), own=own, island_mm=island_side(asm.profile))
+    res = _search_pose(asm, {}, structural_ups(asm.scene), dirs)
+    asm.print_pose = {}
+    if asm.profile.orient == "auto_config":
+        from mlc.mesh import configs
+        why = configs.applicable(asm)
+        cfg = None if why else configs.best_configuration(asm)
+        if why or cfg is None:
+            asm.notes.append(f"configuration: the rest configuration is printed ({why or 'no other is reached'})")
+        else:
+            ups, cdirs = configs.posed_directions(asm, cfg["kin"], cfg["T"])
+            rc = _search_pose(asm, cfg["part_T"], ups, cdirs)
+            ang = ", ".join(f"{k.split(':')[0]} {v:+g}" for k, v in cfg["angles_deg"].items())
+            sc, sr = rc["stats"], res["stats"]
+            fig = (f"support {100 * sc.support_fraction:.1f} % of the part volume ({sc.support_inside_mm3:.1f} mm^3 "
+                   f"between parts), bed contact {100 * sc.contact_fraction:.1f} %, against {100 * sr.support_fraction:.1f} % "
+                   f"({sr.support_inside_mm3:.1f} mm^3), {100 * sr.contact_fraction:.1f} % at rest")
+            if _better(rc["key"], res["key"]):
+                asm.print_pose = cfg["part_T"]
+                asm.print_config = cfg["angles_deg"]
+                res = rc
+                asm.notes.append(
+                    f"configuration: printed with the input levers' hinges turned from rest ({ang} degrees; "
+                    f"{cfg['reached']} configurations reached on a {configs.SCAN_STEP_DEG:g}-degree grid with every "
+                    f"part at least the clearance apart, {cfg['evaluated']} measured): {fig}; turn them back to rest "
+                    f"after printing")
+            else:
+                asm.notes.append(f"configuration: the rest configuration is printed; the best other ({ang} degrees) "
+                                 f"is not {MIN_GAIN:g} of the part volume better: {fig}")
     u, st = res["up"], res["stats"]
     asm.pose_search = res
     ue, se = res["estimate_up"], res["estimate_stats"]

@@ -17,7 +17,9 @@ pin_diameter      hinge pin diameter (>= min_feature)
 circular_segments polygon segments of every cylinder (never manifold3d's default)
 pin               "pin" (a straight pin through the knuckles) or "cone" (45 degree cone pins)
 orient            "auto" (the up direction, of the world axes and slab normals, with the least
-                  support and most bed contact), "axes_flat" (hinge axes flat on the bed) or "as_is"
+                  support and most bed contact), "auto_config" (the same, and the configuration of
+                  the mechanism its joints reach with the best bed: mlc.mesh.configs), "axes_flat"
+                  (hinge axes flat on the bed) or "as_is"
 
 A profile is a built-in name or a YAML/JSON file validated against
 ``mlc/schemas/profile.schema.json``; command-line overrides replace single values.
@@ -75,7 +77,7 @@ class Profile:
 #: smallest printed size accepted (mm)
 MIN_SIZE_MM = 0.01
 PIN_KINDS = ("pin", "cone")
-ORIENTS = ("as_is", "axes_flat", "auto")
+ORIENTS = ("as_is", "axes_flat", "auto", "auto_config")
 
 #: the paper printed 0.1 mm slabs at sigma = 5 mm (0.02 sigma); the simulations use 0.01 sigma.
 PAPER_SLAB_MM = 0.1
