@@ -292,7 +292,8 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
     for n, pitches, r in near:
         lo, hi = _bounds(n, bmax, free_start and start_bend_max, end_bends)
         x = _polish(np.array(r.bends), lo, hi, c0, u0, t0, pitches, P, e1, e2)
-        cs, us, ts = _fk(c0, u0, t0, x, pitches)
+        cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
+        _fk_kernel(c0, u0, t0, x, pitches, cs, us, ts, True)
         err = float(max(np.linalg.norm(cs[-1] - P), abs(us[-1] @ e1), abs(us[-1] @ e2)))
         aerr = 0.0 if app is None else float(np.linalg.norm(ts[-1] - app))
         if DEBUG:
@@ -319,19 +320,21 @@ def _bounds(n: int, bmax: float, free_start, end_bends) -> tuple[np.ndarray, np.
 
 def _polish(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, margin: float = 1e-9) -> np.ndarray:
     """Close a nearly closed chain exactly.  The passes of :func:`_solve_n` can stall a
-    little short of ``EXACT`` (5e-7 sigma, say) with bends on their bounds: the trust
-    region's steps shrink to nothing there.  Gauss-Newton on the five closure equations
-    alone (the last pair's position, its axis across the target's), over the bends not on
+    little short of ``EXACT`` (5e-7 sigma, say) on long chains: :func:`_fk_kernel`'s
+    rounding error grows along the chain, and the trust region stops where it dominates.
+    This closes the chain as assembled (``exact`` kinematics): Gauss-Newton on the five
+    closure equations alone (the last pair's position, its axis across the target's), over the bends not on
     a bound: each step the smallest that solves the linearised equations (least squares),
-    halved until it stays within the bounds and lowers the closure error.  Returns the
-    bends (rad), unchanged if no step helps."""
+    the bends it would push through a bound held there and the step solved again, then
+    halved until it lowers the closure error.  Returns the bends (rad), unchanged if no
+    step helps."""
     n = x.shape[0]
     cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
     J = np.empty((5 + (n - 1), n))
     no_wp = np.zeros(0, dtype=np.int64)
 
     def error(b) -> float:
-        _fk_kernel(c0, u0, t0, b, pitches, cs, us, ts)
+        _fk_kernel(c0, u0, t0, b, pitches, cs, us, ts, True)
         return float(max(np.linalg.norm(cs[-1] - P), abs(us[-1] @ e1), abs(us[-1] @ e2)))
 
     x = np.clip(np.ascontiguousarray(x, dtype=np.float64), lo, hi)
@@ -343,10 +346,18 @@ def _polish(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, margin: float = 1e-9) -> 
         _jac_kernel(cs, us, ts, e1, e2, False, no_wp, 0.0, 0.0, J)
         r = 10.0 * np.array([*(cs[-1] - P), us[-1] @ e1, us[-1] @ e2])
         free = (x > lo + margin) & (x < hi - margin)
+        step = np.zeros(n)
+        for _ in range(8):          # bends the step would push through a bound are held there
+            if not free.any():
+                break
+            step[:] = 0.0
+            step[free] = np.linalg.lstsq(J[:5, free], -r, rcond=None)[0]
+            out = free & ((x + step < lo) | (x + step > hi))
+            if not out.any():
+                break
+            free &= ~out
         if not free.any():
             break
-        step = np.zeros(n)
-        step[free] = np.linalg.lstsq(J[:5, free], -r, rcond=None)[0]
         t = 1.0
         while t > 1e-3:
             x_new = np.clip(x + t * step, lo, hi)
@@ -383,8 +394,16 @@ def _rot(v, k, th):
 
 
 @njit(cache=True)
-def _fk_kernel(c0, u0, t0, b, pitch, cs, us, ts):
-    """Chain frames (see chain_frames) into cs (n+1,3), us (n+1,3), ts (n,3): arrays only."""
+def _fk_kernel(c0, u0, t0, b, pitch, cs, us, ts, exact=False):
+    """Chain frames (see chain_frames) into cs (n+1,3), us (n+1,3), ts (n,3): arrays only.
+
+    ``u <- t x u`` is unstable in floating point: an axis whose norm is off by e turns the
+    next tangent into one off by about e sin(bend), so the error grows about 1.25 times a
+    half unit (2e-6 sigma at the end of 150 half units, where ``chain_frames``, which builds
+    the bodies with exact rotations, is right to 1e-12).  With ``exact`` each new axis and
+    tangent is renormalised.  The inverse kinematics of ``_solve_n`` runs without it
+    (renormalising there changes the last bits of every route, so every scene);
+    ``_polish`` closes the chain with it, as assembled."""
     n = b.shape[0]
     for j in range(3):
         cs[0, j] = c0[j]
@@ -412,6 +431,12 @@ def _fk_kernel(c0, u0, t0, b, pitch, cs, us, ts):
         us[i + 1, 0] = t[1] * us[i, 2] - t[2] * us[i, 1]
         us[i + 1, 1] = t[2] * us[i, 0] - t[0] * us[i, 2]
         us[i + 1, 2] = t[0] * us[i, 1] - t[1] * us[i, 0]
+        if exact:
+            nu = math.sqrt(us[i + 1, 0] ** 2 + us[i + 1, 1] ** 2 + us[i + 1, 2] ** 2)
+            nt = math.sqrt(t[0] ** 2 + t[1] ** 2 + t[2] ** 2)
+            for j in range(3):
+                us[i + 1, j] /= nu
+                t[j] /= nt
 
 
 def _fk(c0, u0, t0, b, pitch):
