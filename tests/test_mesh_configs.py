@@ -148,7 +148,6 @@ def nor_fdm():
 def test_the_writers_and_the_bed_check_print_the_configuration(nor_fdm):
     """With a print pose set, the STL/3MF meshes, the print size and the bed checks are the
     parts moved into that configuration, then oriented; without one, the rest configuration."""
-    import manifold3d as mf
     from mlc.mesh.build import _orientation, transform_solid
     from mlc.mesh.checks import bed_checks, print_size
     from mlc.mesh.export import part_meshes
@@ -178,7 +177,6 @@ def test_the_writers_and_the_bed_check_print_the_configuration(nor_fdm):
     finally:
         asm.print_pose = {}
         asm.orient = _orientation(asm)
-    del mf
 
 
 def test_best_configuration_beats_rest_by_its_own_measure(nor_fdm, monkeypatch):
@@ -201,9 +199,10 @@ def test_best_configuration_beats_rest_by_its_own_measure(nor_fdm, monkeypatch):
 
 
 def test_auto_config_prints_another_configuration_only_when_it_is_better(nor_fdm, monkeypatch):
+    from dataclasses import replace
+
     from mlc.mesh import configs, pose
     from mlc.mesh.build import _orientation
-    from dataclasses import replace
     asm, kin, clear = nor_fdm
     for k, v in (("SCAN_STEP_DEG", 30.0), ("SCAN_LIMIT_DEG", 60.0), ("EVAL_EVERY", 1), ("REFINE", 0)):
         monkeypatch.setattr(configs, k, v)
