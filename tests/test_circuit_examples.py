@@ -1,8 +1,8 @@
 """Every example compiles into a circuit scene that `mlc verify` passes statically on all
 rows (issue 9, item 6): through the CLI, as a user runs it.
 
-``bcd7seg.pla`` (14 gates, 10848 bodies) takes about 26 minutes on two shared cores
-(build 6 min, 16 rows 20 min), too long for CI: it runs with ``MLC_SLOW_TESTS=1``, and
+``bcd7seg.pla`` (14 gates, 11128 bodies) takes about 29 minutes on two shared cores
+(session 25), too long for CI: it runs with ``MLC_SLOW_TESTS=1``, and
 ``benchmarks/circuit_examples.py`` verifies it on every row (results committed in
 ``benchmarks/results/circuit_examples.json``).  Each other example is verified here on at most
 :data:`CI_ROWS` rows (all zeros, all ones, and rows drawn with a fixed seed), every row with
