@@ -323,11 +323,11 @@ def _polish(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, margin: float = 1e-9) -> 
     little short of ``EXACT`` (5e-7 sigma, say) on long chains: :func:`_fk_kernel`'s
     rounding error grows along the chain, and the trust region stops where it dominates.
     This closes the chain as assembled (``exact`` kinematics): Gauss-Newton on the five
-    closure equations alone (the last pair's position, its axis across the target's), over the bends not on
-    a bound: each step the smallest that solves the linearised equations (least squares),
-    the bends it would push through a bound held there and the step solved again, then
-    halved until it lowers the closure error.  Returns the bends (rad), unchanged if no
-    step helps."""
+    closure equations alone (the last pair's position, its axis across the target's),
+    over the bends not on a bound.  Each step is the smallest that solves the linearised
+    equations (least squares); the bends it would push through a bound are held there and
+    the step solved again; it is halved until it lowers the closure error.  Returns the
+    bends (rad), unchanged if no step helps."""
     n = x.shape[0]
     cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
     J = np.empty((5 + (n - 1), n))
