@@ -50,14 +50,20 @@ def test_a_parallelogram_turns_both_cranks_alike():
     assert np.allclose(R_coupler, np.eye(3), atol=1e-7)
 
 
-@pytest.fixture(scope="module")
-def nand_fdm():
+def _fdm_gate(name: str):
+    """(assembly, kinematics, clearance) of library gate ``name`` (expanding) in the fdm
+    profile, at rest and unrotated."""
     from mlc.gates.library import gate_scene
     from mlc.mesh.build import build_assembly
     from mlc.mesh.profiles import load_profile
-    asm = build_assembly(gate_scene("NAND", "expand"), load_profile("fdm", {"orient": "as_is"}))
+    asm = build_assembly(gate_scene(name, "expand"), load_profile("fdm", {"orient": "as_is"}))
     kin = Kinematics(asm)
     return asm, kin, Clearance(asm, kin)
+
+
+@pytest.fixture(scope="module")
+def nand_fdm():
+    return _fdm_gate("NAND")
 
 
 def test_a_gate_has_its_two_input_levers_as_freedoms(nand_fdm):
@@ -137,12 +143,7 @@ def _nor_at(asm, kin, a, b, step=10.0):
 
 @pytest.fixture(scope="module")
 def nor_fdm():
-    from mlc.gates.library import gate_scene
-    from mlc.mesh.build import build_assembly
-    from mlc.mesh.profiles import load_profile
-    asm = build_assembly(gate_scene("NOR", "expand"), load_profile("fdm", {"orient": "as_is"}))
-    kin = Kinematics(asm)
-    return asm, kin, Clearance(asm, kin)
+    return _fdm_gate("NOR")
 
 
 def test_the_writers_and_the_bed_check_print_the_configuration(nor_fdm):

@@ -342,7 +342,7 @@ def _polish(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, margin: float = 1e-9) -> 
     for _ in range(POLISH_STEPS):
         if err < EXACT:
             break
-        error(x)                                 # frames of x
+        # cs, us, ts hold the frames of x: error() was last called on it
         _jac_kernel(cs, us, ts, e1, e2, False, no_wp, 0.0, 0.0, J)
         r = 10.0 * np.array([*(cs[-1] - P), us[-1] @ e1, us[-1] @ e2])
         free = (x > lo + margin) & (x < hi - margin)
