@@ -116,6 +116,32 @@ def test_a_wrong_truth_table_is_caught_on_its_row_and_output():
     assert rows[-1]["margin"] < -0.2
 
 
+@pytest.mark.parametrize("as_circuit", [False, True])
+def test_a_cache_reuses_each_rows_preparation_and_changes_nothing(monkeypatch, as_circuit):
+    """A campaign's cache: the second call on a row does not solve its equilibrium or its
+    signal times again and gives exactly the numbers of a call without the cache; another
+    kT is prepared afresh.  ``as_circuit`` treats the gate as a circuit (DENSE_MAX lowered),
+    whose preparation is the signal times rather than the spectrum."""
+    import mlc.verify.dynamic as dyn
+    import mlc.verify.static as st
+    if as_circuit:
+        monkeypatch.setattr(dyn, "DENSE_MAX", 6)
+    sc = gate_scene("NAND", "expand")
+    plain = check_scene_dynamic_multi(sc, 1e-5, [1], rows=["01"], progress=False)
+    cache = {}
+    first = check_scene_dynamic_multi(sc, 1e-5, [1], rows=["01"], progress=False, cache=cache)
+    calls = []
+    real_eq, real_sig = st.equilibrium, dyn.signal_time
+    monkeypatch.setattr(st, "equilibrium", lambda *a, **k: calls.append("eq") or real_eq(*a, **k))
+    monkeypatch.setattr(dyn, "signal_time", lambda *a, **k: calls.append("sig") or real_sig(*a, **k))
+    again = check_scene_dynamic_multi(sc, 1e-5, [1], rows=["01"], progress=False, cache=cache)
+    assert calls == []
+    assert plain == first == again
+    assert plain[0]["ok"] and (plain[0]["tau"] > 0)
+    check_scene_dynamic_multi(sc, 2e-5, [1], rows=["01"], progress=False, cache=cache, max_time=1.0)
+    assert "eq" in calls
+
+
 def test_a_plateau_alone_is_fooled_by_a_long_chain():
     """Why the time-scale condition exists: without it the far end of a 10-unit chain, still
     at its old length when the first windows agree, is declared relaxed and read wrong;

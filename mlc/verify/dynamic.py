@@ -307,7 +307,7 @@ def relax_all(sim: Simulation, probes: list[str], kT: float, t_min: float = 0.0,
 def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "stiff", rows=None,
                               progress=None, dt: float | None = None, tau_factor: float = TAU_FACTOR,
                               max_time: float | None = None, window: float | None = None,
-                              tau: float | None = None) -> list[dict]:
+                              tau: float | None = None, cache: dict | None = None) -> list[dict]:
     """Brownian-dynamics check of ``scene`` against its truth table (any number of inputs,
     outputs and probes).  For each input row (``rows``: bit strings in ``scene.inputs``
     order, default all) and seed (``seeds``: a count, meaning seeds 0..n-1, or a list),
@@ -333,7 +333,12 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
     connector chains it is pi^2/8 times the slowest relaxation time, the ratio for a
     diffusing line driven at one end).
     ``max_time`` (t0): give up on a run after this long (default the larger of 20 t0 and
-    12 tau of the row).  ``window`` (t0): averaging window (default the larger of 0.05 t0 and tau/20)."""
+    12 tau of the row).  ``window`` (t0): averaging window (default the larger of 0.05 t0 and tau/20).
+    ``cache``: a dict kept by a caller that checks the same scene row by row or seed by seed
+    in several calls (a campaign): each row's static preparation (its equilibrium, the
+    probes' thermal spread and its signal times, all deterministic) is stored there and
+    reused, so a later call on the same row and kT gives the same numbers without redoing it
+    (a fifth of a 4-to-1 multiplexer's run).  Only for one scene: the keys do not name it."""
     from mlc.io.progress import Progress
     from mlc.verify.static import equilibrium
 
@@ -351,7 +356,11 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
         tau = float(tau)
     elif large:   # the rest row has no switch of its own: its floor is the slowest of all rows
         rows_t = select_rows(scene) if "0" * len(scene.inputs) in states else states
-        t_start = {s: signal_time(scene, "0" * len(scene.inputs), s, gamma_r=opt0.gamma_r) for s in rows_t}
+        memo = cache.setdefault("t_start", {}) if cache is not None else {}
+        for s in rows_t:
+            if s not in memo:
+                memo[s] = signal_time(scene, "0" * len(scene.inputs), s, gamma_r=opt0.gamma_r)
+        t_start = {s: memo[s] for s in rows_t}
         tau = max(list(t_start.values()) + [0.0])
     else:
         tau = relaxation_time(scene, gamma_r=opt0.gamma_r)
@@ -372,19 +381,25 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
             drives = {inp: Drive.constant(int(bit)) for inp, bit in zip(scene.inputs, state)}
             # the row's static equilibrium: the probes' thermal spread and the relaxation time
             # there (the slowest of start and end pose sets the time floor)
-            try:
-                eq = equilibrium(scene, state)
-                sd = probe_thermal_sd(scene, kT, eq.pos, eq.quat)
-                if tau_given:
-                    tau_row = tau
-                elif large and state == rest:     # no switch: the probes' correlation time
-                    tau_row = tau
-                elif large:
-                    tau_row = max(t_start[state], signal_time(scene, rest, state, eq.pos, eq.quat, opt0.gamma_r))
-                else:
-                    tau_row = max(tau, relaxation_time(scene, eq.pos, eq.quat, opt0.gamma_r))
-            except (MlcError, ValueError, RuntimeError, np.linalg.LinAlgError):
-                sd, tau_row = probe_thermal_sd(scene, kT), tau
+            key = ("row", state, kT, tau if tau_given or (large and state == rest) else None)
+            if cache is not None and key in cache:
+                sd, tau_row = cache[key]
+            else:
+                try:
+                    eq = equilibrium(scene, state)
+                    sd = probe_thermal_sd(scene, kT, eq.pos, eq.quat)
+                    if tau_given:
+                        tau_row = tau
+                    elif large and state == rest:     # no switch: the probes' correlation time
+                        tau_row = tau
+                    elif large:
+                        tau_row = max(t_start[state], signal_time(scene, rest, state, eq.pos, eq.quat, opt0.gamma_r))
+                    else:
+                        tau_row = max(tau, relaxation_time(scene, eq.pos, eq.quat, opt0.gamma_r))
+                except (MlcError, ValueError, RuntimeError, np.linalg.LinAlgError):
+                    sd, tau_row = probe_thermal_sd(scene, kT), tau
+                if cache is not None:
+                    cache[key] = (sd, tau_row)
             t_min = tau_factor * tau_row if state != rest else 0.0
             per = []
             # within a run the bar moves with the time run over the time it usually takes:
