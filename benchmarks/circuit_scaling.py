@@ -9,12 +9,17 @@
   every probe read right.  Goals (issue 9): build of 200 gates under 2 s, static
   verification of one row of a 200-gate circuit under 10 s, build cost no worse than
   linear in bodies.
+* NAND meshes of width 7 and growing depth (``--meshes``; ``mlc.logic.library.nand_mesh``,
+  compiled at -O0 so that it keeps 7 gates a level; depth 29 is 203 gates on 14 inputs):
+  every wire runs one level up and one column across, so unlike the adders and multipliers
+  the family reaches 200 gates within the router's reach and the scene's 14 inputs.
 * The full adder verified by Brownian dynamics on one row with each scheme: the cost of a
   t0 measured over a short run, times the row's floor (``dynamic_per_scheme``; Euler's row
   is ~2.5e8 steps, so it is never run whole).
 
     python benchmarks/circuit_scaling.py [--widths 1 2 3] [--skip-dynamic]   (adders; keeps the multipliers)
     python benchmarks/circuit_scaling.py --multipliers 2 3 4 5 6     (merged into the JSON point by point)
+    python benchmarks/circuit_scaling.py --meshes 1 2 4 8 16 29      (the same)
     python benchmarks/circuit_scaling.py --dynamic-only     (the per-scheme part alone)
     python benchmarks/circuit_scaling.py --refit            (fit and goals from the JSON)
 
@@ -41,22 +46,27 @@ import numpy as np
 from mlc.circuit.build import build_circuit
 from mlc.errors import MlcError
 from mlc.io.atomic import atomic_path
-from mlc.logic.library import array_multiplier, ripple_adder
+from mlc.logic.library import array_multiplier, nand_mesh, ripple_adder
 from mlc.pipeline import compile_spec
 from mlc.verify.circuit import verify_static
 
 OUT = Path(__file__).resolve().parent / "results"
+MESH_WIDTH = 7        # nand_mesh's width: 14 inputs, 7 gates a level (depth 29: 203 gates)
 
 
 def adder_point(w: int, family: str = "adder") -> dict:
     """One circuit of the series: the ``w``-bit ripple-carry adder, or (``family`` "multiplier")
-    the ``w`` x ``w`` array multiplier (2w inputs: 6 bits are 222 gates on 12 inputs).  The
+    the ``w`` x ``w`` array multiplier (2w inputs: 6 bits are 222 gates on 12 inputs), or
+    (``family`` "mesh") ``nand_mesh(MESH_WIDTH, w)``, compiled at -O0 (depth 29: 203 gates).  The
     refusal of netlists whose build estimate passes an hour (``MAX_GATES``) is lifted here:
     measuring beyond it is the point.  A multiplier the build refuses (from 4 x 4 on, a wire
     longer than any chain) is returned as a record of the refusal: inputs, gates, ``refused``."""
     from mlc.circuit import build as cb
-    spec = ripple_adder(w) if family == "adder" else array_multiplier(w)
-    c = compile_spec(spec, 2, "expand")
+    if family == "mesh":            # structure kept: -O2 would merge what repeats
+        spec, level = nand_mesh(MESH_WIDTH, w), 0
+    else:
+        spec, level = (ripple_adder(w) if family == "adder" else array_multiplier(w)), 2
+    c = compile_spec(spec, level, "expand")
     cb.MAX_GATES = max(cb.MAX_GATES, len(c.netlist.gates))
     from mlc.circuit import route
     hits0 = list(route.CACHE_HITS)
@@ -165,13 +175,16 @@ def refit(res: dict) -> dict:
     """Fit (per family), goals and extrapolation of ``res`` from its built points.  The goals are
     read off the smallest circuit of 200 gates or more when one was built, else carried to 200
     gates from the adders' power laws (``extrapolated_200_gates``)."""
-    fams = {"adder": res.get("adders", []), "multiplier": [p for p in res.get("multipliers", []) if "bodies" in p]}
+    fams = {"adder": res.get("adders", []), "multiplier": [p for p in res.get("multipliers", []) if "bodies" in p],
+            "mesh": res.get("meshes", [])}
     res["fit"], res["goals"], res["extrapolated_200_gates"] = fit_and_goals(fams["adder"])
     res["fit_multipliers"] = fit_and_goals(fams["multiplier"])[0] if len(fams["multiplier"]) >= 3 else {}
-    big = [p for p in fams["adder"] + fams["multiplier"] if p["gates"] >= 200]
+    res["fit_meshes"] = fit_and_goals(fams["mesh"])[0] if len(fams["mesh"]) >= 3 else {}
+    big = [p for p in fams["adder"] + fams["multiplier"] + fams["mesh"] if p["gates"] >= 200]
     if big:
         p = min(big, key=lambda p: p["gates"])
-        res["goals"] = {"circuit": f"{p.get('family', 'adder')} {p['width']} bits, {p['gates']} gates, "
+        size = f"depth {p['width']}" if p.get("family") == "mesh" else f"{p['width']} bits"
+        res["goals"] = {"circuit": f"{p.get('family', 'adder')} {size}, {p['gates']} gates, "
                                    f"{p['bodies']} bodies",
                         "build_200_gates_under_2s": p["build_s"] < 2.0, "build_s": p["build_s"],
                         "build_over_goal": p["build_s"] / 2.0,
@@ -188,7 +201,8 @@ def plot(res: dict) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))
-    for fam, key, col in (("ripple-carry adders", "adders", "C0"), ("array multipliers", "multipliers", "C2")):
+    for fam, key, col in (("ripple-carry adders", "adders", "C0"), ("array multipliers", "multipliers", "C2"),
+                          (f"NAND meshes, width {MESH_WIDTH}", "meshes", "C3")):
         pts = [p for p in res.get(key, []) if "bodies" in p]
         if not pts:
             continue
@@ -224,6 +238,9 @@ def main():
     ap.add_argument("--multipliers", type=int, nargs="*",
                     help="measure these w x w array multipliers and merge them into the committed JSON "
                          "(the adders and the dynamic part are kept)")
+    ap.add_argument("--meshes", type=int, nargs="*",
+                    help=f"measure nand_mesh({MESH_WIDTH}, depth) for these depths (depth 29: 203 gates, short wires) "
+                         "and merge them into the committed JSON (the adders and the dynamic part are kept)")
     ap.add_argument("--skip-dynamic", action="store_true")
     ap.add_argument("--budget", type=float, default=1800.0, help="stop growing after this many seconds")
     ap.add_argument("--dynamic-only", action="store_true",
@@ -251,15 +268,18 @@ def main():
             old["dynamic_full_adder"] = dynamic_per_scheme()
         save(old)
         return
-    if args.multipliers:
-        pts = {p["width"]: p for p in old.get("multipliers", [])}
-        for w in args.multipliers:
-            p = adder_point(w, "multiplier")               # a refusal is recorded with its reason
+    for fam, key, sizes in (("multiplier", "multipliers", args.multipliers), ("mesh", "meshes", args.meshes)):
+        if not sizes:
+            continue
+        pts = {p["width"]: p for p in old.get(key, [])}
+        for w in sizes:
+            p = adder_point(w, fam)                      # a refusal is recorded with its reason
             pts[w] = p
             print(json.dumps({k: (round(v, 3) if isinstance(v, float) else v) for k, v in p.items()
                               if k != "build_parts_s"}), flush=True)
-            old["multipliers"] = [pts[k] for k in sorted(pts)]
+            old[key] = [pts[k] for k in sorted(pts)]
             save(old)                                    # after every point: a long series keeps what it measured
+    if args.multipliers or args.meshes:
         return
     widths = args.widths or [w for w in range(1, 8) if w <= args.max_width]
     points = []
@@ -279,7 +299,8 @@ def main():
     dyn = old.get("dynamic_full_adder", []) if args.skip_dynamic else dynamic_per_scheme()
     res = {"machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
                        "load": os.getloadavg()[0] if hasattr(os, "getloadavg") else None},
-           "adders": points, "multipliers": old.get("multipliers", []), "dynamic_full_adder": dyn}
+           "adders": points, "multipliers": old.get("multipliers", []), "meshes": old.get("meshes", []),
+           "dynamic_full_adder": dyn}
     save(res)
 
 

@@ -122,6 +122,30 @@ def array_multiplier(w: int, swap: bool = False) -> NetworkSpec:
                        source=f"array_multiplier({w})")
 
 
+def nand_mesh(width: int, depth: int) -> NetworkSpec:
+    """A mesh of ``depth`` levels of ``width`` gates, each fed by two neighbours of the level
+    below: level 1 is ``NAND(x2i, x2i+1)``; above it gate i is ``NAND(g_i, g_i+1)`` of the
+    level below, the last ``NOR(g_w-1, g_w-2)`` (a NAND there would repeat its neighbour).
+    Inputs ``x0 .. x(2 width - 1)``, outputs ``y0 ..`` the top level.  Every wire runs one
+    level up and at most one column across, so a circuit of many gates keeps short wires;
+    at width 7 (14 inputs) it keeps ``width * depth`` gates when compiled at -O0 (narrower
+    meshes repeat their functions after a few levels and synthesis merges them)."""
+    if width < 2 or depth < 1:
+        raise ValueError("nand_mesh needs width >= 2 and depth >= 1")
+    ins = [f"x{i}" for i in range(2 * width)]
+    nodes = [Node("input", name=x) for x in ins]
+
+    def add(op: str, *args: int) -> int:
+        nodes.append(Node(op, args))
+        return len(nodes) - 1
+
+    level = [add("nand", 2 * i, 2 * i + 1) for i in range(width)]
+    for _ in range(depth - 1):
+        level = [add("nand", level[i], level[i + 1]) if i + 1 < width else add("nor", level[i], level[i - 1])
+                 for i in range(width)]
+    return NetworkSpec(ins, [f"y{i}" for i in range(width)], nodes, level, source=f"nand_mesh({width},{depth})")
+
+
 SEG = {0: "abcdef", 1: "bc", 2: "abdeg", 3: "abcdg", 4: "bcfg", 5: "acdfg", 6: "acdefg",
        7: "abc", 8: "abcdefg", 9: "abcdfg"}
 
