@@ -204,12 +204,13 @@ def _factorised(prob):
     problem's poses, regularised by ``eps`` = 1e-10 of its largest diagonal entry so that
     the zero modes (rigid motion, floppy bends) do not make it singular."""
     import scipy.sparse as sp
-    from scipy.sparse.linalg import splu
+
+    from mlc.verify.static import spd_lu
 
     J = prob.jacobian().tocsr()
     H = (J.T @ J).tocsc()
     eps = 1e-10 * max(float(H.diagonal().max()), 1e-300)
-    return J, splu((H + sp.identity(prob.n, format="csc") * eps).tocsc()), eps
+    return J, spd_lu(H + sp.identity(prob.n, format="csc") * eps), eps
 
 
 def _diag(v):
@@ -223,12 +224,14 @@ def _smallest_nonzero_sparse(H) -> float:
     of zero modes (shift-invert Lanczos, asking for more eigenvalues until a non-zero
     one shows up)."""
     import scipy.sparse as sp
-    from scipy.sparse.linalg import LinearOperator, eigsh, splu
+    from scipy.sparse.linalg import LinearOperator, eigsh
+
+    from mlc.verify.static import spd_lu
 
     n = H.shape[0]
     lam_max = float(eigsh(H, k=1, which="LA", return_eigenvectors=False, tol=1e-3)[0])
     shift = 1e-7 * lam_max
-    lu = splu((H + sp.identity(n, format="csc") * shift).tocsc())
+    lu = spd_lu(H + sp.identity(n, format="csc") * shift)
     op = LinearOperator((n, n), matvec=lu.solve, dtype=float)
     k = 16
     while True:
