@@ -220,7 +220,18 @@ def spd_lu(M):
     return splu(M.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
 
 
-def _minimise(prob: _Problem, L, reg: float = None) -> int:
+def colamd_lu(M):
+    """The factorisation before :func:`spd_lu` (COLAMD order, partial pivoting).  The circuit
+    builder still poses its gates with it (:func:`mlc.circuit.build._posed_gate`): their
+    poses feed every routed scene, and another factorisation moves them by ~1e-12 sigma,
+    enough to change a scene's bits and so its key in the dynamic campaigns
+    (benchmarks/circuit_dynamic.py)."""
+    from scipy.sparse.linalg import splu
+
+    return splu(M.tocsc(), permc_spec="COLAMD")
+
+
+def _minimise(prob: _Problem, L, reg: float = None, lu_of=None) -> int:
     """Levenberg-Marquardt with geodesic acceleration on 0.5 |r|^2 from the current poses;
     returns the iteration count.
 
@@ -230,8 +241,9 @@ def _minimise(prob: _Problem, L, reg: float = None) -> int:
     factorisation): moving a floppy chain along its linearised zero mode stretches its
     joints quadratically, and without the correction the step is cut back to a crawl
     (module doc).  The corrected step dx + a/2 is tried when |a| <= ACCEL_RATIO |dx|,
-    otherwise dx alone."""
+    otherwise dx alone.  ``lu_of``: the factorisation (default :func:`spd_lu`)."""
     reg = REG if reg is None else reg
+    lu_of = spd_lu if lu_of is None else lu_of
 
     def total(rr):
         return 0.5 * float(rr @ rr) + 0.5 * reg * float(np.sum(prob.disp ** 2))
@@ -253,7 +265,7 @@ def _minimise(prob: _Problem, L, reg: float = None) -> int:
         for _ in range(12):
             M = (H + sp.diags(lam * scale + 1e-14, format="csc")).tocsc()
             try:
-                lu = spd_lu(M)
+                lu = lu_of(M)
             except RuntimeError:
                 lam *= 10.0
                 continue
@@ -289,10 +301,11 @@ def _state_bits(scene: Scene, state: str) -> np.ndarray:
 
 
 def equilibrium(scene: Scene, state: str, start_state: str | None = None,
-                steps: int = CONTINUATION_STEPS, pos=None, quat=None) -> Equilibrium:
+                steps: int = CONTINUATION_STEPS, pos=None, quat=None, lu_of=None) -> Equilibrium:
     """Equilibrium of ``scene`` with its inputs in ``state``, reached by continuation from
     the scene's own poses (or ``pos``/``quat``), taken to be the equilibrium of
-    ``start_state`` (default all 0)."""
+    ``start_state`` (default all 0).  ``lu_of``: the factorisation of the normal equations
+    (default :func:`spd_lu`; the circuit builder passes :func:`colamd_lu`)."""
     A = scene.arrays()
     target = _state_bits(scene, state)
     start = _state_bits(scene, start_state or "0" * len(scene.inputs))
@@ -306,11 +319,11 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
         if stiff:                                       # stiffness homotopy (module docstring)
             prob.bond_k = np.minimum(prob.bond_k, k_cap)
         for t in path:
-            nit += _minimise(prob, L0 + t * (L1 - L0))
+            nit += _minimise(prob, L0 + t * (L1 - L0), lu_of=lu_of)
         if stiff:
             prob.bond_k = np.array(A.bond_k, float)
-            nit += _minimise(prob, L1)
-        nit += _minimise(prob, L1, reg=REG_POLISH)     # polish: the least-motion bias removed
+            nit += _minimise(prob, L1, lu_of=lu_of)
+        nit += _minimise(prob, L1, reg=REG_POLISH, lu_of=lu_of)     # polish: the least-motion bias removed
     pos, R = prob.pos, prob.R
     p, _ = prob.sites()
     quat = np.array([matrix_to_quat(r) for r in R]) if len(R) else np.zeros((0, 4))
