@@ -128,12 +128,12 @@ class Circuit:
 def _posed_gate(gtype: str, signal: str, state: str):
     """(scene, pos, quat) of a library gate in input state ``state`` ("ab")."""
     from mlc.gates.library import gate_scene
-    from mlc.verify.static import colamd_lu, equilibrium
+    from mlc.verify.static import equilibrium
     sc = gate_scene(gtype, signal)
     if state == "00":
         A = sc.arrays()
         return sc, A.pos.copy(), A.quat.copy()
-    eq = equilibrium(sc, state, lu_of=colamd_lu)      # the factorisation the scenes were built with
+    eq = equilibrium(sc, state)
     return sc, eq.pos, eq.quat
 
 

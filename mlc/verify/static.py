@@ -7,8 +7,7 @@ rest or actuated lengths and the body poses minimise the total bond energy
 
 (units: sigma, k0).  The residual vector (zero-length bonds without tolerance contribute
 their 3-vector, the others a scalar) is minimised by a damped Gauss-Newton
-(Levenberg-Marquardt) iteration on the sparse normal equations, factorised by SuperLU
-in its symmetric mode (:func:`spd_lu`):
+(Levenberg-Marquardt) iteration on the sparse normal equations, factorised by SuperLU:
 each iteration linearises about the current poses, a body's update being a translation
 and a rotation vector ``w`` (R <- exp(w) R, d site/d w = -[R s]x), so no rotation
 parametrisation accumulates.  No body is pinned.  Zero-energy modes (the six rigid-body
@@ -208,24 +207,25 @@ class _Problem:
 
 
 def spd_lu(M):
-    """SuperLU factorisation of a symmetric positive definite sparse matrix ``M`` (the
-    damped normal equations here, the shifted Hessians of :mod:`mlc.verify.dynamic`) in
+    """SuperLU factorisation of a symmetric positive definite sparse matrix ``M`` in
     SuperLU's symmetric mode: a minimum-degree order of M + M^T and pivots on the diagonal,
-    which is stable for such a matrix as Cholesky is.  On the full adder's normal
-    equations (20376 unknowns) it keeps half of COLAMD's fill (9.5e5 against 2.0e6 entries
-    in L + U), and a static row takes half the CPU (benchmarks/static_lu.py).  A matrix
-    that is singular to working precision raises RuntimeError, as with any order."""
+    which is stable for such a matrix as Cholesky is.  On the examples' normal equations it
+    keeps 64 to 76 % of COLAMD's fill and factorises 1.1 to 1.5 times faster
+    (benchmarks/static_lu.py).  :mod:`mlc.verify.dynamic` takes it for its harmonic
+    analyses (one factorisation, many solves).  The minimiser does not: its path depends on
+    the last bits of each step, and on mux4's all-ones row it took 90 iterations with this
+    order against 47 with COLAMD.  A matrix singular to working precision raises
+    RuntimeError, as with any order."""
     from scipy.sparse.linalg import splu
 
     return splu(M.tocsc(), permc_spec="MMD_AT_PLUS_A", diag_pivot_thresh=0.0, options={"SymmetricMode": True})
 
 
 def colamd_lu(M):
-    """The factorisation before :func:`spd_lu` (COLAMD order, partial pivoting).  The circuit
-    builder still poses its gates with it (:func:`mlc.circuit.build._posed_gate`): their
-    poses feed every routed scene, and another factorisation moves them by ~1e-12 sigma,
-    enough to change a scene's bits and so its key in the dynamic campaigns
-    (benchmarks/circuit_dynamic.py)."""
+    """The minimiser's factorisation (COLAMD order, partial pivoting).  Every routed scene
+    depends on it through its gates' poses (:func:`mlc.circuit.build._posed_gate`): another
+    factorisation moves them by ~1e-12 sigma, enough to change a scene's bits and so its
+    key in the dynamic campaigns (benchmarks/circuit_dynamic.py)."""
     from scipy.sparse.linalg import splu
 
     return splu(M.tocsc(), permc_spec="COLAMD")
@@ -241,9 +241,9 @@ def _minimise(prob: _Problem, L, reg: float = None, lu_of=None) -> int:
     factorisation): moving a floppy chain along its linearised zero mode stretches its
     joints quadratically, and without the correction the step is cut back to a crawl
     (module doc).  The corrected step dx + a/2 is tried when |a| <= ACCEL_RATIO |dx|,
-    otherwise dx alone.  ``lu_of``: the factorisation (default :func:`spd_lu`)."""
+    otherwise dx alone.  ``lu_of``: the factorisation (default :func:`colamd_lu`)."""
     reg = REG if reg is None else reg
-    lu_of = spd_lu if lu_of is None else lu_of
+    lu_of = colamd_lu if lu_of is None else lu_of
 
     def total(rr):
         return 0.5 * float(rr @ rr) + 0.5 * reg * float(np.sum(prob.disp ** 2))
@@ -305,7 +305,7 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
     """Equilibrium of ``scene`` with its inputs in ``state``, reached by continuation from
     the scene's own poses (or ``pos``/``quat``), taken to be the equilibrium of
     ``start_state`` (default all 0).  ``lu_of``: the factorisation of the normal equations
-    (default :func:`spd_lu`; the circuit builder passes :func:`colamd_lu`)."""
+    (default :func:`colamd_lu`)."""
     A = scene.arrays()
     target = _state_bits(scene, state)
     start = _state_bits(scene, start_state or "0" * len(scene.inputs))
