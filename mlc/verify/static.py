@@ -210,8 +210,8 @@ def spd_lu(M):
     """SuperLU factorisation of a symmetric positive definite sparse matrix ``M`` in
     SuperLU's symmetric mode: a minimum-degree order of M + M^T and pivots on the diagonal,
     which is stable for such a matrix as Cholesky is.  On the examples' normal equations it
-    keeps 64 to 76 % of COLAMD's fill and factorises 1.1 to 1.5 times faster
-    (benchmarks/static_lu.py).  :mod:`mlc.verify.dynamic` takes it for its harmonic
+    keeps 64 to 76 % of COLAMD's fill and factorises 1.2 to 1.3 times faster
+    (benchmarks/results/static_lu.json).  :mod:`mlc.verify.dynamic` takes it for its harmonic
     analyses (one factorisation, many solves).  The minimiser does not: its path depends on
     the last bits of each step, and on mux4's all-ones row it took 90 iterations with this
     order against 47 with COLAMD.  A matrix singular to working precision raises
