@@ -27,7 +27,6 @@ from pathlib import Path
 
 import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
-import scipy.sparse as sp
 
 import mlc.verify.static as S
 from mlc.io.atomic import atomic_path
@@ -43,7 +42,7 @@ def fill(scene, row: str) -> dict:
     A = scene.arrays()
     prob = S._Problem(scene, A.pos, A.quat, pin_first=False)
     J = prob.jacobian(np.zeros(6 * len(prob.free)), A.muscle_lengths([int(b) for b in row])).tocsc()
-    M = (J.T @ J + sp.identity(J.shape[1], format="csc") * S.REG).tocsc()
+    M = prob.normal_matrix(J, S.REG)
     out = {"unknowns": int(M.shape[0]), "nnz": int(M.nnz)}
     for name, f in (("symmetric", S.spd_lu), ("colamd", S.colamd_lu)):
         c = time.process_time()

@@ -78,11 +78,11 @@ def test_stiff_joints_converge_by_stiffness_homotopy(monkeypatch):
 
 
 def test_spd_lu_solves_the_normal_equations_with_less_fill_than_colamd():
-    """The factorisation the minimiser takes (SuperLU's symmetric mode) solves the damped
-    normal equations of a small compiled circuit (condition ~1e10: its chains' floppy bends
-    are held only by REG) with a backward error |Mx - b| / (|M| |x|) near the rounding unit,
-    as small as COLAMD's (the order it replaced), and keeps less fill; a singular matrix
-    raises."""
+    """SuperLU's symmetric mode (``spd_lu``, which the dynamic check's harmonic analyses take)
+    solves the damped normal equations of a small compiled circuit (condition ~1e10: its
+    chains' floppy bends are held only by REG) with a backward error |Mx - b| / (|M| |x|) near
+    the rounding unit, as small as COLAMD's (the order the static minimiser keeps), and keeps
+    less fill; a singular matrix raises."""
     import scipy.sparse as sp
     from scipy.sparse.linalg import splu
 
@@ -93,7 +93,7 @@ def test_spd_lu_solves_the_normal_equations_with_less_fill_than_colamd():
     A = s.arrays()
     prob = _Problem(s, A.pos, A.quat, pin_first=False)
     J = prob.jacobian(np.zeros(6 * len(prob.free)), A.muscle_lengths([1, 1, 1])).tocsc()
-    M = (J.T @ J + sp.identity(J.shape[1], format="csc") * REG).tocsc()
+    M = prob.normal_matrix(J, REG)
     b = np.random.default_rng(3).standard_normal(M.shape[0])
     lu, colamd = spd_lu(M), splu(M, permc_spec="COLAMD")
     norm_m = sp.linalg.norm(M, 1)

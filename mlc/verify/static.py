@@ -130,6 +130,11 @@ class _Problem:
         out.append(np.sqrt(A.muscle_k) * (np.linalg.norm(dm, axis=1) - L_muscle))
         return np.concatenate(out)
 
+    def normal_matrix(self, J, reg: float):
+        """The damped normal matrix J^T J + reg I (CSC) that each Levenberg-Marquardt step
+        factorises, before its lam D damping (k0; ``reg`` the least-motion weight)."""
+        return (J.T @ J + sp.identity(J.shape[1], format="csc") * reg).tocsc()
+
     def jacobian(self, x=None, L_muscle=None):
         """Sparse d residual / d (t, w) of the free bodies at the current poses (``x``, if
         given, must be zero: the linearisation is always about the current poses; the
@@ -258,7 +263,7 @@ def _minimise(prob: _Problem, L, reg: float = None, lu_of=None) -> int:
             break
         J = prob.jacobian()
         g = J.T @ r + reg * prob.disp[prob.free].ravel()
-        H = (J.T @ J + sp.identity(prob.n, format="csr") * reg).tocsc()
+        H = prob.normal_matrix(J, reg)
         diag = H.diagonal()
         scale = np.maximum(diag, 1e-12 * max(float(diag.max(initial=0.0)), 1.0))
         improved = stalled = False
