@@ -37,6 +37,7 @@ import json
 import math
 import os
 import platform
+import signal
 import time
 from pathlib import Path
 
@@ -54,13 +55,18 @@ OUT = Path(__file__).resolve().parent / "results"
 MESH_WIDTH = 7        # nand_mesh's width: 14 inputs, 7 gates a level (depth 29: 203 gates)
 
 
-def adder_point(w: int, family: str = "adder") -> dict:
+def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: float | None = None) -> dict:
     """One circuit of the series: the ``w``-bit ripple-carry adder, or (``family`` "multiplier")
     the ``w`` x ``w`` array multiplier (2w inputs: 6 bits are 222 gates on 12 inputs), or
     (``family`` "mesh") ``nand_mesh(MESH_WIDTH, w)``, compiled at -O0 (depth 29: 203 gates).  The
     refusal of netlists whose build estimate passes an hour (``MAX_GATES``) is lifted here:
     measuring beyond it is the point.  A multiplier the build refuses (from 4 x 4 on, a wire
-    longer than any chain) is returned as a record of the refusal: inputs, gates, ``refused``."""
+    longer than any chain) is returned as a record of the refusal: inputs, gates, ``refused``.
+
+    ``on_built(point)`` is called with the point as built, before its static check (its
+    ``verify_row_s`` None), so that a long series keeps the build it measured.  A static check
+    that passes ``verify_budget`` seconds of wall time is stopped (SIGALRM, between two Python
+    steps of the minimiser) and recorded as ``verify_stopped_after_s``, ``verify_row_s`` None."""
     from mlc.circuit import build as cb
     if family == "mesh":            # structure kept: -O2 would merge what repeats
         spec, level = nand_mesh(MESH_WIDTH, w), 0
@@ -82,16 +88,36 @@ def adder_point(w: int, family: str = "adder") -> dict:
     t_build, c_build = time.perf_counter() - t0, time.process_time() - c0
     sc = circ.scene
     row = "1" * len(sc.inputs)
-    rep = verify_static(sc, rows=[row])
-    return {"family": family, "width": w, "gates": len(c.netlist.gates), "bodies": len(sc.bodies), "chains": circ.chains,
+    point = {"family": family, "width": w, "gates": len(c.netlist.gates), "bodies": len(sc.bodies), "chains": circ.chains,
             "half_units": circ.half_units, "build_s": t_build, "build_cpu_s": c_build, "load": load0,
             "route_solves": route.CACHE_HITS[1] - hits0[1], "route_repeats": route.CACHE_HITS[0] - hits0[0],
             "tight_chains": sc.meta["connector"]["tight_chains"], "build_parts_s": circ.seconds,
             "state_contacts": sc.meta["connector"].get("state_contacts", []),
             "rerouted_contacts": sc.meta["connector"].get("rerouted_contacts", []),
             "contact_min": min((k.clearance for k in circ.contacts), default=None),
-            "verify_row_s": rep.rows[0]["seconds"], "row": row, "ok": rep.ok,
-            "clearance": rep.rows[0].get("clearance"), "joint_stretch": rep.rows[0]["joint_stretch"]}
+            "verify_row_s": None, "row": row}
+    if on_built is not None:
+        on_built(dict(point))
+    del circ
+
+    def stop(signum, frame):
+        raise TimeoutError
+    old = signal.signal(signal.SIGALRM, stop) if verify_budget else None
+    t0 = time.perf_counter()
+    try:
+        if verify_budget:
+            signal.setitimer(signal.ITIMER_REAL, verify_budget)
+        rep = verify_static(sc, rows=[row])
+    except TimeoutError:
+        point["verify_stopped_after_s"] = time.perf_counter() - t0
+        return point
+    finally:
+        if verify_budget:
+            signal.setitimer(signal.ITIMER_REAL, 0)
+            signal.signal(signal.SIGALRM, old)
+    point.update({"verify_row_s": rep.rows[0]["seconds"], "ok": rep.ok, "clearance": rep.rows[0].get("clearance"),
+                  "joint_stretch": rep.rows[0]["joint_stretch"]})
+    return point
 
 
 def fit_and_goals(points: list[dict]):
@@ -104,22 +130,25 @@ def fit_and_goals(points: list[dict]):
     b = np.array([p["bodies"] for p in points], float)
     tb = np.array([p["build_s"] for p in points])
     cb = np.array([p["build_cpu_s"] for p in points])
-    tv = np.array([p["verify_row_s"] for p in points])
+    checked = [p for p in points if p.get("verify_row_s") is not None]
+    bv = np.array([p["bodies"] for p in checked], float)
+    tv = np.array([p["verify_row_s"] for p in checked])
     fit, extra = {}, None
     if len(points) >= 3:
         fit["build_exponent_in_bodies"] = float(np.polyfit(np.log(b), np.log(tb), 1)[0])
         fit["build_cpu_exponent_in_bodies"] = float(np.polyfit(np.log(b), np.log(cb), 1)[0])
-        fit["verify_exponent_in_bodies"] = float(np.polyfit(np.log(b), np.log(tv), 1)[0])
+        if len(checked) >= 3:
+            fit["verify_exponent_in_bodies"] = float(np.polyfit(np.log(bv), np.log(tv), 1)[0])
         fit["bodies_exponent_in_gates"] = float(np.polyfit(np.log(g), np.log(b), 1)[0])
     biggest = max(points, key=lambda p: p["gates"])
     goals = {"build_200_gates_under_2s": None, "verify_row_200_gates_under_10s": None}
     if biggest["gates"] >= 200:
         goals = {"build_200_gates_under_2s": biggest["build_s"] < 2.0,
-                 "verify_row_200_gates_under_10s": biggest["verify_row_s"] < 10.0}
-    elif len(points) >= 3:
+                 "verify_row_200_gates_under_10s": _verify_goal(biggest)}
+    elif len(points) >= 3 and len(checked) >= 3:
         lb = np.polyval(np.polyfit(np.log(g), np.log(b), 1), math.log(200.0))
         build_cpu = float(np.exp(np.polyval(np.polyfit(np.log(b), np.log(cb), 1), lb)))
-        verify = float(np.exp(np.polyval(np.polyfit(np.log(b), np.log(tv), 1), lb)))
+        verify = float(np.exp(np.polyval(np.polyfit(np.log(bv), np.log(tv), 1), lb)))
         extra = {"from_gates": [int(x) for x in g], "bodies": float(np.exp(lb)), "build_cpu_s": build_cpu,
                  "verify_row_s": verify, "build_over_goal": build_cpu / 2.0, "verify_over_goal": verify / 10.0}
     return fit, goals, extra
@@ -171,6 +200,14 @@ def dynamic_per_scheme(row: str = "111", probe_t0: float = 2.0, euler_steps: int
     return out
 
 
+def _verify_goal(p: dict):
+    """One row's static check under 10 s: True or False when it finished, False when it was
+    stopped after 10 s or more (``verify_stopped_after_s``), None when it never ran."""
+    if p.get("verify_row_s") is not None:
+        return p["verify_row_s"] < 10.0
+    return False if p.get("verify_stopped_after_s", 0.0) >= 10.0 else None
+
+
 def refit(res: dict) -> dict:
     """Fit (per family), goals and extrapolation of ``res`` from its built points.  The goals are
     read off the smallest circuit of 200 gates or more when one was built, else carried to 200
@@ -188,8 +225,12 @@ def refit(res: dict) -> dict:
                                    f"{p['bodies']} bodies",
                         "build_200_gates_under_2s": p["build_s"] < 2.0, "build_s": p["build_s"],
                         "build_over_goal": p["build_s"] / 2.0,
-                        "verify_row_200_gates_under_10s": p["verify_row_s"] < 10.0,
-                        "verify_row_s": p["verify_row_s"], "verify_over_goal": p["verify_row_s"] / 10.0}
+                        "verify_row_200_gates_under_10s": _verify_goal(p),
+                        "verify_row_s": p["verify_row_s"],
+                        "verify_over_goal": None if p["verify_row_s"] is None else p["verify_row_s"] / 10.0}
+        if p.get("verify_stopped_after_s") is not None:
+            res["goals"]["verify_stopped_after_s"] = p["verify_stopped_after_s"]
+            res["goals"]["verify_over_goal_at_least"] = p["verify_stopped_after_s"] / 10.0
     return res
 
 
@@ -211,7 +252,12 @@ def plot(res: dict) -> None:
         ax[0].loglog(g, b, "o-", color=col, label=fam)
         ax[1].loglog(b, [p["build_s"] for p in pts], "o-", color=col, label=f"{fam}: build, wall")
         ax[1].loglog(b, [p["build_cpu_s"] for p in pts], "o--", color=col, alpha=0.5, label=f"{fam}: build, CPU")
-        ax[1].loglog(b, [p["verify_row_s"] for p in pts], "s:", color=col, label=f"{fam}: static check, one row")
+        chk = [p for p in pts if p.get("verify_row_s") is not None]
+        ax[1].loglog([p["bodies"] for p in chk], [p["verify_row_s"] for p in chk], "s:", color=col,
+                     label=f"{fam}: static check, one row")
+        for p in pts:
+            if p.get("verify_stopped_after_s"):      # a lower bound: stopped, not finished
+                ax[1].plot([p["bodies"]], [p["verify_stopped_after_s"]], "^", color=col, mfc="none")
     ax[0].set_xlabel("gates")
     ax[0].set_ylabel("bodies in the scene")
     ax[0].legend(fontsize=8)
@@ -241,6 +287,9 @@ def main():
     ap.add_argument("--meshes", type=int, nargs="*",
                     help=f"measure nand_mesh({MESH_WIDTH}, depth) for these depths (depth 29: 203 gates, short wires) "
                          "and merge them into the committed JSON (the adders and the dynamic part are kept)")
+    ap.add_argument("--verify-budget", type=float, default=None,
+                    help="s (wall): stop a point's static check after this long and record it as stopped "
+                         "(--multipliers and --meshes; default: no limit)")
     ap.add_argument("--skip-dynamic", action="store_true")
     ap.add_argument("--budget", type=float, default=1800.0, help="stop growing after this many seconds")
     ap.add_argument("--dynamic-only", action="store_true",
@@ -272,8 +321,13 @@ def main():
         if not sizes:
             continue
         pts = {p["width"]: p for p in old.get(key, [])}
+        def built(p):                                   # the build kept before the (long) static check
+            pts[p["width"]] = p
+            old[key] = [pts[k] for k in sorted(pts)]
+            save(old)
+
         for w in sizes:
-            p = adder_point(w, fam)                      # a refusal is recorded with its reason
+            p = adder_point(w, fam, on_built=built, verify_budget=args.verify_budget)  # a refusal: its reason
             pts[w] = p
             print(json.dumps({k: (round(v, 3) if isinstance(v, float) else v) for k, v in p.items()
                               if k != "build_parts_s"}), flush=True)
