@@ -20,6 +20,8 @@
     python benchmarks/circuit_scaling.py [--widths 1 2 3] [--skip-dynamic]   (adders; keeps the multipliers)
     python benchmarks/circuit_scaling.py --multipliers 2 3 4 5 6     (merged into the JSON point by point)
     python benchmarks/circuit_scaling.py --meshes 1 2 4 8 16 29      (the same)
+    python benchmarks/circuit_scaling.py --meshes 29 --verify-budget 1800   (the build saved first;
+                                                    a check stopped at 1800 s is a lower bound)
     python benchmarks/circuit_scaling.py --dynamic-only     (the per-scheme part alone)
     python benchmarks/circuit_scaling.py --refit            (fit and goals from the JSON)
 
