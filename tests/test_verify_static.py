@@ -106,3 +106,30 @@ def test_spd_lu_solves_the_normal_equations_with_less_fill_than_colamd():
     assert lu.L.nnz + lu.U.nnz < colamd.L.nnz + colamd.U.nnz
     with pytest.raises(RuntimeError):
         spd_lu(sp.csc_matrix(np.diag([1.0, 0.0, 2.0])))
+
+
+def test_a_row_reports_its_progress_and_the_report_is_unchanged():
+    """A large circuit's row takes minutes: equilibrium() reports after each minimisation
+    (the continuation steps, then the polish), and verify_static passes that on as a
+    fractional row, so the bar moves within a row; whole rows are reported as they finish.
+    Reporting changes nothing: the same poses and the same report as without a callback."""
+    from mlc.verify.circuit import ROW_SHARES, verify_static
+    from mlc.verify.static import CONTINUATION_STEPS
+
+    s = gate_scene("NAND", "expand")
+    fs = []
+    eq = equilibrium(s, "11", progress=fs.append)
+    assert fs == [k / (CONTINUATION_STEPS + 1) for k in range(1, CONTINUATION_STEPS + 2)]
+    assert np.array_equal(eq.pos, equilibrium(s, "11").pos)
+
+    calls = []
+    rep = verify_static(s, rows=["01", "11"], progress=lambda d, t: calls.append((d, t)))
+    assert all(t == 2 for _, t in calls)
+    done = [d for d, _ in calls]
+    assert done == sorted(done) and len(set(done)) == len(done)          # always forward
+    assert done.count(1) == 1 and done[-1] == 2                          # whole rows as they finish
+    within = [d for d in done if 0 < d < 1]
+    assert len(within) == CONTINUATION_STEPS + 2                         # the minimisations, the spread
+    assert within[-1] == ROW_SHARES[1] and within[-2] == ROW_SHARES[0]
+    plain = verify_static(s, rows=["01", "11"])
+    assert [(e["measured"], e["ok"]) for e in rep.entries] == [(e["measured"], e["ok"]) for e in plain.entries]

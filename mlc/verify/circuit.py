@@ -28,6 +28,8 @@ from mlc.scene.model import Scene
 TOL_LENGTH = 0.05       # sigma: a read length must be this close to its ideal (static)
 TOL_STRETCH = 1e-3      # sigma: largest joint stretch allowed in a row's equilibrium
 THERMAL_SDS = 3.0       # a bit is read reliably at kT when its margin is at least this many thermal spreads
+ROW_SHARES = (0.8, 0.9)  # progress within a static row: the equilibrium done, then the thermal spread
+                         # (measured on a 5232-body circuit: 80 % of the row, 4 %, then the clearance 10 %)
 
 
 @dataclass
@@ -81,7 +83,12 @@ def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_s
     :func:`mlc.verify.dynamic.probe_thermal_sd`), and each row ``thermal_ok``: every
     expected bit read with a margin of at least ``THERMAL_SDS`` spreads.  Like clearance it
     is its own verdict and a warning: a row that fails it computes right at rest but not
-    reliably at ``kT`` (docs/circuits.md, "Thermal spread")."""
+    reliably at ``kT`` (docs/circuits.md, "Thermal spread").
+
+    ``progress(done, total)``: called as rows finish (``done`` whole rows of ``total``) and
+    within a row (``done`` fractional: ``ROW_SHARES`` of the row after its equilibrium's
+    minimisations, its thermal spread and its clearance), so that one row of a large circuit,
+    minutes long, moves its progress bar."""
     from mlc.verify.dynamic import probe_thermal_sd
     from mlc.verify.overlap import clearance as clear
     from mlc.verify.static import equilibrium
@@ -93,10 +100,13 @@ def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_s
                                                "joint_k": scene.meta.get("connector", {}).get("joint_k", 1.0)})
     for i, state in enumerate(states):
         t_row = time.perf_counter()
-        eq = equilibrium(scene, state)
+        eq = equilibrium(scene, state, progress=None if not progress else
+                         (lambda f, i=i: progress(i + ROW_SHARES[0] * f, len(states))))
         want = scene.truth_table.get(state)
         row_ok = eq.max_joint_stretch <= tol_stretch
         sd = probe_thermal_sd(scene, kT, eq.pos, eq.quat) if kT is not None and kT > 0 else {}
+        if progress and clearance:
+            progress(i + ROW_SHARES[1], len(states))
         thermal_ok = True
         for pr in scene.probes:
             k = scene.outputs.index(pr.output)
