@@ -13,10 +13,12 @@ exact oriented-box clearance of every pair of slabs of different bodies in that 
 Rows: the wires named in the predicted contacts (below zero) take a few combinations of
 values over all input rows (:func:`mlc.circuit.build._wire_values`); for each combination
 the row with the fewest ones (then the smallest) is checked, the combinations whose wires
-switch most from the built row first.  Each row's result is written as soon as it is
-measured, so a run stopped part way keeps what it measured.
+switch most from the built row first.  Then, up to ``--max-rows``, the all-ones row (every
+muscle moved) and rows drawn at random (``--seed``): with no contact predicted, these test
+the prediction's "clear" on rows it did not single out.  Each row's result is written as
+soon as it is measured, so a run stopped part way keeps what it measured.
 
-    python benchmarks/circuit_state_contacts.py [--adder 7] [--max-rows 8] [--budget S]
+    python benchmarks/circuit_state_contacts.py [--adder 7] [--max-rows 8] [--budget S] [--seed 0]
 
 Writes ``benchmarks/results/circuit_state_contacts.json``: per row the wires' values, the
 row's smallest clearance and its pair, whether the row reads right, and the seconds.
@@ -33,6 +35,7 @@ import time
 from pathlib import Path
 
 import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
+import numpy as np
 
 from mlc.circuit import build as cb
 from mlc.circuit.build import _wire_values, build_circuit
@@ -81,6 +84,7 @@ def main():
     ap.add_argument("--adder", type=int, default=7, help="width of the ripple-carry adder (bits)")
     ap.add_argument("--max-rows", type=int, default=8, help="check at most this many rows")
     ap.add_argument("--budget", type=float, default=None, help="stop starting rows after this many seconds")
+    ap.add_argument("--seed", type=int, default=0, help="seed of the random rows that fill up to --max-rows")
     ap.add_argument("--json", type=Path, default=OUT / "circuit_state_contacts.json")
     a = ap.parse_args()
     spec = ripple_adder(a.adder)
@@ -100,8 +104,17 @@ def main():
     wires = sorted({wire_of(t, c.netlist) for t in tags})
     res["wires"] = ["/".join(w) for w in wires]
     inputs = list(sc.inputs)
-    plan = rows_for(c.netlist, inputs, wires)[:a.max_rows]
-    res["planned_rows"] = [r for r, _ in plan]
+    plan = [(r, combo, "contact" if wires else "all zero (as built; no contact predicted)")
+            for r, combo in rows_for(c.netlist, inputs, wires)][:a.max_rows]
+    fill = ["1" * len(inputs)]
+    rng = np.random.default_rng(a.seed)
+    while len(fill) < a.max_rows + 1:
+        fill.append("".join(map(str, rng.integers(0, 2, len(inputs)))))
+    for r in fill:
+        if len(plan) < a.max_rows and r not in [p[0] for p in plan]:
+            v = _wire_values(c.netlist, dict(zip(inputs, map(int, r))))
+            plan.append((r, tuple(v[w] for w in wires), "all ones" if r == fill[0] else f"random (seed {a.seed})"))
+    res["planned_rows"] = [[r, why] for r, _, why in plan]
 
     def save():
         with atomic_path(a.json) as tmp:
@@ -109,13 +122,13 @@ def main():
     save()
     print(f"{len(sc.bodies)} bodies, built in {res['build_cpu_s']:.0f} s CPU; predicted below zero: {touching}")
     start = time.perf_counter()
-    for row, combo in plan:
+    for row, combo, why in plan:
         if a.budget is not None and time.perf_counter() - start > a.budget:
             res["stopped"] = f"budget of {a.budget} s passed before row {row}"
             break
         rep = verify_static(sc, rows=[row])
         r = rep.rows[0]
-        res["rows"].append({"row": row, "wire_values": dict(zip(res["wires"], combo)), "ok": bool(r["ok"]),
+        res["rows"].append({"row": row, "why": why, "wire_values": dict(zip(res["wires"], combo)), "ok": bool(r["ok"]),
                             "clearance": r.get("clearance"), "clearance_pair": r.get("clearance_pair"),
                             "joint_stretch": r["joint_stretch"], "seconds": r["seconds"]})
         print(res["rows"][-1], flush=True)
