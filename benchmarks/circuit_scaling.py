@@ -22,6 +22,8 @@
     python benchmarks/circuit_scaling.py --meshes 1 2 4 8 16 29      (the same)
     python benchmarks/circuit_scaling.py --meshes 29 --verify-budget 1800   (the build saved first;
                                                     a check stopped at 1800 s is a lower bound)
+    python benchmarks/circuit_scaling.py --meshes 29 --save-scenes S    (and the scene, to S/mesh_29.yaml)
+    python benchmarks/circuit_scaling.py --meshes 29 --check-saved S    (no build: the check again)
     python benchmarks/circuit_scaling.py --dynamic-only     (the per-scheme part alone)
     python benchmarks/circuit_scaling.py --refit            (fit and goals from the JSON)
 
@@ -57,7 +59,24 @@ OUT = Path(__file__).resolve().parent / "results"
 MESH_WIDTH = 7        # nand_mesh's width: 14 inputs, 7 gates a level (depth 29: 203 gates)
 
 
-def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: float | None = None) -> dict:
+def scene_path(folder: Path, family: str, w: int) -> Path:
+    """Where ``--save-scenes`` writes a point's scene and ``--check-saved`` reads it."""
+    return Path(folder) / f"{family}_{w}.yaml"
+
+
+def save_scene(sc, path: Path) -> str:
+    """Write ``sc`` to ``path``; returns the sha256 prefix of the text written."""
+    import hashlib
+
+    from mlc.scene.io import dump_scene
+    text = dump_scene(sc)
+    with atomic_path(path) as tmp:
+        Path(tmp).write_text(text)
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
+
+
+def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: float | None = None,
+                save_to: Path | None = None) -> dict:
     """One circuit of the series: the ``w``-bit ripple-carry adder, or (``family`` "multiplier")
     the ``w`` x ``w`` array multiplier (2w inputs: 6 bits are 222 gates on 12 inputs), or
     (``family`` "mesh") ``nand_mesh(MESH_WIDTH, w)``, compiled at -O0 (depth 29: 203 gates).  The
@@ -68,7 +87,10 @@ def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: flo
     ``on_built(point)`` is called with the point as built, before its static check (its
     ``verify_row_s`` None), so that a long series keeps the build it measured.  A static check
     that passes ``verify_budget`` seconds of wall time is stopped (SIGALRM, between two Python
-    steps of the minimiser) and recorded as ``verify_stopped_after_s``, ``verify_row_s`` None."""
+    steps of the minimiser) and recorded as ``verify_stopped_after_s``, ``verify_row_s`` None.
+    ``save_to`` (a folder): the scene is written there before the check (:func:`scene_path`;
+    ``scene_sha`` in the point), so that a check stopped at its budget can be run again
+    without the build (``--check-saved``)."""
     from mlc.circuit import build as cb
     if family == "mesh":            # structure kept: -O2 would merge what repeats
         spec, level = nand_mesh(MESH_WIDTH, w), 0
@@ -98,9 +120,18 @@ def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: flo
             "rerouted_contacts": sc.meta["connector"].get("rerouted_contacts", []),
             "contact_min": min((k.clearance for k in circ.contacts), default=None),
             "verify_row_s": None, "row": row}
+    if save_to is not None:
+        point["scene_sha"] = save_scene(sc, scene_path(save_to, family, w))
     if on_built is not None:
         on_built(dict(point))
     del circ
+    return check_point(point, sc, verify_budget)
+
+
+def check_point(point: dict, sc, verify_budget: float | None = None) -> dict:
+    """``point`` with the static check of its row on scene ``sc`` (see :func:`adder_point`)."""
+    row = point["row"]
+    point.pop("verify_stopped_after_s", None)
 
     def stop(signum, frame):
         raise TimeoutError
@@ -120,6 +151,22 @@ def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: flo
     point.update({"verify_row_s": rep.rows[0]["seconds"], "ok": rep.ok, "clearance": rep.rows[0].get("clearance"),
                   "joint_stretch": rep.rows[0]["joint_stretch"]})
     return point
+
+
+def checked_saved(point: dict | None, folder: Path, family: str, w: int, verify_budget: float | None) -> dict:
+    """The committed ``point`` with its static check run again on the scene saved for it."""
+    import hashlib
+
+    from mlc.scene.io import dump_scene, load_scene
+    path = scene_path(folder, family, w)
+    if point is None or "scene_sha" not in point:
+        raise SystemExit(f"{family} {w}: no committed point with a saved scene (build it with --save-scenes)")
+    if not path.is_file():
+        raise SystemExit(f"{path}: no such scene (build it with --save-scenes {folder})")
+    sc = load_scene(path)
+    if hashlib.sha256(dump_scene(sc).encode()).hexdigest()[:16] != point["scene_sha"]:
+        raise SystemExit(f"{path} is not the scene of the committed {family} {w} point (scene_sha differs)")
+    return check_point(dict(point), sc, verify_budget)
 
 
 def fit_and_goals(points: list[dict]):
@@ -292,6 +339,11 @@ def main():
     ap.add_argument("--verify-budget", type=float, default=None,
                     help="s (wall): stop a point's static check after this long and record it as stopped "
                          "(--multipliers and --meshes; default: no limit)")
+    ap.add_argument("--save-scenes", type=Path, metavar="DIR",
+                    help="--multipliers, --meshes: write each point's scene to DIR before its check")
+    ap.add_argument("--check-saved", type=Path, metavar="DIR",
+                    help="--multipliers, --meshes: no build; run the static check of each point on the scene "
+                         "--save-scenes wrote to DIR (it must be the one the point records, scene_sha)")
     ap.add_argument("--skip-dynamic", action="store_true")
     ap.add_argument("--budget", type=float, default=1800.0, help="stop growing after this many seconds")
     ap.add_argument("--dynamic-only", action="store_true",
@@ -329,7 +381,10 @@ def main():
             save(old)
 
         for w in sizes:
-            p = adder_point(w, fam, on_built=built, verify_budget=args.verify_budget)  # a refusal: its reason
+            if args.check_saved:
+                p = checked_saved(pts.get(w), args.check_saved, fam, w, args.verify_budget)
+            else:                                        # a refusal: its reason
+                p = adder_point(w, fam, on_built=built, verify_budget=args.verify_budget, save_to=args.save_scenes)
             pts[w] = p
             print(json.dumps({k: (round(v, 3) if isinstance(v, float) else v) for k, v in p.items()
                               if k != "build_parts_s"}), flush=True)
