@@ -2,7 +2,8 @@
 its truth table, statically or by Brownian dynamics.
 
 * **static**: for each row, the equilibrium reached from the scene's rest pose by moving
-  the muscles (:func:`mlc.verify.static.equilibrium`), every probe read; a row passes
+  the muscles (:func:`mlc.verify.static.equilibrium`, without its polish: ``polish``
+  below), every probe read; a row passes
   when every probe reads the expected bit with the length within ``tol_length`` of the
   ideal, the largest joint stretch is within ``tol_stretch`` (no gate strained by its
   wiring), and no two slabs of different bodies interpenetrate in that pose
@@ -76,14 +77,16 @@ def select_rows(scene: Scene, rows=None) -> list[str]:
 
 def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_stretch: float = TOL_STRETCH,
                   clearance: bool = True, progress=None, require_clearance: bool = False,
-                  kT: float | None = 1e-5) -> Report:
+                  kT: float | None = 1e-5, polish: bool = False) -> Report:
     """Static check of every row in ``rows`` (default all), see the module docstring.  With
     ``kT`` (k0 sigma^2; None: skipped) each entry also gets ``thermal_sd``, the probe's
     harmonic thermal spread in that row's equilibrium (sigma,
     :func:`mlc.verify.dynamic.probe_thermal_sd`), and each row ``thermal_ok``: every
     expected bit read with a margin of at least ``THERMAL_SDS`` spreads.  Like clearance it
     is its own verdict and a warning: a row that fails it computes right at rest but not
-    reliably at ``kT`` (docs/circuits.md, "Thermal spread").
+    reliably at ``kT`` (docs/circuits.md, "Thermal spread").  ``polish``: end each row's
+    equilibrium with its polish, which moves the bodies by ~1e-9 sigma and takes about half
+    of the minimisation time (:func:`mlc.verify.static.equilibrium`).
 
     ``progress(done, total)``: called as rows finish (``done`` whole rows of ``total``) and
     within a row (``done`` fractional: ``ROW_SHARES`` of the row after its equilibrium's
@@ -100,7 +103,7 @@ def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_s
                                                "joint_k": scene.meta.get("connector", {}).get("joint_k", 1.0)})
     for i, state in enumerate(states):
         t_row = time.perf_counter()
-        eq = equilibrium(scene, state, progress=None if not progress else
+        eq = equilibrium(scene, state, polish=polish, progress=None if not progress else
                          (lambda f, i=i: progress(i + ROW_SHARES[0] * f, len(states))))
         want = scene.truth_table.get(state)
         row_ok = eq.max_joint_stretch <= tol_stretch

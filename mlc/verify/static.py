@@ -306,14 +306,22 @@ def _state_bits(scene: Scene, state: str) -> np.ndarray:
 
 
 def equilibrium(scene: Scene, state: str, start_state: str | None = None,
-                steps: int = CONTINUATION_STEPS, pos=None, quat=None, lu_of=None, progress=None) -> Equilibrium:
+                steps: int = CONTINUATION_STEPS, pos=None, quat=None, lu_of=None, progress=None,
+                polish: bool = True) -> Equilibrium:
     """Equilibrium of ``scene`` with its inputs in ``state``, reached by continuation from
     the scene's own poses (or ``pos``/``quat``), taken to be the equilibrium of
     ``start_state`` (default all 0).  ``lu_of``: the factorisation of the normal equations
     (default :func:`colamd_lu`).  ``progress(f)``, if given, is called after each
     minimisation with the fraction ``f`` (0 < f <= 1) of the minimisations done (the
     continuation steps, the stiff joints' restoring one, the polish): a large circuit's row
-    takes minutes, and its progress bar moves within it."""
+    takes minutes, and its progress bar moves within it.
+
+    ``polish``: end with a minimisation at ``REG_POLISH``, which takes the least-motion
+    term's bias off the pose.  That bias is of order ``REG`` (1e-9 sigma), far below any
+    tolerance of a read length, but the circuit builder poses its gates with it and the
+    scenes it writes depend on those last bits.  In a connector circuit the polish crawls
+    along the chains' floppy modes: it is about half of a row's minimisation time, so the
+    circuits' static verifier leaves it out (``polish=False``; docs/circuits.md)."""
     A = scene.arrays()
     target = _state_bits(scene, state)
     start = _state_bits(scene, start_state or "0" * len(scene.inputs))
@@ -326,7 +334,7 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
         stiff = bool(np.any(prob.bond_k > k_cap))
         if stiff:                                       # stiffness homotopy (module docstring)
             prob.bond_k = np.minimum(prob.bond_k, k_cap)
-        total, done = len(path) + stiff + 1, 0
+        total, done = len(path) + stiff + polish, 0
 
         def tick():
             nonlocal done
@@ -340,8 +348,9 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
             prob.bond_k = np.array(A.bond_k, float)
             nit += _minimise(prob, L1, lu_of=lu_of)
             tick()
-        nit += _minimise(prob, L1, reg=REG_POLISH, lu_of=lu_of)     # polish: the least-motion bias removed
-        tick()
+        if polish:
+            nit += _minimise(prob, L1, reg=REG_POLISH, lu_of=lu_of)     # the least-motion bias removed
+            tick()
     pos, R = prob.pos, prob.R
     p, _ = prob.sites()
     quat = np.array([matrix_to_quat(r) for r in R]) if len(R) else np.zeros((0, 4))
