@@ -32,7 +32,10 @@ machine in one run; compare ratios, not absolute numbers across machines.  ``bui
 is the build's CPU time (process_time) and ``load`` the 1-minute load average when the
 build started: on a shared machine wall time is CPU time over the share of a core the
 process gets.  ``route_solves``/``route_repeats``: chains solved / served by the router's
-cache (build_circuit's second build repeats some of the first's solves).
+cache (build_circuit's second build repeats some of the first's solves).  A point whose
+check records ``polish: false`` ran it as ``mlc verify`` does since verify_static left out
+the equilibrium's polish (benchmarks/static_polish.py); the points without the field ran it
+with the polish.
 """
 from __future__ import annotations
 
@@ -48,7 +51,7 @@ from pathlib import Path
 import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 
-from mlc.circuit.build import build_circuit
+from mlc.circuit.build import CircuitOptions, build_circuit
 from mlc.errors import MlcError
 from mlc.io.atomic import atomic_path
 from mlc.logic.library import array_multiplier, nand_mesh, ripple_adder
@@ -64,15 +67,19 @@ def scene_path(folder: Path, family: str, w: int) -> Path:
     return Path(folder) / f"{family}_{w}.yaml"
 
 
-def save_scene(sc, path: Path) -> str:
-    """Write ``sc`` to ``path``; returns the sha256 prefix of the text written."""
+def scene_digest(text: str) -> str:
+    """A saved scene's ``scene_sha``: the sha256 prefix of its text (``dump_scene``)."""
     import hashlib
+    return hashlib.sha256(text.encode()).hexdigest()[:16]
 
+
+def save_scene(sc, path: Path) -> str:
+    """Write ``sc`` to ``path``; returns :func:`scene_digest` of the text written."""
     from mlc.scene.io import dump_scene
     text = dump_scene(sc)
     with atomic_path(path) as tmp:
         Path(tmp).write_text(text)
-    return hashlib.sha256(text.encode()).hexdigest()[:16]
+    return scene_digest(text)
 
 
 def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: float | None = None,
@@ -91,19 +98,17 @@ def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: flo
     ``save_to`` (a folder): the scene is written there before the check (:func:`scene_path`;
     ``scene_sha`` in the point), so that a check stopped at its budget can be run again
     without the build (``--check-saved``)."""
-    from mlc.circuit import build as cb
     if family == "mesh":            # structure kept: -O2 would merge what repeats
         spec, level = nand_mesh(MESH_WIDTH, w), 0
     else:
         spec, level = (ripple_adder(w) if family == "adder" else array_multiplier(w)), 2
     c = compile_spec(spec, level, "expand")
-    cb.MAX_GATES = max(cb.MAX_GATES, len(c.netlist.gates))
     from mlc.circuit import route
     hits0 = list(route.CACHE_HITS)
     load0 = os.getloadavg()[0]
     t0, c0 = time.perf_counter(), time.process_time()
     try:
-        circ = build_circuit(c.netlist, spec)
+        circ = build_circuit(c.netlist, spec, CircuitOptions(max_gates=len(c.netlist.gates)))
     except MlcError as e:
         if family == "adder":
             raise
@@ -140,7 +145,7 @@ def check_point(point: dict, sc, verify_budget: float | None = None) -> dict:
     try:
         if verify_budget:
             signal.setitimer(signal.ITIMER_REAL, verify_budget)
-        rep = verify_static(sc, rows=[row])
+        rep = verify_static(sc, rows=[row], polish=False)
     except TimeoutError:
         point["verify_stopped_after_s"] = time.perf_counter() - t0
         return point
@@ -149,14 +154,12 @@ def check_point(point: dict, sc, verify_budget: float | None = None) -> dict:
             signal.setitimer(signal.ITIMER_REAL, 0)
             signal.signal(signal.SIGALRM, old)
     point.update({"verify_row_s": rep.rows[0]["seconds"], "ok": rep.ok, "clearance": rep.rows[0].get("clearance"),
-                  "joint_stretch": rep.rows[0]["joint_stretch"]})
+                  "joint_stretch": rep.rows[0]["joint_stretch"], "polish": False})
     return point
 
 
 def checked_saved(point: dict | None, folder: Path, family: str, w: int, verify_budget: float | None) -> dict:
     """The committed ``point`` with its static check run again on the scene saved for it."""
-    import hashlib
-
     from mlc.scene.io import dump_scene, load_scene
     path = scene_path(folder, family, w)
     if point is None or "scene_sha" not in point:
@@ -164,7 +167,7 @@ def checked_saved(point: dict | None, folder: Path, family: str, w: int, verify_
     if not path.is_file():
         raise SystemExit(f"{path}: no such scene (build it with --save-scenes {folder})")
     sc = load_scene(path)
-    if hashlib.sha256(dump_scene(sc).encode()).hexdigest()[:16] != point["scene_sha"]:
+    if scene_digest(dump_scene(sc)) != point["scene_sha"]:
         raise SystemExit(f"{path} is not the scene of the committed {family} {w} point (scene_sha differs)")
     return check_point(dict(point), sc, verify_budget)
 

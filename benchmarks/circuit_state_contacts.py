@@ -37,8 +37,7 @@ from pathlib import Path
 import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 
-from mlc.circuit import build as cb
-from mlc.circuit.build import _wire_values, build_circuit
+from mlc.circuit.build import CircuitOptions, _wire_values, build_circuit
 from mlc.io.atomic import atomic_path
 from mlc.logic.library import ripple_adder
 from mlc.pipeline import compile_spec
@@ -89,9 +88,8 @@ def main():
     a = ap.parse_args()
     spec = ripple_adder(a.adder)
     c = compile_spec(spec, 2, "expand")
-    cb.MAX_GATES = max(cb.MAX_GATES, len(c.netlist.gates))
     t0, c0 = time.perf_counter(), time.process_time()
-    circ = build_circuit(c.netlist, spec)
+    circ = build_circuit(c.netlist, spec, CircuitOptions(max_gates=len(c.netlist.gates)))
     sc = circ.scene
     res = {"what": __doc__.split("\n\n")[0], "circuit": f"ripple_adder({a.adder}), -O2, expand",
            "gates": len(c.netlist.gates), "bodies": len(sc.bodies),

@@ -83,8 +83,7 @@ def mesh_scene(depth: int):
     from mlc.pipeline import compile_spec
     spec = nand_mesh(7, depth)
     c = compile_spec(spec, 0, "expand")
-    cb.MAX_GATES = max(cb.MAX_GATES, len(c.netlist.gates))
-    return cb.build_circuit(c.netlist, spec).scene
+    return cb.build_circuit(c.netlist, spec, cb.CircuitOptions(max_gates=len(c.netlist.gates))).scene
 
 
 def summary(points: list[dict]) -> dict:

@@ -281,7 +281,10 @@ def test_build_time_estimate_follows_the_measured_circuits():
 
 def test_a_netlist_too_large_to_build_is_refused_with_the_estimate(monkeypatch, tmp_path, capsys):
     """An 84-AND circuit (EPFL ctrl) routed for 45 min without a word; now refused before the work,
-    naming the estimate and --no-circuit, exit 2, nothing written."""
+    naming the estimate, --no-circuit and the --max-gates that would build it, exit 2, nothing
+    written; with that --max-gates (not one less) it builds."""
+    import re
+
     from mlc.circuit import build as cb
     from mlc.cli import main
     monkeypatch.setattr(cb, "MAX_GATES", 2)
@@ -290,6 +293,21 @@ def test_a_netlist_too_large_to_build_is_refused_with_the_estimate(monkeypatch, 
     err = capsys.readouterr().err
     assert "gates; placing and routing it as one mechanism would take about" in err and "--no-circuit" in err, err
     assert err.count("\n") == 1 and not out.exists()
+    n = int(re.search(r"netlist has (\d+) gates", err).group(1))
+    assert f"--max-gates {n}" in err, err
+    assert main(["compile", "-e", "s = a ^ b ^ c; k = a & b | c", "-o", str(out), "--max-gates", str(n - 1)]) == 2
+    assert not out.exists() and "at most %d gates" % (n - 1) in capsys.readouterr().err
+    assert main(["compile", "-e", "s = a ^ b ^ c; k = a & b | c", "-o", str(out), "--max-gates", str(n)]) == 0
+    assert (out / "circuit.yaml").is_file()                     # the limit lifted, the circuit built
+
+
+def test_max_gates_is_checked_before_the_work(tmp_path, capsys):
+    from mlc.cli import main
+    out = tmp_path / "o"
+    assert main(["compile", "-e", "s = a & b", "-o", str(out), "--max-gates", "0"]) == 2
+    assert "--max-gates must be at least 1" in capsys.readouterr().err and not out.exists()
+    assert main(["compile", "-e", "s = a & b", "-o", str(out), "--no-circuit", "--max-gates", "5"]) == 2
+    assert "--max-gates only applies to the circuit" in capsys.readouterr().err and not out.exists()
 
 
 def _chain_edges(nl, sources):

@@ -109,6 +109,7 @@ class CircuitOptions:
                                      # "Thermal spread": 100 k0 joints give 12 spreads of margin, not 1.8)
     direct: bool = False             # join a gate's single-sink net by one full unit (mlc.circuit.direct)
     direct_skip: tuple = ()          # ... except into these sinks (build_circuit fills it: see there)
+    max_gates: int | None = None     # refuse larger netlists before the work (None: MAX_GATES)
 
 
 @dataclass
@@ -326,12 +327,16 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
 
     opt = options or CircuitOptions()
     t_start = time.perf_counter()
-    if len(netlist.gates) > MAX_GATES:
-        est = build_cpu_estimate(len(netlist.gates))
-        raise MlcError(f"netlist has {len(netlist.gates)} gates; placing and routing it as one mechanism would take "
-                       f"about {est / 3600:.2g} h of CPU (it grows as gates^{BUILD_CPU_EXPONENT:g}); the circuit back "
-                       f"end builds at most {MAX_GATES} gates", netlist.source,
-                       "compile with --no-circuit for the netlist alone, or split the design")
+    limit = MAX_GATES if opt.max_gates is None else opt.max_gates
+    if len(netlist.gates) > limit:
+        n = len(netlist.gates)
+        est = build_cpu_estimate(n)
+        raise MlcError(f"netlist has {n} gates; placing and routing it as one mechanism would take "
+                       f"about {est / 3600:.2g} h of CPU (the ripple-carry adders' fit, gates^{BUILD_CPU_EXPONENT:g}; "
+                       f"short wires build faster); the circuit back end builds at most {limit} gates unless told",
+                       netlist.source,
+                       f"compile with --no-circuit for the netlist alone, split the design, or lift the limit "
+                       f"with --max-gates {n}")
     if len(netlist.inputs) > MAX_INPUTS:
         raise MlcError(f"netlist has {len(netlist.inputs)} inputs; a circuit scene lists every row of its truth "
                        f"table and holds at most {MAX_INPUTS}", netlist.source,

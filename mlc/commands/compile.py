@@ -76,6 +76,9 @@ def register(sub):
     p.add_argument("--joint-k", dest="joint_k", type=float, default=None, metavar="K",
                    help="connector joints' stiffness in units of the design k0 (default 100; 1 is the paper's, "
                         "whose long chains spread thermally over a third of the logic margin, docs/circuits.md)")
+    p.add_argument("--max-gates", dest="max_gates", type=int, default=None, metavar="N",
+                   help="build circuits of up to N gates (default: about an hour of place-and-route CPU by the "
+                        "adders' fit; docs/circuits.md)")
     p.add_argument("--direct", action="store_true",
                    help="join a gate whose output feeds exactly one gate input by one full connector unit, "
                         "the sink placed on it (docs/circuits.md section 3, 'Direct connection')")
@@ -245,6 +248,13 @@ def run(args) -> int:
         if not (MIN_JOINT_K <= joint_k <= MAX_JOINT_K):
             raise MlcError(f"--joint-k must be from {MIN_JOINT_K:g} to {MAX_JOINT_K:g} (k0), got {joint_k}",
                            "--joint-k", "use e.g. --joint-k 1 (the paper's joints) or 100 (the default)")
+    max_gates = getattr(args, "max_gates", None)
+    if max_gates is not None:
+        if not want_circuit:
+            raise MlcError("--max-gates only applies to the circuit", "--no-circuit", "drop --no-circuit")
+        if max_gates < 1:
+            raise MlcError(f"--max-gates must be at least 1, got {max_gates}", "--max-gates",
+                           "give the largest gate count to build, e.g. --max-gates 250")
     if getattr(args, "direct", False) and not want_circuit:
         raise MlcError("--direct only applies to the circuit", "--no-circuit", "drop --no-circuit")
     if getattr(args, "robot", None):
@@ -274,7 +284,7 @@ def run(args) -> int:
         from mlc.pipeline import build
         from mlc.scene.io import dump_scene
         extra = {} if joint_k is None else {"joint_k": joint_k}
-        opts = CircuitOptions(direct=bool(getattr(args, "direct", False)), **extra)
+        opts = CircuitOptions(direct=bool(getattr(args, "direct", False)), max_gates=max_gates, **extra)
         with Progress("placing and routing", total=1) as bar:
             build(c, progress=lambda done, total: (setattr(bar, "total", total), bar.update(done)), options=opts)
         scene = c.circuit.scene
