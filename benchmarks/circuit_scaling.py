@@ -33,9 +33,9 @@ is the build's CPU time (process_time) and ``load`` the 1-minute load average wh
 build started: on a shared machine wall time is CPU time over the share of a core the
 process gets.  ``route_solves``/``route_repeats``: chains solved / served by the router's
 cache (build_circuit's second build repeats some of the first's solves).  A point whose
-check records ``polish: false`` ran it as ``mlc verify`` does since verify_static left out
-the equilibrium's polish (benchmarks/static_polish.py); the points without the field ran it
-with the polish.
+check records ``polish: auto`` ran it as ``mlc verify`` does since session 29: the
+equilibrium polished only where its minimisation stalled (benchmarks/static_polish.py); the
+points without the field ran it with the polish always.
 """
 from __future__ import annotations
 
@@ -145,7 +145,7 @@ def check_point(point: dict, sc, verify_budget: float | None = None) -> dict:
     try:
         if verify_budget:
             signal.setitimer(signal.ITIMER_REAL, verify_budget)
-        rep = verify_static(sc, rows=[row], polish=False)
+        rep = verify_static(sc, rows=[row])
     except TimeoutError:
         point["verify_stopped_after_s"] = time.perf_counter() - t0
         return point
@@ -154,7 +154,7 @@ def check_point(point: dict, sc, verify_budget: float | None = None) -> dict:
             signal.setitimer(signal.ITIMER_REAL, 0)
             signal.signal(signal.SIGALRM, old)
     point.update({"verify_row_s": rep.rows[0]["seconds"], "ok": rep.ok, "clearance": rep.rows[0].get("clearance"),
-                  "joint_stretch": rep.rows[0]["joint_stretch"], "polish": False})
+                  "joint_stretch": rep.rows[0]["joint_stretch"], "polish": "auto"})
     return point
 
 
@@ -356,6 +356,8 @@ def main():
     ap.add_argument("--json", type=Path, default=OUT / "circuit_scaling.json",
                     help="results file read and written (another name lets two series run at once)")
     args = ap.parse_args()
+    if args.save_scenes is not None:              # before the build: an hour's build lost to a missing folder
+        args.save_scenes.mkdir(parents=True, exist_ok=True)
     path = args.json
     old = json.loads(path.read_text()) if path.exists() else {}
 

@@ -10,12 +10,19 @@ the equilibrium is solved twice, with and without the polish, and compared:
 * the bits read, the largest joint stretch and the smallest slab clearance
   (:func:`mlc.verify.overlap.clearance`) of each pose.
 
+The summary also gives ``auto``, what ``mlc verify`` does (``polish=None``): the unpolished
+pose where its largest joint stretch and muscle strain are within ``POLISH_ABOVE``, else
+the polished one.  It is derived from the two solves, not run a third time: ``polish=None``
+is the unpolished path followed, past the threshold, by the polish, so its pose is bit for
+bit one of the two (``tests/test_verify_static.py``); its time is counted as that solve's.
+
 Circuits: the examples, compiled and built as ``mlc compile`` does (every row of tetris,
 snake3 and both full adders; ``--sample`` rows drawn with ``--seed`` for the larger
 tables), and ``nand_mesh(7, depth)`` at -O0 for each ``--meshes`` depth (its all-ones row,
 the row ``circuit_scaling.py`` times).
 
     python benchmarks/static_polish.py [--only tetris.tt ...] [--meshes 2] [--sample 4] [--seed 0]
+    python benchmarks/static_polish.py --summarise     (the summary again from the JSON; runs nothing)
 
 Writes benchmarks/results/static_polish.json and .png.  Wall seconds in one run on this
 (shared) machine: compare the ratio of the two times, not absolute numbers.
@@ -69,6 +76,7 @@ def compare_row(scene, row: str) -> dict:
             "max_body_move": float(np.abs(with_.pos - without.pos).max()),
             "same_bits": all(a == b for a, b in bits.values()),
             "stretch_polish": with_.max_joint_stretch, "stretch_no_polish": without.max_joint_stretch,
+            "strain_no_polish": without.max_muscle_strain,
             "clearance_polish": c_with, "clearance_no_polish": c_without}
 
 
@@ -86,10 +94,20 @@ def mesh_scene(depth: int):
     return cb.build_circuit(c.netlist, spec, cb.CircuitOptions(max_gates=len(c.netlist.gates))).scene
 
 
+def auto_polishes(r: dict) -> bool:
+    """Whether ``polish=None`` polished this row (the muscle strain was not recorded before
+    session 29's second run: then the stretch alone)."""
+    return max(r["stretch_no_polish"], r.get("strain_no_polish", 0.0)) > static.POLISH_ABOVE
+
+
 def summary(points: list[dict]) -> dict:
     rows = [r for p in points for r in p["rows"]]
     t_with = sum(r["seconds_polish"] for r in rows)
     t_without = sum(r["seconds_no_polish"] for r in rows)
+    auto = [auto_polishes(r) for r in rows]
+    t_auto = sum(r["seconds_polish"] if a else r["seconds_no_polish"] for r, a in zip(rows, auto))
+    lu_auto = sum(r["lu_polish"] if a else r["lu_no_polish"] for r, a in zip(rows, auto))
+    left = [r for r, a in zip(rows, auto) if not a]
     return {"rows": len(rows), "seconds_polish": t_with, "seconds_no_polish": t_without,
             "time_ratio": t_with / t_without if t_without else None,
             "lu_ratio": sum(r["lu_polish"] for r in rows) / max(1, sum(r["lu_no_polish"] for r in rows)),
@@ -97,7 +115,14 @@ def summary(points: list[dict]) -> dict:
             "max_body_move": max(r["max_body_move"] for r in rows),
             "all_same_bits": all(r["same_bits"] for r in rows),
             "max_stretch_no_polish": max(r["stretch_no_polish"] for r in rows),
-            "max_clearance_change": max(abs(r["clearance_polish"] - r["clearance_no_polish"]) for r in rows)}
+            "max_clearance_change": max(abs(r["clearance_polish"] - r["clearance_no_polish"]) for r in rows),
+            "auto": {"polish_above": static.POLISH_ABOVE, "rows_polished": sum(auto), "seconds": t_auto,
+                     "time_ratio_polish_to_auto": t_with / t_auto if t_auto else None,
+                     "lu_ratio_polish_to_auto": sum(r["lu_polish"] for r in rows) / max(1, lu_auto),
+                     "max_probe_change": max((r["max_probe_change"] for r in left), default=0.0),
+                     "max_body_move": max((r["max_body_move"] for r in left), default=0.0),
+                     "max_stretch": max([r["stretch_polish"] for r, a in zip(rows, auto) if a]
+                                        + [r["stretch_no_polish"] for r in left])}}
 
 
 def plot(points: list[dict], path: Path):
@@ -127,7 +152,14 @@ def main():
     ap.add_argument("--meshes", nargs="*", type=int, default=[2], help="nand_mesh(7, depth) depths")
     ap.add_argument("--sample", type=int, default=4, help="rows drawn from the larger examples' tables")
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--summarise", action="store_true", help="recompute the summary from the JSON; run nothing")
     args = ap.parse_args()
+    if args.summarise:
+        res = json.loads((OUT / "static_polish.json").read_text())
+        res["summary"] = summary(res["points"])
+        (OUT / "static_polish.json").write_text(json.dumps(res, indent=1))
+        print(json.dumps(res["summary"], indent=1))
+        return
     commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
                             text=True).stdout.strip()
     paths = sorted(p for p in (ROOT / "examples").iterdir() if p.suffix in SUFFIXES)

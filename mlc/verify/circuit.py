@@ -2,8 +2,8 @@
 its truth table, statically or by Brownian dynamics.
 
 * **static**: for each row, the equilibrium reached from the scene's rest pose by moving
-  the muscles (:func:`mlc.verify.static.equilibrium`, without its polish: ``polish``
-  below), every probe read; a row passes
+  the muscles (:func:`mlc.verify.static.equilibrium`, polished only where it stalled:
+  ``polish`` below), every probe read; a row passes
   when every probe reads the expected bit with the length within ``tol_length`` of the
   ideal, the largest joint stretch is within ``tol_stretch`` (no gate strained by its
   wiring), and no two slabs of different bodies interpenetrate in that pose
@@ -77,16 +77,17 @@ def select_rows(scene: Scene, rows=None) -> list[str]:
 
 def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_stretch: float = TOL_STRETCH,
                   clearance: bool = True, progress=None, require_clearance: bool = False,
-                  kT: float | None = 1e-5, polish: bool = False) -> Report:
+                  kT: float | None = 1e-5, polish: bool | None = None) -> Report:
     """Static check of every row in ``rows`` (default all), see the module docstring.  With
     ``kT`` (k0 sigma^2; None: skipped) each entry also gets ``thermal_sd``, the probe's
     harmonic thermal spread in that row's equilibrium (sigma,
     :func:`mlc.verify.dynamic.probe_thermal_sd`), and each row ``thermal_ok``: every
     expected bit read with a margin of at least ``THERMAL_SDS`` spreads.  Like clearance it
     is its own verdict and a warning: a row that fails it computes right at rest but not
-    reliably at ``kT`` (docs/circuits.md, "Thermal spread").  ``polish``: end each row's
-    equilibrium with its polish, which moves the bodies by ~1e-9 sigma and takes about half
-    of the minimisation time (:func:`mlc.verify.static.equilibrium`).
+    reliably at ``kT`` (docs/circuits.md, "Thermal spread").  ``polish``: that of
+    :func:`mlc.verify.static.equilibrium`; by default (None) a row's equilibrium is polished
+    only when its minimisation stalled with a joint stretched or a muscle strained by more
+    than ``POLISH_ABOVE``.
 
     ``progress(done, total)``: called as rows finish (``done`` whole rows of ``total``) and
     within a row (``done`` fractional: ``ROW_SHARES`` of the row after its equilibrium's

@@ -47,6 +47,7 @@ REG = 1e-9                  # k0: weight of the least-motion term on zero-energy
 REG_POLISH = 1e-16          # k0: the same in the final polish (removes REG's bias on the pose)
 ACCEL_H = 0.1               # finite-difference step (fraction of dx) for the geodesic acceleration
 ACCEL_RATIO = 1.5           # the acceleration is used while |a| <= this |dx| (|a/2| <= 0.75 |dx|)
+POLISH_ABOVE = 1e-7         # sigma: polish=None polishes only when a joint is stretched or a muscle strained more
 STIFF_CAP = 4.0             # bonds stiffer than this many times the stiffest muscle are softened to it
                             # for the continuation, then restored for the polish (see equilibrium)
 
@@ -307,7 +308,7 @@ def _state_bits(scene: Scene, state: str) -> np.ndarray:
 
 def equilibrium(scene: Scene, state: str, start_state: str | None = None,
                 steps: int = CONTINUATION_STEPS, pos=None, quat=None, lu_of=None, progress=None,
-                polish: bool = True) -> Equilibrium:
+                polish: bool | None = True) -> Equilibrium:
     """Equilibrium of ``scene`` with its inputs in ``state``, reached by continuation from
     the scene's own poses (or ``pos``/``quat``), taken to be the equilibrium of
     ``start_state`` (default all 0).  ``lu_of``: the factorisation of the normal equations
@@ -317,11 +318,14 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
     takes minutes, and its progress bar moves within it.
 
     ``polish``: end with a minimisation at ``REG_POLISH``, which takes the least-motion
-    term's bias off the pose.  That bias is of order ``REG`` (1e-9 sigma), far below any
-    tolerance of a read length, but the circuit builder poses its gates with it and the
-    scenes it writes depend on those last bits.  In a connector circuit the polish crawls
-    along the chains' floppy modes: it is about half of a row's minimisation time, so the
-    circuits' static verifier leaves it out (``polish=False``; docs/circuits.md)."""
+    term's bias off the pose and finishes a minimisation that stalled short of equilibrium.
+    In a connector circuit it crawls along the chains' floppy modes, a third of a row's
+    factorisations (benchmarks/results/static_polish.json).  ``True``: always (the circuit
+    builder poses its gates so, and the scenes it writes depend on those last bits);
+    ``False``: never; ``None``: only when the pose before it has a joint stretched or a
+    muscle strained by more than ``POLISH_ABOVE`` (sigma), that is, when the minimisation
+    stalled; otherwise the pose is the one ``True`` starts its polish from (what the
+    circuits' static verifier uses; docs/circuits.md, "Speed")."""
     A = scene.arrays()
     target = _state_bits(scene, state)
     start = _state_bits(scene, start_state or "0" * len(scene.inputs))
@@ -334,7 +338,7 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
         stiff = bool(np.any(prob.bond_k > k_cap))
         if stiff:                                       # stiffness homotopy (module docstring)
             prob.bond_k = np.minimum(prob.bond_k, k_cap)
-        total, done = len(path) + stiff + polish, 0
+        total, done = len(path) + stiff + (polish is not False), 0
 
         def tick():
             nonlocal done
@@ -348,19 +352,28 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
             prob.bond_k = np.array(A.bond_k, float)
             nit += _minimise(prob, L1, lu_of=lu_of)
             tick()
-        if polish:
+        if polish or (polish is None and max(_strains(prob, L1)) > POLISH_ABOVE):
             nit += _minimise(prob, L1, reg=REG_POLISH, lu_of=lu_of)     # the least-motion bias removed
+        if polish is not False:
             tick()
     pos, R = prob.pos, prob.R
     p, _ = prob.sites()
     quat = np.array([matrix_to_quat(r) for r in R]) if len(R) else np.zeros((0, 4))
+    stretch, strain = _strains(prob, L1)
+    probes = {pr.name: float(np.linalg.norm(p[A.probe_i[i]] - p[A.probe_j[i]])) for i, pr in enumerate(scene.probes)}
+    r = prob.residuals(L1) if prob.m else np.zeros(0)
+    return Equilibrium(state, pos.copy(), quat, probes, stretch, strain, float(0.5 * r @ r), nit)
+
+
+def _strains(prob: _Problem, L_muscle) -> tuple[float, float]:
+    """(largest joint stretch beyond its tolerance, largest | muscle length - L |) at the
+    current poses (sigma)."""
+    A = prob.A
+    p, _ = prob.sites()
     d = np.linalg.norm(p[A.bond_i] - p[A.bond_j], axis=1) if len(A.bond_i) else np.zeros(0)
     stretch = np.maximum(0.0, np.abs(d - A.bond_rest) - A.bond_tol) if len(d) else np.zeros(0)
     dm = np.linalg.norm(p[A.muscle_i] - p[A.muscle_j], axis=1) if len(A.muscle_i) else np.zeros(0)
-    probes = {pr.name: float(np.linalg.norm(p[A.probe_i[i]] - p[A.probe_j[i]])) for i, pr in enumerate(scene.probes)}
-    r = prob.residuals(L1) if prob.m else np.zeros(0)
-    return Equilibrium(state, pos.copy(), quat, probes, float(stretch.max(initial=0.0)),
-                       float(np.abs(dm - L1).max(initial=0.0)), float(0.5 * r @ r), nit)
+    return float(stretch.max(initial=0.0)), float(np.abs(dm - L_muscle).max(initial=0.0))
 
 
 def solve_states(scene: Scene) -> dict[str, Equilibrium]:
