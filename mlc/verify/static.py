@@ -27,7 +27,10 @@ its stall test stops it short of equilibrium.  The continuation is therefore run
 bond softened to at most ``STIFF_CAP`` times the stiffest muscle (a homotopy in stiffness:
 the equilibrium of a mechanism whose joints hold moves by O(load/k) with k, a fraction of
 the joint stretch, below 1e-3 sigma), and the real stiffnesses are restored for the last
-two minimisations, which start next to their solution and converge in a few steps.
+minimisations (the restoring one and the polish), which start next to their solution.
+The restoring one can still stall (bcd7seg's row 1111: joint stretch 4.4e-5 sigma,
+benchmarks/results/static_polish.json); the polish then finishes it, which is why
+``equilibrium(polish=None)`` polishes exactly where a joint or muscle is left off.
 """
 from __future__ import annotations
 
