@@ -14,8 +14,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 
 from mlc.cli import main
+from mlc.scene import io
 
 ROOT = Path(__file__).resolve().parents[1]
 SLOW = {"bcd7seg.pla"}
@@ -52,6 +54,9 @@ def test_every_example_becomes_a_circuit_that_verifies(example, tmp_path, capsys
     n_inputs = json.loads(capsys.readouterr().out)["inputs"]
     scene = out / "circuit.yaml"
     assert scene.exists()
+    if yaml.__with_libyaml__:                   # libyaml's emitter writes what the Python one would
+        data = io.scene_to_data(io.load_scene(scene))
+        assert io._emit(data, io._CDumper) == io._emit(data, io._PyDumper)
     rows = _rows(n_inputs)
     rc = main(["verify", str(scene), "--json"] + (["--rows", *rows] if rows else []))
     rep = json.loads(capsys.readouterr().out)

@@ -177,13 +177,58 @@ def test_alias_limit_allows_ordinary_reuse():
     assert str(e.value).startswith("b.yaml:7:")
 
 
+def _locs(x, out):
+    """Every location a loaded document records, depth first."""
+    if isinstance(x, dict):
+        out += [x.loc, *x.item_locs.values()]
+        for v in x.values():
+            _locs(v, out)
+    elif isinstance(x, list):
+        out += [x.loc, *x.item_locs]
+        for v in x:
+            _locs(v, out)
+    return out
+
+
+@pytest.mark.skipif(not yamlsrc.yaml.__with_libyaml__, reason="PyYAML built without libyaml")
+def test_libyaml_reads_what_the_python_loader_reads_and_errors_keep_its_words(scene_text, monkeypatch):
+    text = scene_text + "extra: [1e308, 0x1f, -2E-3, ~, yes, '1']\n"
+    fast = yamlsrc._CLoader(text, "s.yaml").get_single_data()
+    slow = yamlsrc._Loader(text, "s.yaml").get_single_data()
+    assert fast == slow and _locs(fast, []) == _locs(slow, []) and len(_locs(fast, [])) > 100
+    assert fast["extra"] == [1e308, 31, -2e-3, None, True, "1"]
+    calls = []
+
+    class Python(yamlsrc._Loader):
+        def __init__(self, *a):
+            calls.append(a[1])
+            super().__init__(*a)
+    monkeypatch.setattr(yamlsrc, "_Loader", Python)
+    assert yamlsrc.load(text, "s.yaml") == slow and calls == []      # a good file: libyaml's parser only
+    with pytest.raises(MlcError) as e:                                 # a bad one: the Python parser's words
+        yamlsrc.load("a: [1, 2\nb: 3\n", "bad.yaml")
+    assert calls == ["bad.yaml"] and str(e.value).startswith("bad.yaml:2:") and "expected ',' or ']'" in str(e.value)
+    with pytest.raises(MlcError, match="duplicate key 'a'"):
+        yamlsrc.load("a: 1\na: 2\n", "dup.yaml")
+    assert calls == ["bad.yaml", "dup.yaml"]
+
+
 def test_yaml_size_limit(scene_text, tmp_path, monkeypatch, capsys):
+    from mlc.scene import io
+    assert io.MAX_SCENE_BYTES > 184 * 2 ** 20 > yamlsrc.MAX_BYTES    # a 200-gate circuit's scene loads
     src = tmp_path / "s.yaml"
     src.write_text(scene_text)
-    monkeypatch.setattr(yamlsrc, "MAX_BYTES", len(scene_text.encode()) - 1)   # one byte too many
+    monkeypatch.setattr(io, "MAX_SCENE_BYTES", len(scene_text.encode()) - 1)   # one byte too many
     before = listing(tmp_path)
     code, _, err = run(capsys, "draw", src, "-o", tmp_path / "x.png")
     assert_clean_failure(code, err, before, tmp_path, str(src), "larger than")
+    with pytest.raises(MlcError, match="larger than"):
+        io.parse_scene(scene_text, "s.yaml")
+    monkeypatch.setattr(io, "MAX_SCENE_BYTES", len(scene_text.encode()))
+    assert io.load_scene(src).name == io.parse_scene(scene_text).name
+    monkeypatch.setattr(yamlsrc, "MAX_BYTES", len(scene_text.encode()) - 1)   # other YAML: their own limit
+    with pytest.raises(MlcError, match="larger than"):
+        yamlsrc.read_text(src)
     monkeypatch.setattr(yamlsrc, "MAX_BYTES", len(scene_text.encode()))
     assert yamlsrc.read_text(src) == scene_text
 

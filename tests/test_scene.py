@@ -16,6 +16,24 @@ def test_round_trip_is_stable():
     assert np.array_equal(a.site_local, b.site_local) and np.array_equal(a.bond_i, b.bond_i)
 
 
+def test_libyaml_writes_the_same_scene_text_as_the_python_emitter():
+    """dump_scene takes libyaml's emitter when PyYAML has it; the text must not change
+    (the dynamic campaigns key their scenes by it).  Every library gate here, every
+    example circuit in tests/test_circuit_examples.py."""
+    import yaml
+
+    from mlc.gates.library import GATE_NAMES, SIGNALS
+    from mlc.scene import io
+
+    if not yaml.__with_libyaml__:
+        pytest.skip("PyYAML built without libyaml: dump_scene uses the Python emitter")
+    assert io._Dumper is io._CDumper
+    for gate in GATE_NAMES:
+        for conv in SIGNALS:
+            data = io.scene_to_data(gate_scene(gate, conv))
+            assert io._emit(data, io._CDumper) == io._emit(data, io._PyDumper), (gate, conv)
+
+
 def test_arrays_shapes():
     a = gate_scene("AND", "contract").arrays()
     assert a.pos.shape == (8, 3) and a.quat.shape == (8, 4)
