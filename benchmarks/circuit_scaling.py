@@ -153,8 +153,12 @@ def check_point(point: dict, sc, verify_budget: float | None = None) -> dict:
         if verify_budget:
             signal.setitimer(signal.ITIMER_REAL, 0)
             signal.signal(signal.SIGALRM, old)
-    point.update({"verify_row_s": rep.rows[0]["seconds"], "ok": rep.ok, "clearance": rep.rows[0].get("clearance"),
-                  "joint_stretch": rep.rows[0]["joint_stretch"], "polish": "auto"})
+    r = rep.rows[0]
+    point.update({"verify_row_s": r["seconds"], "ok": rep.ok, "clearance": r.get("clearance"),
+                  "joint_stretch": r["joint_stretch"], "muscle_strain": r["muscle_strain"],
+                  "iterations": r["iterations"], "polish": "auto",
+                  "failures": [{k: e[k] for k in ("output", "expected", "bit", "measured", "margin", "error")}
+                               for e in rep.failures()]})
     return point
 
 

@@ -12,6 +12,7 @@ from mlc.pipeline import compile_spec
 from mlc.scene.io import dump_scene, parse_scene
 from mlc.verify.circuit import format_report, verify_static
 from mlc.verify.overlap import clearance
+from mlc.verify.static import CONTINUATION_STEPS
 
 
 @pytest.fixture(scope="module")
@@ -55,6 +56,7 @@ def test_every_row_verifies_statically_and_reports_clearance(tetris):
     assert len(rep.rows) == 4
     for row in rep.rows:
         assert row["joint_stretch"] < 1e-3           # no gate strained by its wiring
+        assert row["muscle_strain"] < 1e-3 and row["iterations"] >= CONTINUATION_STEPS   # each step minimised
         assert isinstance(row["clearance"], float) and row["clearance_ok"] == (row["clearance"] > -1e-6)
         # the lanes keep every pair of slabs of different bodies apart in every row (exact box test)
         assert row["clearance"] > 0, (row["state"], row["clearance_pair"])

@@ -128,7 +128,8 @@ def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_s
                 if margin is not None and not margin >= THERMAL_SDS * sd[pr.name]:
                     thermal_ok = False
             rep.entries.append(entry)
-        row = {"state": state, "joint_stretch": eq.max_joint_stretch, "seconds": 0.0}
+        row = {"state": state, "joint_stretch": eq.max_joint_stretch, "muscle_strain": eq.max_muscle_strain,
+               "iterations": eq.iterations, "seconds": 0.0}
         if sd:
             row["thermal_ok"] = thermal_ok
         if clearance:
