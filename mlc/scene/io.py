@@ -136,8 +136,9 @@ _PyDumper.add_representer(list, _repr_list)
 if yaml.__with_libyaml__:
     class _CDumper(yaml.CSafeDumper):
         """libyaml's emitter behind the same representers: the same text as :class:`_PyDumper`
-        (tests/test_scene_io.py compares them on every gate and example circuit), 2.4 to 2.8
-        times faster; a 200-gate circuit's 184 MB scene took 13 minutes with the other."""
+        (tests/test_scene.py and tests/test_circuit_examples.py compare them on every gate and
+        example circuit), 2.7 to 3.3 times faster (benchmarks/results/scene_io.json); a
+        200-gate circuit's 184 MB scene took 13 minutes with the other."""
 
     _CDumper.add_representer(list, _repr_list)
     _Dumper = _CDumper
