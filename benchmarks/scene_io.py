@@ -61,7 +61,6 @@ def measure(name: str, scene) -> dict:
     data = io.scene_to_data(scene)
     py_text, py_w = _timed(lambda: io._emit(data, io._PyDumper))
     c_text, c_w = _timed(lambda: io._emit(data, io._CDumper))
-    del data
     text = io.dump_scene(scene)
     py_data, py_r = _timed(lambda: yamlsrc._Loader(text, name).get_single_data())
     c_data, c_r = _timed(lambda: yamlsrc._CLoader(text, name).get_single_data())
