@@ -170,10 +170,13 @@ def checked_saved(point: dict | None, folder: Path, family: str, w: int, verify_
         raise SystemExit(f"{family} {w}: no committed point with a saved scene (build it with --save-scenes)")
     if not path.is_file():
         raise SystemExit(f"{path}: no such scene (build it with --save-scenes {folder})")
+    t0 = time.perf_counter()
     sc = load_scene(path)
+    t1 = time.perf_counter()
     if scene_digest(dump_scene(sc)) != point["scene_sha"]:
         raise SystemExit(f"{path} is not the scene of the committed {family} {w} point (scene_sha differs)")
-    return check_point(dict(point), sc, verify_budget)
+    point = dict(point, scene_load_s=t1 - t0, scene_dump_s=time.perf_counter() - t1)
+    return check_point(point, sc, verify_budget)
 
 
 def fit_and_goals(points: list[dict]):

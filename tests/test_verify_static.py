@@ -164,3 +164,44 @@ def test_the_polish_is_left_out_only_where_the_minimisation_converged(monkeypatc
     assert not np.array_equal(a.pos, b.pos)                              # the polish did run in a
     monkeypatch.setattr(static, "POLISH_ABOVE", 0.0)
     assert np.array_equal(equilibrium(sc, row, polish=None).pos, a.pos)
+
+
+def test_a_minimisation_cut_short_is_reported_as_not_converged(monkeypatch):
+    """Equilibrium.converged is False when the minimisation stopped short (here: one
+    iteration a step), True when it reached equilibrium; verify_static passes it on, and
+    the report says the lengths of such a row are no equilibrium's, and names --dynamic."""
+    from mlc.verify import static
+    from mlc.verify.circuit import format_report, verify_static
+
+    s = gate_scene("NAND", "expand")
+    assert equilibrium(s, "11").converged
+    monkeypatch.setattr(static, "GN_MAX_ITER", 1)
+    eq = equilibrium(s, "11", polish=False)
+    assert not eq.converged and eq.max_joint_stretch > static.POLISH_ABOVE
+    rep = verify_static(s, rows=["11"], kT=None, polish=False)
+    assert rep.rows[0]["converged"] is False and rep.rows[0]["iterations"] == static.CONTINUATION_STEPS
+    assert rep.rows[0]["joint_stretch"] == eq.max_joint_stretch
+    if not rep.ok:
+        assert "stopped short of equilibrium" in format_report(rep) and "--dynamic --rows 11" in format_report(rep)
+
+
+def test_the_report_tells_a_right_bit_off_its_length_from_a_wrong_bit():
+    """A read with the right bit but too far from its length is not called a wrong bit, and a
+    probe on a zero-stiffness mode (infinite harmonic spread) gets its own warning instead of
+    a --joint-k suggestion of infinity."""
+    from mlc.verify.circuit import Report, format_report
+
+    rep = Report("c", "static", params={"tol_length": 0.05, "tol_stretch": 1e-3, "kT": 1e-5, "joint_k": 1.0})
+    rep.entries = [
+        {"state": "11", "output": "y0", "expected": 0, "measured": 1.1058, "bit": 0, "margin": 0.1442,
+         "error": 0.1058, "ok": False, "thermal_sd": float("inf")},
+        {"state": "11", "output": "y1", "expected": 1, "measured": 1.1, "bit": 0, "margin": -0.15,
+         "error": 0.4, "ok": False, "thermal_sd": 0.01}]
+    rep.rows = [{"state": "11", "joint_stretch": 7.7e-4, "converged": False, "iterations": 98, "clearance": 0.02,
+                 "ok": False}]
+    text = format_report(rep)
+    assert "output y0: bit 0 as expected, but read 1.1058 sigma, 0.1058 sigma from its length" in text
+    assert "output y1: expected 1, read 1.1000 sigma (bit 0)" in text
+    assert "row 11, output y0 (and 0 more entries, in 1 rows) sits on a mode of zero stiffness" in text
+    assert "stopped short of equilibrium (joint stretch 7.70e-04 sigma after 98 iterations)" in text
+    assert "inf" not in text.replace("infinite", "")

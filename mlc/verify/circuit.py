@@ -129,7 +129,7 @@ def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_s
                     thermal_ok = False
             rep.entries.append(entry)
         row = {"state": state, "joint_stretch": eq.max_joint_stretch, "muscle_strain": eq.max_muscle_strain,
-               "iterations": eq.iterations, "seconds": 0.0}
+               "iterations": eq.iterations, "converged": eq.converged, "seconds": 0.0}
         if sd:
             row["thermal_ok"] = thermal_ok
         if clearance:
@@ -221,14 +221,31 @@ def format_report(rep: Report) -> str:
     else:
         for e in bad[:10]:
             want = "don't care" if e["expected"] is None else e["expected"]
-            lines.append(f"WRONG: row {e['state']}, output {e['output']}: expected {want}, read "
-                         f"{e['measured']:.4f} sigma (bit {e['bit']})")
+            if e["bit"] == e["expected"] and e.get("error") is not None:
+                lines.append(f"WRONG: row {e['state']}, output {e['output']}: bit {e['bit']} as expected, but "
+                             f"read {e['measured']:.4f} sigma, {e['error']:.4f} sigma from its length (tolerance "
+                             f"{rep.params.get('tol_length', TOL_LENGTH)})")
+            else:
+                lines.append(f"WRONG: row {e['state']}, output {e['output']}: expected {want}, read "
+                             f"{e['measured']:.4f} sigma (bit {e['bit']})")
         for r in bad_rows:
+            if rep.mode == "static" and not r.get("converged", True):
+                lines.append(f"row {r['state']}: the static minimisation stopped short of equilibrium (joint "
+                             f"stretch {r['joint_stretch']:.2e} sigma after {r.get('iterations')} iterations), so "
+                             f"these lengths are not an equilibrium's; `mlc verify SCENE --dynamic --rows "
+                             f"{r['state']}` checks the row by Brownian dynamics (docs/circuits.md, 'Scaling')")
             if rep.mode == "static" and r["joint_stretch"] > rep.params.get("tol_stretch", TOL_STRETCH):
                 lines.append(f"WRONG: row {r['state']}: joint stretch {r['joint_stretch']:.2e} sigma "
                              f"(bound {rep.params.get('tol_stretch', TOL_STRETCH)})")
     thermal = [e for e in rep.entries if e.get("thermal_sd") is not None and e["margin"] is not None
                and not e["margin"] >= THERMAL_SDS * e["thermal_sd"]]
+    floppy = [e for e in thermal if not math.isfinite(e["thermal_sd"])]
+    thermal = [e for e in thermal if math.isfinite(e["thermal_sd"])]
+    if floppy:
+        rows_f = sorted({e["state"] for e in floppy})
+        lines.append(f"WARNING: row {floppy[0]['state']}, output {floppy[0]['output']} (and {len(floppy) - 1} more "
+                     f"entries, in {len(rows_f)} rows) sits on a mode of zero stiffness in the pose found: its "
+                     f"harmonic thermal spread is unbounded")
     if thermal:
         w = min(thermal, key=lambda e: e["margin"] / e["thermal_sd"] if e["thermal_sd"] > 0 else -1.0)
         rows_t = sorted({e["state"] for e in thermal})

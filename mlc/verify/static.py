@@ -16,7 +16,9 @@ modes, a connector chain's floppy bending) are fixed by a weak term
 continuation step: among all equilibria the solver takes the one reached by the least
 motion, which is what overdamped dynamics does quasi-statically (a floppy mode has no
 force on it, and the drag makes the least-dissipation path the one taken).  ``REG`` is
-small enough (1e-9 k0) that it biases joint stretch by less than 1e-8 sigma.  The Jacobian is assembled with numpy, without Python loops over bonds,
+small enough (1e-9 k0) that it biases joint stretch by less than 1e-8 sigma in the
+examples; its pull adds up along a circuit's chains, to a few 1e-6 sigma in a 200-gate
+one, which the final polish removes.  The Jacobian is assembled with numpy, without Python loops over bonds,
 so a circuit of ~10^4 bodies solves in seconds.  The muscles are moved from the starting
 state to the target in a few continuation steps so that the solution stays on the
 mechanism's physical branch.
@@ -66,6 +68,7 @@ class Equilibrium:
     energy: float                   # k0 sigma^2
     iterations: int = 0
     rows: list = field(default_factory=list)
+    converged: bool = True          # False: the minimisation stopped short (see equilibrium)
 
 
 def _expmap_batch(w: np.ndarray) -> np.ndarray:
@@ -328,7 +331,15 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
     ``False``: never; ``None``: only when the pose before it has a joint stretched or a
     muscle strained by more than ``POLISH_ABOVE`` (sigma), that is, when the minimisation
     stalled; otherwise the pose is the one ``True`` starts its polish from (what the
-    circuits' static verifier uses; docs/circuits.md, "Speed")."""
+    circuits' static verifier uses; docs/circuits.md, "Speed").
+
+    The result's ``converged`` is False when the last minimisation stopped short of
+    equilibrium: a joint stretched or a muscle strained by more than ``POLISH_ABOVE`` with
+    more energy left in the bonds than the least-motion term (``REG``) holds on the motion
+    of that minimisation.  At a regularised equilibrium that term holds at least as much
+    (its pull, summed along a deep circuit's chains, stretches joints by a few 1e-6 sigma);
+    a minimisation that crawled along a long curved valley keeps most of its energy in the
+    bonds (the 200-gate mesh's all-ones row, docs/circuits.md, "Scaling")."""
     A = scene.arrays()
     target = _state_bits(scene, state)
     start = _state_bits(scene, start_state or "0" * len(scene.inputs))
@@ -365,7 +376,9 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
     stretch, strain = _strains(prob, L1)
     probes = {pr.name: float(np.linalg.norm(p[A.probe_i[i]] - p[A.probe_j[i]])) for i, pr in enumerate(scene.probes)}
     r = prob.residuals(L1) if prob.m else np.zeros(0)
-    return Equilibrium(state, pos.copy(), quat, probes, stretch, strain, float(0.5 * r @ r), nit)
+    energy = float(0.5 * r @ r)
+    converged = max(stretch, strain) <= POLISH_ABOVE or energy <= 0.5 * REG * float(np.sum(prob.disp ** 2))
+    return Equilibrium(state, pos.copy(), quat, probes, stretch, strain, energy, nit, converged=converged)
 
 
 def _strains(prob: _Problem, L_muscle) -> tuple[float, float]:
