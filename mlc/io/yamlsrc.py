@@ -123,8 +123,8 @@ if yaml.__with_libyaml__:
     class _CLoader(_Limits, Composer, CParser, SafeConstructor, Resolver):
         """:class:`_Loader` on libyaml's scanner and parser: the same composer (so the same
         limits), constructors and marks, 2.9 to 3.3 times faster on circuit scenes
-        (benchmarks/results/scene_io.json; a 200-gate one is 184 MB).  Only for reading: any error is reported by :class:`_Loader`, whose words
-        the messages keep (:func:`load`)."""
+        (benchmarks/results/scene_io.json; a 200-gate one is 184 MB).  Only for reading:
+        any error is reported again by :class:`_Loader`, in its words (:func:`load`)."""
 
         def __init__(self, stream, filename: str):
             CParser.__init__(self, stream)

@@ -17,7 +17,8 @@ from mlc.scene.model import Body, Bond, Box, Muscle, Probe, Scene, check_row
 
 FORMAT_VERSION = 1
 #: Largest scene file read, in bytes: a 200-gate circuit's scene is 184 MB (docs/circuits.md,
-#: "Scaling"), well over the 64 MB other YAML inputs may have; this allows about 1000 gates.
+#: "Scaling"), well over the 64 MB other YAML inputs may have; this allows some 900 gates
+#: (bodies grow as gates^1.17, benchmarks/results/circuit_scaling.json).
 MAX_SCENE_BYTES = 2 ** 30
 _IDQ = [1.0, 0.0, 0.0, 0.0]
 
