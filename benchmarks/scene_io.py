@@ -45,18 +45,6 @@ def _timed(f):
     return out, time.perf_counter() - t0
 
 
-def _locs(x, out):
-    if isinstance(x, dict):
-        out += [x.loc, *x.item_locs.values()]
-        for v in x.values():
-            _locs(v, out)
-    elif isinstance(x, list):
-        out += [x.loc, *x.item_locs]
-        for v in x:
-            _locs(v, out)
-    return out
-
-
 def measure(name: str, scene) -> dict:
     data = io.scene_to_data(scene)
     py_text, py_w = _timed(lambda: io._emit(data, io._PyDumper))
@@ -64,7 +52,7 @@ def measure(name: str, scene) -> dict:
     text = io.dump_scene(scene)
     py_data, py_r = _timed(lambda: yamlsrc._Loader(text, name).get_single_data())
     c_data, c_r = _timed(lambda: yamlsrc._CLoader(text, name).get_single_data())
-    same_data = py_data == c_data and _locs(py_data, []) == _locs(c_data, [])
+    same_data = py_data == c_data and yamlsrc.locations(py_data) == yamlsrc.locations(c_data)
     del py_data, c_data
     parsed, parse_s = _timed(lambda: io.parse_scene(text, name))
     return {"scene": name, "bodies": len(scene.bodies), "mb": len(text.encode()) / 2 ** 20,

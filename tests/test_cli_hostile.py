@@ -177,25 +177,14 @@ def test_alias_limit_allows_ordinary_reuse():
     assert str(e.value).startswith("b.yaml:7:")
 
 
-def _locs(x, out):
-    """Every location a loaded document records, depth first."""
-    if isinstance(x, dict):
-        out += [x.loc, *x.item_locs.values()]
-        for v in x.values():
-            _locs(v, out)
-    elif isinstance(x, list):
-        out += [x.loc, *x.item_locs]
-        for v in x:
-            _locs(v, out)
-    return out
-
-
 @pytest.mark.skipif(not yamlsrc.yaml.__with_libyaml__, reason="PyYAML built without libyaml")
 def test_libyaml_reads_what_the_python_loader_reads_and_errors_keep_its_words(scene_text, monkeypatch):
     text = scene_text + "extra: [1e308, 0x1f, -2E-3, ~, yes, '1']\n"
     fast = yamlsrc._CLoader(text, "s.yaml").get_single_data()
     slow = yamlsrc._Loader(text, "s.yaml").get_single_data()
-    assert fast == slow and _locs(fast, []) == _locs(slow, []) and len(_locs(fast, [])) > 100
+    locs = yamlsrc.locations(fast)
+    assert fast == slow and locs == yamlsrc.locations(slow) and len(locs) > 100
+    assert locs[0] == yamlsrc.Loc("s.yaml", 3, 1) and len(set(locs)) > 100      # distinct places, after the header
     assert fast["extra"] == [1e308, 31, -2e-3, None, True, "1"]
     calls = []
 

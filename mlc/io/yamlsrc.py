@@ -60,6 +60,21 @@ class LocList(list):
             return self.loc
 
 
+def locations(data) -> list:
+    """Every :class:`~mlc.errors.Loc` a loaded document records, depth first (to compare two
+    loaders)."""
+    out, stack = [], [data]
+    while stack:
+        x = stack.pop()
+        if isinstance(x, dict):
+            out += [x.loc, *x.item_locs.values()]
+            stack.extend(reversed(list(x.values())))
+        elif isinstance(x, list):
+            out += [x.loc, *x.item_locs]
+            stack.extend(reversed(x))
+    return out
+
+
 def _at(filename, mark) -> Loc:
     return Loc(filename, mark.line + 1, mark.column + 1) if mark is not None else Loc(filename)
 
