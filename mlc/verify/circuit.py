@@ -230,10 +230,11 @@ def format_report(rep: Report) -> str:
                              f"{e['measured']:.4f} sigma (bit {e['bit']})")
         for r in bad_rows:
             if rep.mode == "static" and not r.get("converged", True):
-                lines.append(f"row {r['state']}: the static minimisation stopped short of equilibrium (joint "
-                             f"stretch {r['joint_stretch']:.2e} sigma after {r.get('iterations')} iterations), so "
-                             f"these lengths are not an equilibrium's; `mlc verify SCENE --dynamic --rows "
-                             f"{r['state']}` checks the row by Brownian dynamics (docs/circuits.md, 'Scaling')")
+                lines.append(f"row {r['state']}: the static minimisation ended with energy left in the bonds "
+                             f"(joint stretch {r['joint_stretch']:.2e} sigma after {r.get('iterations')} "
+                             f"iterations): it stopped short of equilibrium, or the mechanism is jammed; "
+                             f"`mlc verify SCENE --dynamic --rows {r['state']}` checks the row by Brownian "
+                             f"dynamics (docs/circuits.md, 'Scaling')")
             if rep.mode == "static" and r["joint_stretch"] > rep.params.get("tol_stretch", TOL_STRETCH):
                 lines.append(f"WRONG: row {r['state']}: joint stretch {r['joint_stretch']:.2e} sigma "
                              f"(bound {rep.params.get('tol_stretch', TOL_STRETCH)})")

@@ -68,7 +68,7 @@ class Equilibrium:
     energy: float                   # k0 sigma^2
     iterations: int = 0
     rows: list = field(default_factory=list)
-    converged: bool = True          # False: the minimisation stopped short (see equilibrium)
+    converged: bool = True          # False: stopped short, or jammed (see equilibrium)
 
 
 def _expmap_batch(w: np.ndarray) -> np.ndarray:
@@ -333,13 +333,15 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
     stalled; otherwise the pose is the one ``True`` starts its polish from (what the
     circuits' static verifier uses; docs/circuits.md, "Speed").
 
-    The result's ``converged`` is False when the last minimisation stopped short of
-    equilibrium: a joint stretched or a muscle strained by more than ``POLISH_ABOVE`` with
-    more energy left in the bonds than the least-motion term (``REG``) holds on the motion
-    of that minimisation.  At a regularised equilibrium that term holds at least as much
-    (its pull, summed along a deep circuit's chains, stretches joints by a few 1e-6 sigma);
-    a minimisation that crawled along a long curved valley keeps most of its energy in the
-    bonds (the 200-gate mesh's all-ones row, docs/circuits.md, "Scaling")."""
+    The result's ``converged`` is False when the last minimisation ended with a joint
+    stretched or a muscle strained by more than ``POLISH_ABOVE`` and more energy left in the
+    bonds than the least-motion term (``REG``) holds on the motion of that minimisation.  At
+    the regularised equilibrium of a mechanism that can meet all its bonds that term holds
+    at least as much (its pull, summed along a deep circuit's chains, stretches joints by a
+    few 1e-6 sigma); a minimisation that crawled along a long curved valley keeps most of
+    its energy in the bonds (the 200-gate mesh's all-ones row, docs/circuits.md,
+    "Scaling").  So does a jammed mechanism at its true equilibrium: False means one of the
+    two, and only the dynamic check tells which."""
     A = scene.arrays()
     target = _state_bits(scene, state)
     start = _state_bits(scene, start_state or "0" * len(scene.inputs))
