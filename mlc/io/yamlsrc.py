@@ -80,7 +80,17 @@ def _at(filename, mark) -> Loc:
 
 
 class _Limits:
-    """The composer's limits on depth and alias expansion, and the file name, for both loaders."""
+    """The composer's limits on depth and alias expansion, and the file name, for both loaders.
+
+    It also constructs as it composes.  PyYAML composes a whole document into nodes (each
+    scalar a node with two marks) before it constructs any data: a circuit scene's nodes
+    take several times the memory of its data.  Each item of a top-level list or mapping
+    (a body, a bond: depth ``STREAM_DEPTH``) is therefore constructed as soon as it is
+    composed, and its nodes dropped; the document's node tree keeps only the empty shell of
+    each item, which the constructor then finds in its table of constructed objects.  An
+    item is kept as nodes when anchors could reach into it (the document has an anchor) or
+    when it is a merge key's value (``<<``), whose nodes the constructor of its parent
+    reads."""
 
     filename = "<input>"
 
@@ -89,7 +99,7 @@ class _Limits:
         self._depth = 0
         self._count = 0          # nodes of the document with every alias expanded
         self._written = 0        # nodes written out in the text
-        self._size: dict = {}    # id(node) -> expanded size of its subtree
+        self._size: dict = {}    # id(anchored node) -> expanded size of its subtree
 
     def compose_node(self, parent, index):
         if self.check_event(AliasEvent):
@@ -105,20 +115,43 @@ class _Limits:
                                f"nodes (an alias bomb?)", _at(self.filename, event.start_mark),
                                f"aliases may add at most {MAX_ALIAS_NODES:,} nodes; write the data out")
             return node
-        mark = self.peek_event().start_mark
+        event = self.peek_event()
         self._depth += 1
         if self._depth > MAX_DEPTH:
-            raise MlcError(f"lists and mappings nested more than {MAX_DEPTH} deep", _at(self.filename, mark),
-                           "flatten the data")
+            raise MlcError(f"lists and mappings nested more than {MAX_DEPTH} deep",
+                           _at(self.filename, event.start_mark), "flatten the data")
         before = self._count
         self._count += 1
         self._written += 1
         try:
             node = super().compose_node(parent, index)
+            if self._depth == STREAM_DEPTH and not self.anchors and not _is_merge_key(index) \
+                    and isinstance(node, (yaml.MappingNode, yaml.SequenceNode)):
+                self._construct_now(node)
         finally:
             self._depth -= 1
-        self._size[id(node)] = self._count - before
+        if getattr(event, "anchor", None) is not None:
+            self._size[id(node)] = self._count - before
         return node
+
+    def _construct_now(self, node):
+        """Construct ``node``'s data now, in a table of its own (no alias can reach into it),
+        and keep only its empty shell and its data."""
+        table, self.constructed_objects = self.constructed_objects, {}
+        try:
+            data = self.construct_object(node, deep=True)
+        finally:
+            self.constructed_objects = table
+        table[node] = data
+        node.value = []
+
+
+#: Depth (the document's root is 1) of the nodes :class:`_Limits` constructs as it composes.
+STREAM_DEPTH = 3
+
+
+def _is_merge_key(index) -> bool:
+    return isinstance(index, yaml.ScalarNode) and index.tag == "tag:yaml.org,2002:merge"
 
 
 class _Loader(_Limits, yaml.SafeLoader):
