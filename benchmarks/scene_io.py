@@ -9,7 +9,11 @@ A compiled circuit's scene grows with its bodies: 184 MB for the 200-gate mesh
 * read: ``mlc.io.yamlsrc.load`` with its pure-Python ``_Loader`` and with ``_CLoader``
   (libyaml's scanner and parser under the same composer and constructors), whether the
   data and every recorded source location are identical, and the whole ``parse_scene``
-  (read, schema, model) as ``load_scene`` does it.
+  (read, schema, model) as ``load_scene`` does it;
+* the memory of a read (libyaml's parser): the peak resident size a fresh process adds while
+  ``yamlsrc.load`` reads the text, with each item constructed as it is composed (what
+  ``load`` does, :class:`mlc.io.yamlsrc._Limits`) and with the whole node tree composed
+  first (``STREAM_DEPTH = 0``, PyYAML's own order), and the wall time of each.
 
 Scenes: the examples compiled as ``mlc compile`` does (``--examples``), and
 ``nand_mesh(7, depth)`` at -O0 for each ``--meshes`` depth (static_polish.py's builds).
@@ -25,6 +29,9 @@ import argparse
 import json
 import os
 import platform
+import subprocess
+import sys
+import tempfile
 import time
 from pathlib import Path
 
@@ -45,6 +52,42 @@ def _timed(f):
     return out, time.perf_counter() - t0
 
 
+_READ = """
+import sys, time, json
+from mlc.io import yamlsrc
+yamlsrc.STREAM_DEPTH = int(sys.argv[2])
+text = open(sys.argv[1], encoding="utf-8").read()
+
+def status(key):
+    with open("/proc/self/status") as f:
+        return next(int(line.split()[1]) for line in f if line.startswith(key + ":"))
+with open("/proc/self/clear_refs", "w") as f:
+    f.write("5")                       # the peak resident size (VmHWM) starts again from now
+before = status("VmRSS")
+t0 = time.perf_counter()
+data = yamlsrc.load(text, "s.yaml", max_bytes=2 ** 31)
+dt = time.perf_counter() - t0
+print(json.dumps({"s": dt, "peak_mb": (status("VmHWM") - before) / 1024}))
+"""
+
+
+def read_memory(text: str) -> dict:
+    """Peak resident MB that ``yamlsrc.load`` adds to a fresh process (Linux: the peak is
+    reset through /proc/self/clear_refs before the read), item by item (the default) and
+    whole tree first (``STREAM_DEPTH = 0``)."""
+    out = {}
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "s.yaml"
+        path.write_text(text, encoding="utf-8")
+        for key, depth in (("stream", yamlsrc.STREAM_DEPTH), ("tree", 0)):
+            r = subprocess.run([sys.executable, "-c", _READ, str(path), str(depth)], check=True,
+                               capture_output=True, text=True)
+            m = json.loads(r.stdout.strip().splitlines()[-1])
+            out[f"read_{key}_peak_mb"], out[f"read_{key}_s"] = m["peak_mb"], m["s"]
+    out["read_peak_ratio"] = out["read_tree_peak_mb"] / out["read_stream_peak_mb"]
+    return out
+
+
 def measure(name: str, scene) -> dict:
     data = io.scene_to_data(scene)
     py_text, py_w = _timed(lambda: io._emit(data, io._PyDumper))
@@ -60,7 +103,8 @@ def measure(name: str, scene) -> dict:
             "same_text": py_text == c_text,
             "read_python_s": py_r, "read_libyaml_s": c_r, "read_ratio": py_r / c_r,
             "same_data_and_locations": same_data,
-            "parse_scene_s": parse_s, "round_trip": io.dump_scene(parsed) == text}
+            "parse_scene_s": parse_s, "round_trip": io.dump_scene(parsed) == text,
+            **read_memory(text)}
 
 
 def plot(res: dict, path: Path) -> None:
@@ -68,7 +112,7 @@ def plot(res: dict, path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     pts = sorted(res["scenes"], key=lambda p: p["mb"])
-    fig, ax = plt.subplots(figsize=(6.4, 4.2))
+    fig, (ax, am) = plt.subplots(1, 2, figsize=(11, 4.2))
     for key, label, m in (("write_python_s", "write, Python emitter", "o--"),
                           ("write_libyaml_s", "write, libyaml emitter", "o-"),
                           ("read_python_s", "read, Python parser", "s--"),
@@ -80,6 +124,14 @@ def plot(res: dict, path: Path) -> None:
     ax.set_title("Scene files: PyYAML's Python and libyaml paths")
     ax.legend(fontsize=8)
     ax.grid(True, which="both", alpha=0.3)
+    for key, label, m in (("read_tree_peak_mb", "whole node tree, then data", "s--"),
+                          ("read_stream_peak_mb", "each item's data as it is read", "s-")):
+        am.loglog([p["mb"] for p in pts], [p[key] for p in pts], m, label=label)
+    am.set_xlabel("scene file (MB)")
+    am.set_ylabel("peak resident MB added by the read")
+    am.set_title("Memory of a read (libyaml parser)")
+    am.legend(fontsize=8)
+    am.grid(True, which="both", alpha=0.3)
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=110)
@@ -109,6 +161,8 @@ def main():
                        "libyaml_write_mb_per_s": tot["mb"] / tot["write_libyaml_s"],
                        "libyaml_read_mb_per_s": tot["mb"] / tot["read_libyaml_s"],
                        "parse_scene_mb_per_s": tot["mb"] / tot["parse_scene_s"],
+                       "read_peak_mb_per_file_mb": {k: [round(p[f"read_{k}_peak_mb"] / p["mb"], 1) for p in points]
+                                                    for k in ("stream", "tree")},
                        "all_same": all(p["same_text"] and p["same_data_and_locations"] and p["round_trip"]
                                        for p in points)}}
     OUT.mkdir(exist_ok=True)
