@@ -204,3 +204,30 @@ def test_the_report_tells_a_right_bit_off_its_length_from_a_wrong_bit():
     assert "ended with energy left in the bonds (joint stretch 7.70e-04 sigma after 98 iterations)" in text
     assert "stopped short of equilibrium, or the mechanism is jammed" in text and "--dynamic --rows 11" in text
     assert "inf" not in text.replace("infinite", "")
+
+
+def test_a_stall_stops_a_minimisation_at_once_only_where_its_bonds_are_closed(monkeypatch):
+    """One iteration that gains little (a stall) ends a minimisation whose joints and muscles
+    are within STALL_CLOSED; with bonds still off it takes STALL_RUN stalls in a row (a deep
+    circuit's cost falls in a sawtooth, docs/circuits.md).  Here every iteration counts as
+    stalled (STALL_GAIN > 1)."""
+    from mlc.verify import static
+    s = gate_scene("NAND", "expand")
+    A = s.arrays()
+    L = A.muscle_lengths(static._state_bits(s, "11"))
+    monkeypatch.setattr(static, "STALL_GAIN", 2.0)
+    monkeypatch.setattr(static, "STALL_RUN", 5)
+    prob = static._Problem(s, A.pos, A.quat, pin_first=False)           # at rest, the muscles at '11'
+    it = static._minimise(prob, L)                                      # stops at the first closed stall
+    assert 1 < it < 5 and max(static._strains(prob, L)) <= static.STALL_CLOSED
+    monkeypatch.setattr(static, "STALL_CLOSED", 0.0)                    # bonds never closed: STALL_RUN stalls
+    for run in (2, 5):
+        monkeypatch.setattr(static, "STALL_RUN", run)
+        prob = static._Problem(s, A.pos, A.quat, pin_first=False)
+        assert static._minimise(prob, L) == run
+    monkeypatch.undo()
+    eq = equilibrium(s, "11")                                          # at equilibrium: one stall ends it
+    prob = static._Problem(s, eq.pos, eq.quat, pin_first=False)
+    assert max(static._strains(prob, L)) <= static.STALL_CLOSED
+    before = prob.pos.copy()
+    assert static._minimise(prob, L) == 1 and np.abs(prob.pos - before).max() < 1e-9

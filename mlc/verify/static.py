@@ -30,8 +30,9 @@ bond softened to at most ``STIFF_CAP`` times the stiffest muscle (a homotopy in 
 the equilibrium of a mechanism whose joints hold moves by O(load/k) with k, a fraction of
 the joint stretch, below 1e-3 sigma), and the real stiffnesses are restored for the last
 minimisations (the restoring one and the polish), which start next to their solution.
-The restoring one can still stall (bcd7seg's row 1111: joint stretch 4.4e-5 sigma,
-benchmarks/results/static_polish.json); the polish then finishes it, which is why
+The restoring one can still stop short (bcd7seg's row 1111: joint stretch 4.4e-5 sigma,
+benchmarks/results/static_polish.json, measured when one stalled iteration stopped a
+minimisation; see :func:`_minimise`); the polish then finishes it, which is why
 ``equilibrium(polish=None)`` polishes exactly where a joint or muscle is left off.
 """
 from __future__ import annotations
@@ -53,6 +54,9 @@ REG_POLISH = 1e-16          # k0: the same in the final polish (removes REG's bi
 ACCEL_H = 0.1               # finite-difference step (fraction of dx) for the geodesic acceleration
 ACCEL_RATIO = 1.5           # the acceleration is used while |a| <= this |dx| (|a/2| <= 0.75 |dx|)
 POLISH_ABOVE = 1e-7         # sigma: polish=None polishes only when a joint is stretched or a muscle strained more
+STALL_GAIN = 1e-3           # an iteration that lowers the cost by less than this fraction of it has stalled
+STALL_RUN = 3               # stalled iterations in a row that stop a minimisation whose bonds are still off:
+STALL_CLOSED = 1e-7         # sigma: a joint stretched or a muscle strained by more than this
 STIFF_CAP = 4.0             # bonds stiffer than this many times the stiffest muscle are softened to it
                             # for the continuation, then restored for the polish (see equilibrium)
 
@@ -253,7 +257,16 @@ def _minimise(prob: _Problem, L, reg: float = None, lu_of=None) -> int:
     factorisation): moving a floppy chain along its linearised zero mode stretches its
     joints quadratically, and without the correction the step is cut back to a crawl
     (module doc).  The corrected step dx + a/2 is tried when |a| <= ACCEL_RATIO |dx|,
-    otherwise dx alone.  ``lu_of``: the factorisation (default :func:`colamd_lu`)."""
+    otherwise dx alone.  ``lu_of``: the factorisation (default :func:`colamd_lu`).
+
+    It stops when the cost is below 1e-30, when the largest update is below ``GN_TOL``,
+    when no damping gives a lower cost, after ``GN_MAX_ITER`` iterations, or when it stalls
+    (an iteration lowers the cost by less than ``STALL_GAIN`` of it): at once if no joint is stretched
+    nor any muscle strained by more than ``STALL_CLOSED``, otherwise after ``STALL_RUN``
+    stalled iterations in a row.  In a deep circuit the cost falls along a long, soft valley
+    in a sawtooth: an iteration whose damping was just raised gains little and the next
+    ones gain 3 to 10 % each (the 200-gate mesh's all-ones row, docs/circuits.md); one
+    stalled iteration there is no sign of an equilibrium."""
     reg = REG if reg is None else reg
     lu_of = colamd_lu if lu_of is None else lu_of
 
@@ -264,7 +277,7 @@ def _minimise(prob: _Problem, L, reg: float = None, lu_of=None) -> int:
     r = prob.residuals(L)
     cost = total(r)
     lam = 1e-6
-    it = 0
+    it = stalls = 0
     for it in range(1, GN_MAX_ITER + 1):
         if cost < 1e-30:
             break
@@ -294,13 +307,16 @@ def _minimise(prob: _Problem, L, reg: float = None, lu_of=None) -> int:
             c_new = total(r_new)
             if c_new <= cost:
                 improved = True
-                stalled = (cost - c_new) < 1e-3 * cost
+                stalled = (cost - c_new) < STALL_GAIN * cost
                 r, cost = r_new, c_new
                 lam = max(lam / 5.0, 1e-12)
                 break
             prob.restore(snap)
             lam *= 10.0
-        if not improved or stalled or float(np.abs(dx).max(initial=0.0)) < GN_TOL:
+        if not improved or float(np.abs(dx).max(initial=0.0)) < GN_TOL:
+            break
+        stalls = stalls + 1 if stalled else 0
+        if stalls and (stalls >= STALL_RUN or max(_strains(prob, L)) <= STALL_CLOSED):
             break
     return it
 
