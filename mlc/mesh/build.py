@@ -265,6 +265,9 @@ class Assembly:
     # orient @ print_pose[part] (print_T)
     print_pose: dict = field(default_factory=dict)
     print_config: dict = field(default_factory=dict)   # {input lever hinge: degrees from rest} printed
+    # print-only feet (mlc.mesh.feet): {part: volume added, mm^3}; empty: none
+    feet: dict = field(default_factory=dict)
+    feet_free: dict = field(default_factory=dict)    # {part: its solid before the feet} (measurements)
 
     def print_T(self, name: str) -> np.ndarray:
         """Model rest frame -> print frame (4x4, mm) of part ``name``: its configuration, then
@@ -344,7 +347,9 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     :func:`mlc.mesh.pipeline.state_poses` with ``max_move``): after the trims of the logic states,
     slabs that come closer than the clearance in any of these poses are trimmed too
     (:func:`_clear_motion`), as ``mlc stl`` does for a mechanism of fewer than
-    :data:`REUSE_MIN_PARTS` parts."""
+    :data:`REUSE_MIN_PARTS` parts; then the parts that move in one plane (a gate's lever loop) get
+    print-only feet down to the bed, clear of the other parts in these poses
+    (:func:`mlc.mesh.feet.add_feet`)."""
     try:
         return _build_assembly(scene, profile, poses, resolve, reuse, motion_poses)
     finally:
@@ -909,6 +914,12 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
             _clear_motion(asm, protected, soft, list(motion_poses), motion_T)
     _log("final trims done; drilling")
     _drill(asm, lugs, lug_hole, lug_out, t, motion_T)
+    if resolve and motion_T:
+        # print-only feet under the parts that move in one plane (mlc.mesh.feet): clear of every
+        # other part as printed, in the logic states and in the dense poses; before the orientation
+        from mlc.mesh.feet import add_feet
+        _log("feet")
+        add_feet(asm, [asm.part_transforms(*pq) for pq in (poses or {}).values()] + motion_T)
     asm.orient = _orientation(asm)
     _log("assembly done")
     return asm

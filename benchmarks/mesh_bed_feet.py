@@ -1,0 +1,161 @@
+"""The print-only feet (mlc.mesh.feet) on the library gates: bed contact and support, before and after.
+
+    python benchmarks/mesh_bed_feet.py [--gates NAND NOR] [--signals expand] [--profiles fdm] [--slice]
+
+Each case goes through ``export_assembly`` (what ``mlc stl`` runs, with the feet: the dense
+poses, the motion trims, the feet, the orientation, the printability report).  Recorded per
+(gate, signal, profile):
+
+* ``after``: the report's ``bed_contact`` and ``supports`` (the print pose ``mlc stl`` writes,
+  ``asm.orient``; its up direction in the model's frame), and the blocking checks
+  (``ok``, ``failed``), the smallest gap in motion (``motion_clearance``), at rest (``min_gap``)
+  and the measured walls;
+* ``before``: the same parts without their feet (``asm.feet_free``), the model's z up -- the
+  pose of every library gate before the feet (fdm ``orient: auto`` chose the model's z; mjp and
+  sla print ``as_is``) -- by the report's own bed statistics (``mlc.mesh.printability.bed_stats``
+  on the report's grid);
+* ``feet_mm3``: the material the feet add, per part.
+
+``--slice`` (needs ``prusa-slicer`` on PATH): the ``after`` pose is also sliced by PrusaSlicer
+(``benchmarks/slicer_gates.py``'s ``pose_row``: the 3MF, slices without supports, with supports
+and with supports on the build plate only): first-layer filament (about the first layer's area)
+and support volume, as an outside check.
+
+Every row also gets ``prusa_before``: PrusaSlicer's figures for the same gate and profile before
+the feet (the pose ``before`` of ``benchmarks/results/slicer_gates.json``: the model's z up, the
+parts without feet), with that file's mlc bed contact beside them (``mlc_contact_fraction``: the
+same geometry when it equals this row's ``before``).  ``--annotate`` only adds these to the rows
+already in ``--out``.
+
+Writes benchmarks/results/mesh_bed_feet.json (``--out``; ``--append`` keeps rows of other cases).
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import platform
+import shutil
+import sys
+import tempfile
+import time
+import types
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+sys.path.insert(0, str(ROOT / "benchmarks"))
+
+import numpy as np  # noqa: E402
+
+from mlc.gates.library import GATE_NAMES, gate_scene  # noqa: E402
+from mlc.io.atomic import atomic_path  # noqa: E402
+from mlc.mesh.build import Part  # noqa: E402
+from mlc.mesh.pipeline import export_assembly  # noqa: E402
+from mlc.mesh.profiles import load_profile  # noqa: E402
+
+RESULTS = ROOT / "benchmarks" / "results"
+LAYER = {"mjp": 0.1, "sla": 0.1, "fdm": 0.2}
+
+
+def _check(rep, name) -> dict:
+    c = rep.check(name)
+    return {"ok": c.ok, "value": c.value, "limit": c.limit, "detail": c.detail}
+
+
+def prusa_before(row: dict, ref: dict) -> dict | None:
+    """PrusaSlicer's figures before the feet for ``row``'s case, from slicer_gates.json rows."""
+    for r in ref.get("rows", []):
+        if (r["gate"], r["signal"], r["profile"], r.get("orient", "auto")) == (row["gate"], row["signal"],
+                                                                             row["profile"], "auto"):
+            b = r["before"]
+            return {"source": "benchmarks/results/slicer_gates.json, pose before", "commit": r.get("commit"),
+                    "mlc_contact_fraction": b["mlc_bed"]["contact_fraction"],
+                    "first_layer_mm2": b["none"].get("first_layer_mm2"),
+                    "prusa_support_mm3": b.get("prusa_support_mm3"),
+                    "prusa_support_on_print_mm3": b.get("prusa_support_on_print_mm3"),
+                    "filament_mm3": b["none"].get("filament_mm3")}
+    return None
+
+
+def _write(path: Path, rows: list) -> None:
+    ref_path = RESULTS / "slicer_gates.json"
+    ref = json.loads(ref_path.read_text()) if ref_path.exists() else {}
+    for r in rows:
+        r["prusa_before"] = prusa_before(r, ref)
+    out = {"benchmark": "mesh_bed_feet", "python": platform.python_version(), "cpus": os.cpu_count(),
+           "load_average": [round(x, 2) for x in os.getloadavg()], "rows": rows}
+    with atomic_path(path) as t:
+        Path(t).write_text(json.dumps(out, indent=2) + "\n")
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--gates", nargs="+", default=list(GATE_NAMES))
+    ap.add_argument("--signals", nargs="+", default=["expand"])
+    ap.add_argument("--profiles", nargs="+", default=["fdm"])
+    ap.add_argument("--slice", action="store_true", help="slice the after pose with prusa-slicer")
+    ap.add_argument("--out", default=str(RESULTS / "mesh_bed_feet.json"))
+    ap.add_argument("--append", action="store_true")
+    ap.add_argument("--annotate", action="store_true", help="only add prusa_before to the rows in --out")
+    args = ap.parse_args()
+    if args.annotate:
+        path = Path(args.out)
+        _write(path, json.loads(path.read_text())["rows"])
+        return 0
+    from slicer_gates import pose_row, stats   # noqa: E402 (benchmarks/slicer_gates.py)
+    exe = shutil.which("prusa-slicer") if args.slice else None
+    if args.slice and exe is None:
+        print("prusa-slicer is not on PATH: --slice needs it", file=sys.stderr)
+        return 1
+    path = Path(args.out)
+    rows = []
+    if args.append and path.exists():
+        rows = json.loads(path.read_text())["rows"]
+    tmp = Path(tempfile.mkdtemp(prefix="mlc_feet_"))
+    for signal in args.signals:
+        for name in args.gates:
+            scene = gate_scene(name, signal)
+            for prof in args.profiles:
+                profile = load_profile(prof)
+                t0 = time.perf_counter()
+                asm, rep = export_assembly(scene, profile)
+                wall = time.perf_counter() - t0
+                R = np.asarray(asm.orient, float)[:3, :3]
+                up = R.T @ np.array([0.0, 0.0, 1.0])        # the model's direction that points up
+                free = types.SimpleNamespace(
+                    parts=[Part(p.name, p.kind, asm.feet_free.get(p.name, p.solid), []) for p in asm.parts],
+                    profile=profile)
+                _, b0 = stats(free, np.eye(3))
+                row = {"gate": name, "signal": signal, "profile": prof, "ok": rep.ok,
+                       "failed": {c.name: c.failures[:3] for c in rep.checks if not c.ok and c.blocking},
+                       "goals_not_met": sorted(c.name for c in rep.checks if not c.ok and not c.blocking),
+                       "feet_mm3": asm.feet, "feet_total_mm3": round(sum(asm.feet.values()), 1),
+                       "up": [round(float(x), 4) for x in up],
+                       "after": {"bed_contact": _check(rep, "bed_contact"), "supports": _check(rep, "supports"),
+                                 "bed": asm.bed.to_dict()},
+                       "before": {"up": [0.0, 0.0, 1.0], "bed": b0.to_dict()},
+                       "motion_clearance": _check(rep, "motion_clearance"), "min_gap": _check(rep, "min_gap"),
+                       "states": _check(rep, "states"), "wall_thickness": _check(rep, "wall_thickness"),
+                       "notes": [n for n in rep.notes if n.startswith("feet") or "up is" in n][:4],
+                       "export_s": round(wall, 1)}
+                if exe:
+                    f = tmp / f"{name}_{signal}_{prof}.3mf"
+                    row["prusa_after"] = pose_row(exe, asm, R, up, f, f"{name} {prof}", LAYER[prof])
+                rows = [r for r in rows if (r["gate"], r["signal"], r["profile"]) != (name, signal, prof)]
+                rows.append(row)
+                print(json.dumps({k: row[k] for k in ("gate", "signal", "profile", "ok", "feet_total_mm3", "up")}
+                                 | {"contact": [row["before"]["bed"]["contact_fraction"],
+                                                row["after"]["bed"]["contact_fraction"]],
+                                    "support": [row["before"]["bed"]["support_fraction"],
+                                                row["after"]["bed"]["support_fraction"]],
+                                    "motion_gap": row["motion_clearance"]["value"],
+                                    "prusa": {k: row.get("prusa_after", {}).get(k) for k in
+                                              ("prusa_support_mm3", "prusa_support_fraction")}}), flush=True)
+                _write(path, rows)
+    shutil.rmtree(tmp, ignore_errors=True)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,156 @@
+"""Print-only feet (mlc.mesh.feet): parts that move in one plane carried down to the bed, clear of
+every other part as printed and in every pose."""
+import types
+
+import manifold3d as mf
+import numpy as np
+import pytest
+
+from mlc.mesh import feet as FT
+from mlc.mesh.build import Part, transform_solid
+from mlc.mesh.profiles import load_profile
+
+
+def _box(lo, hi):
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    return mf.Manifold.cube((hi - lo).tolist()).translate(lo.tolist())
+
+
+def _T(R=np.eye(3), t=(0, 0, 0)):
+    T = np.eye(4)
+    T[:3, :3] = R
+    T[:3, 3] = t
+    return T
+
+
+def _rot_x(deg):
+    a = np.radians(deg)
+    return np.array([[1, 0, 0], [0, np.cos(a), -np.sin(a)], [0, np.sin(a), np.cos(a)]])
+
+
+def _rot_z(deg):
+    a = np.radians(deg)
+    return np.array([[np.cos(a), -np.sin(a), 0], [np.sin(a), np.cos(a), 0], [0, 0, 1]])
+
+
+def _toy():
+    """Two vertical plates A and B standing 5 mm above the bed (z = 0), B turning about a z axis
+    relative to A; a block C on the bed under A that tilts about x (not planar) and slides
+    along A: A's foot must go round C in every pose."""
+    prof = load_profile("fdm")
+    parts = [Part("A", "body", _box([0, 0, 5], [30, 1.2, 15])),
+             Part("B", "body", _box([0, 6, 5], [30, 7.2, 15])),
+             Part("C", "body", _box([10, -2, 0], [14, 3, 3]))]
+    asm = types.SimpleNamespace(parts=parts, profile=prof, notes=[],
+                                axes=[types.SimpleNamespace(direction=np.array([0, 0, 1.0]))])
+    asm.part = lambda n: next(p for p in parts if p.name == n)
+    Ts = []
+    for k in range(9):
+        Ts.append({"A": _T(), "B": _T(_rot_z(2 * k), (0.0, 0.0, 0.0)),
+                   "C": _T(_rot_x(3 * k), (0.5 * k, 0.0, 0.0))})
+    return asm, Ts
+
+
+def test_planar_parts_are_found_up_to_a_motion_of_the_whole():
+    asm, Ts = _toy()
+    assert sorted(FT.planar_parts(asm, Ts, [0, 0, 1])) == ["A", "B"]
+    # the mechanism floats: a common motion of every part changes nothing
+    G = _T(_rot_x(25), (3, -2, 7))
+    assert sorted(FT.planar_parts(asm, [{k: G @ v for k, v in T.items()} for T in Ts], [0, 0, 1])) == ["A", "B"]
+    assert len(FT.planar_parts(asm, Ts, [1, 0, 0])) == 1          # B turns about z, C slides along x
+
+
+def test_feet_reach_the_bed_and_keep_the_clearance_in_every_pose():
+    asm, Ts = _toy()
+    c = asm.profile.clearance
+    before = {p.name: p.solid for p in asm.parts}
+    lows = {n: float(np.asarray(s.bounding_box())[2]) for n, s in before.items()}
+    first = mf.CrossSection.batch_boolean([p.solid.slice(0.1) for p in asm.parts], mf.OpType.Add).area()
+    notes = FT.add_feet(asm, Ts)
+    assert notes and set(asm.feet) == {"A", "B"}
+    A, B, C = (asm.part(n).solid for n in "ABC")
+    # both plates now start on the bed, in one piece, and the first layer grew
+    assert lows["A"] == pytest.approx(5.0) and np.asarray(A.bounding_box())[2] == pytest.approx(0.0, abs=1e-9)
+    assert len(A.decompose()) == 1 and len(B.decompose()) == 1
+    after = mf.CrossSection.batch_boolean([p.solid.slice(0.1) for p in asm.parts], mf.OpType.Add).area()
+    assert after > first + 0.5 * (30 * 1.2 * 2 - 5 * 1.2)
+    # C untouched; A's foot goes round C: at least the clearance from C as printed and in every pose
+    assert C.volume() == pytest.approx(before["C"].volume())
+    for T in [{n: np.eye(4) for n in "ABC"}] + Ts:
+        for X, Y in (("A", "C"), ("B", "C"), ("A", "B")):
+            M = np.linalg.solve(T[X], T[Y])
+            g = asm.part(X).solid.min_gap(transform_solid(asm.part(Y).solid, M), 2 * c)
+            assert g >= c - 1e-6, (X, Y, g)
+    # and the foot is not simply absent where C was: A keeps most of its bed section
+    sec = A.slice(0.1).area()
+    assert 0.5 * 30 * 1.2 < sec < 30 * 1.2
+
+
+def test_without_feet_nothing_changes():
+    asm, Ts = _toy()
+    vol = [p.solid.volume() for p in asm.parts]
+    old = FT.BED_FEET
+    try:
+        FT.BED_FEET = False
+        assert FT.add_feet(asm, Ts) == [] and asm.feet == {}
+    finally:
+        FT.BED_FEET = old
+    assert [p.solid.volume() for p in asm.parts] == vol
+
+
+@pytest.fixture(scope="module")
+def nand_fdm():
+    from mlc.gates.library import gate_scene
+    from mlc.mesh.pipeline import export_assembly
+    return export_assembly(gate_scene("NAND", "expand"), load_profile("fdm"))
+
+
+def test_nand_fdm_sits_on_the_bed_and_keeps_the_clearance_in_motion(nand_fdm):
+    """``mlc stl``'s pipeline (dense poses, motion trims, feet, orientation, report): NAND's lever
+    loop gets feet, its first layer reaches BED_CONTACT_MIN -- the same parts without their feet
+    (the model's z up, the pose fdm printed before) do not -- and every check that blocks still
+    passes, the clearance in every dense pose measured on the parts with their feet."""
+    from mlc.mesh.checks import BED_CONTACT_MIN, OVERHANG_DEG, island_side
+    from mlc.mesh.pose import report_grid
+    from mlc.mesh.printability import bed_stats
+    asm, rep = nand_fdm
+    assert {"core_ab", "core_cd", "a_lo", "a_hi", "b_lo", "b_hi"} <= set(asm.feet)
+    assert rep.ok, rep.text()
+    mc = rep.check("motion_clearance")
+    assert mc.ok and mc.blocking and mc.value >= asm.profile.clearance - 1e-6, mc.detail
+    assert rep.check("min_gap").ok and rep.check("states").ok and rep.check("retention").ok
+    assert all(len(p.solid.decompose()) == 1 for p in asm.parts)
+    bc = rep.check("bed_contact")
+    assert bc.ok and bc.value >= BED_CONTACT_MIN, bc.detail
+    # without the feet, as fdm printed it before (the model's z up): far from the goal
+    sol = [(p.name, asm.feet_free.get(p.name, p.solid)) for p in asm.parts]
+    lo = np.min([np.asarray(s.bounding_box())[:3] for _, s in sol], 0)
+    hi = np.max([np.asarray(s.bounding_box())[3:] for _, s in sol], 0)
+    sol = [(n, s.translate([0.0, 0.0, -lo[2]])) for n, s in sol]
+    before = bed_stats(sol, OVERHANG_DEG, report_grid(hi - lo, asm.profile.min_wall), first_layer=0.2,
+                       island_mm=island_side(asm.profile))
+    assert before.contact_fraction < 0.25 * BED_CONTACT_MIN
+    # the loop's parts now start on the bed (the print frame)
+    lows = asm.bed.lowest_mm
+    assert all(lows[n] < 0.05 for n in asm.feet), lows
+
+
+def test_feet_go_down_only_where_the_print_can_have_up():
+    """``as_is`` prints the model's z up: feet only along -z; ``axes_flat`` lays every hinge axis
+    on the bed: no feet.  (A hinge along x would carry the plates down along x, sideways on the
+    printed model: mjp NAND's first run of the benchmark, before this rule.)"""
+    from dataclasses import replace
+    asm, Ts = _toy()
+    asm.profile = replace(asm.profile, orient="as_is")
+    assert FT.plan_feet(asm, [{n: np.eye(4) for n in "ABC"}] + Ts)[0] @ np.array([0, 0, 1.0]) > 0.999
+    # a hinge along x, and C beyond the plates' ends along x: A and B could be carried along -x
+    asm.axes = [types.SimpleNamespace(direction=np.array([1.0, 0, 0]))]
+    asm.part("C").solid = _box([-5, -2, 0], [-1, 3, 3])
+    still = [{"A": _T(), "B": _T(), "C": _T()}]
+    assert FT.plan_feet(asm, still) is None
+    asm.profile = replace(asm.profile, orient="auto")
+    d = FT.plan_feet(asm, still)[0]                           # sideways is allowed when up is searched
+    assert abs(d[0]) > 0.999
+    asm, Ts = _toy()
+    asm.profile = replace(asm.profile, orient="axes_flat")
+    assert FT.add_feet(asm, Ts) == [] and asm.feet == {}
