@@ -55,8 +55,8 @@ ACCEL_H = 0.1               # finite-difference step (fraction of dx) for the ge
 ACCEL_RATIO = 1.5           # the acceleration is used while |a| <= this |dx| (|a/2| <= 0.75 |dx|)
 POLISH_ABOVE = 1e-7         # sigma: polish=None polishes only when a joint is stretched or a muscle strained more
 STALL_GAIN = 1e-3           # an iteration that lowers the cost by less than this fraction of it has stalled
-STALL_RUN = 3               # stalled iterations in a row that stop a minimisation whose bonds are still off:
-STALL_CLOSED = 1e-7         # sigma: a joint stretched or a muscle strained by more than this
+STALL_RUN = 3               # stalled iterations in a row that stop a minimisation whose bonds are still off,
+STALL_CLOSED = 1e-7         # sigma: that is, with a joint stretched or a muscle strained by more than this
 STIFF_CAP = 4.0             # bonds stiffer than this many times the stiffest muscle are softened to it
                             # for the continuation, then restored for the polish (see equilibrium)
 
@@ -265,7 +265,7 @@ def _minimise(prob: _Problem, L, reg: float = None, lu_of=None) -> int:
     nor any muscle strained by more than ``STALL_CLOSED``, otherwise after ``STALL_RUN``
     stalled iterations in a row.  In a deep circuit the cost falls along a long, soft valley
     in a sawtooth: an iteration whose damping was just raised gains little and the next
-    ones gain 3 to 10 % each (the 200-gate mesh's all-ones row, docs/circuits.md); one
+    ones gain a few per cent each (the 200-gate mesh's all-ones row, docs/circuits.md); one
     stalled iteration there is no sign of an equilibrium."""
     reg = REG if reg is None else reg
     lu_of = colamd_lu if lu_of is None else lu_of
