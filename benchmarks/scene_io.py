@@ -107,31 +107,32 @@ def measure(name: str, scene) -> dict:
             **read_memory(text)}
 
 
+def _panel(ax, pts: list, series, ylabel: str, title: str) -> None:
+    """One log-log panel: each (key, label, marker) of ``series`` against the file size."""
+    for key, label, m in series:
+        ax.loglog([p["mb"] for p in pts], [p[key] for p in pts], m, label=label)
+    ax.set_xlabel("scene file (MB)")
+    ax.set_ylabel(ylabel)
+    ax.set_title(title)
+    ax.legend(fontsize=8)
+    ax.grid(True, which="both", alpha=0.3)
+
+
 def plot(res: dict, path: Path) -> None:
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     pts = sorted(res["scenes"], key=lambda p: p["mb"])
     fig, (ax, am) = plt.subplots(1, 2, figsize=(11, 4.2))
-    for key, label, m in (("write_python_s", "write, Python emitter", "o--"),
-                          ("write_libyaml_s", "write, libyaml emitter", "o-"),
-                          ("read_python_s", "read, Python parser", "s--"),
-                          ("read_libyaml_s", "read, libyaml parser", "s-"),
-                          ("parse_scene_s", "parse_scene (libyaml, schema, model)", "^:")):
-        ax.loglog([p["mb"] for p in pts], [p[key] for p in pts], m, label=label)
-    ax.set_xlabel("scene file (MB)")
-    ax.set_ylabel("wall seconds")
-    ax.set_title("Scene files: PyYAML's Python and libyaml paths")
-    ax.legend(fontsize=8)
-    ax.grid(True, which="both", alpha=0.3)
-    for key, label, m in (("read_tree_peak_mb", "whole node tree, then data", "s--"),
-                          ("read_stream_peak_mb", "each item's data as it is read", "s-")):
-        am.loglog([p["mb"] for p in pts], [p[key] for p in pts], m, label=label)
-    am.set_xlabel("scene file (MB)")
-    am.set_ylabel("peak resident MB added by the read")
-    am.set_title("Memory of a read (libyaml parser)")
-    am.legend(fontsize=8)
-    am.grid(True, which="both", alpha=0.3)
+    _panel(ax, pts, (("write_python_s", "write, Python emitter", "o--"),
+                     ("write_libyaml_s", "write, libyaml emitter", "o-"),
+                     ("read_python_s", "read, Python parser", "s--"),
+                     ("read_libyaml_s", "read, libyaml parser", "s-"),
+                     ("parse_scene_s", "parse_scene (libyaml, schema, model)", "^:")),
+           "wall seconds", "Scene files: PyYAML's Python and libyaml paths")
+    _panel(am, pts, (("read_tree_peak_mb", "whole node tree, then data", "s--"),
+                     ("read_stream_peak_mb", "each item's data as it is read", "s-")),
+           "peak resident MB added by the read", "Memory of a read (libyaml parser)")
     fig.tight_layout()
     with atomic_path(path) as tmp:
         fig.savefig(tmp, format="png", dpi=110)
