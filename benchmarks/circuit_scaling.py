@@ -157,6 +157,7 @@ def check_point(point: dict, sc, verify_budget: float | None = None) -> dict:
     point.update({"verify_row_s": r["seconds"], "ok": rep.ok, "clearance": r.get("clearance"),
                   "joint_stretch": r["joint_stretch"], "muscle_strain": r["muscle_strain"],
                   "iterations": r["iterations"], "polish": "auto",
+                  "outputs": {e["output"]: e["measured"] for e in rep.entries},
                   "failures": [{k: e[k] for k in ("output", "expected", "bit", "measured", "margin", "error")}
                                for e in rep.failures()]})
     return point

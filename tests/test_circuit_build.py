@@ -420,3 +420,71 @@ def test_a_wire_longer_than_any_chain_is_refused_before_routing(monkeypatch):
     assert "--no-circuit" in msg
     d = float(msg.split("stands ")[1].split(" sigma")[0])
     assert d > 400
+
+
+@pytest.fixture(scope="module")
+def full_adder():
+    spec = load("examples/full_adder.tt", None)
+    return build_circuit(compile_spec(spec).netlist, spec).scene
+
+
+def test_body_levels_put_every_wire_with_or_before_the_gate_it_feeds(full_adder, tetris):
+    """mlc.circuit.levels: a gate's bodies take its depth; a wire takes the depth of the
+    gate whose input lever it drives, so it is solved with that gate and after its driver."""
+    from mlc.circuit.levels import body_levels
+
+    sc = full_adder
+    lv = body_levels(sc)
+    gates = sc.meta["gates"]
+    names = [b.name for b in sc.bodies]
+    for b, n in enumerate(names):
+        g = n.split("_")[0]
+        if g in gates:
+            assert lv[b] == gates[g]["depth"], n
+    A = sc.arrays()
+    bi, bj = A.site_body[A.bond_i], A.site_body[A.bond_j]
+    fed = drives = 0
+    for x, y in zip(bi, bj):
+        for w, g in ((x, y), (y, x)):
+            gn, _, part = names[g].partition("_")
+            if names[w].startswith("w_") and gn in gates:
+                if part in ("a_lo", "a_hi", "b_lo", "b_hi"):
+                    assert lv[w] <= gates[gn]["depth"], (names[w], names[g])
+                    fed += 1
+                elif part.startswith("out"):
+                    assert lv[w] > gates[gn]["depth"], (names[w], names[g])
+                    drives += 1
+    assert fed and drives
+    from mlc.gates.library import gate_scene
+
+    assert body_levels(gate_scene("NAND")) is None          # a gate alone has no levels
+    # Tetris: one level of gates; its constant outputs' bodies, bonded to no gate, join it
+    assert set(body_levels(tetris[2].scene)) == {1}
+
+
+def test_the_level_by_level_continuation_reaches_the_stock_equilibrium(full_adder):
+    """mlc.verify.static._staged: level by level, each level's inputs already right, leaves
+    the circuit next to its equilibrium (every output within 1e-3 sigma of its ideal length
+    before any minimisation of the whole scene); the equilibrium that follows reads the same
+    lengths as the stock continuation's."""
+    import mlc.verify.static as st
+    from mlc.circuit.levels import body_levels
+
+    sc = full_adder
+    lv = body_levels(sc)
+    assert len(np.unique(lv)) == 4                  # depths 1 to 4
+    A = sc.arrays()
+    row = "011"
+    L0, L1 = A.muscle_lengths(st._state_bits(sc, "000")), A.muscle_lengths(st._state_bits(sc, row))
+    prob = st._Problem(sc, A.pos, A.quat, pin_first=False)
+    st._staged(prob, lv, L0, L1, CONTINUATION_STEPS)
+    p, _ = prob.sites()
+    want = sc.truth_table[row]
+    for pr, i, j in zip(sc.probes, A.probe_i, A.probe_j):
+        bit = int(want[sc.outputs.index(pr.output)])
+        assert abs(np.linalg.norm(p[i] - p[j]) - (pr.actuated if bit else pr.rest)) < 1e-3, pr.name
+    stock = st.equilibrium(sc, row, polish=None)
+    staged = st.equilibrium(sc, row, polish=None, levels=lv)
+    assert staged.converged and staged.max_joint_stretch < 1e-6
+    for k in stock.probes:
+        assert abs(stock.probes[k] - staged.probes[k]) < 1e-6, k

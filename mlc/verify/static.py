@@ -34,6 +34,13 @@ The restoring one can still stop short (bcd7seg's row 1111: joint stretch 4.4e-5
 benchmarks/results/static_polish.json, measured when one stalled iteration stopped a
 minimisation; see :func:`_minimise`); the polish then finishes it, which is why
 ``equilibrium(polish=None)`` polishes exactly where a joint or muscle is left off.
+
+A deep circuit's signal crosses every logic level within each continuation step, and the
+minimisation of the whole scene then crawls along a long, soft valley (the 200-gate mesh's
+all-ones row, docs/circuits.md).  Given the bodies' logic levels, :func:`_staged` solves one
+level at a time with the levels before it held, so that the minimisation of the whole scene
+starts at or next to its equilibrium, and is skipped when every bond is met
+(``equilibrium(levels=...)``, what a circuit's static check uses).
 """
 from __future__ import annotations
 
@@ -99,19 +106,28 @@ def _quat_to_matrix_batch(q: np.ndarray) -> np.ndarray:
 class _Problem:
     """Residuals and sparse Jacobian of the bond energy about the current poses."""
 
-    def __init__(self, scene: Scene, pos0, quat0, pin_first: bool = True):
-        """``pin_first`` holds body 0 fixed (its columns dropped): the rigidity analysis
-        uses that; :func:`equilibrium` pins nothing and uses the least-motion term."""
-        self.A = A = scene.arrays()
+    def __init__(self, scene, pos0, quat0, pin_first: bool = True, free=None, R0=None):
+        """``scene``: a Scene or its arrays (a :class:`SceneArrays`).  ``pin_first`` holds
+        body 0 fixed (its columns dropped): the rigidity analysis uses that;
+        :func:`equilibrium` pins nothing and uses the least-motion term.  ``free``, if given,
+        lists the bodies that move (the others are held); ``R0`` gives the rotation
+        matrices instead of ``quat0``."""
+        self.A = A = scene.arrays() if isinstance(scene, Scene) else scene
         self.N = len(pos0)
         self.pos = np.array(pos0, float)
-        self.R = _quat_to_matrix_batch(np.asarray(quat0, float)) if self.N else np.zeros((0, 3, 3))
+        if R0 is not None:
+            self.R = np.array(R0, float)
+        else:
+            self.R = _quat_to_matrix_batch(np.asarray(quat0, float)) if self.N else np.zeros((0, 3, 3))
         self.vec = (A.bond_rest == 0) & (A.bond_tol == 0)   # zero-length bonds: vector residual
         self.iv = np.nonzero(self.vec)[0]
         self.bond_k = np.array(A.bond_k, float)       # k0: may be softened for a continuation (equilibrium)
         self.isc = np.nonzero(~self.vec)[0]
         self.m = 3 * len(self.iv) + len(self.isc) + len(A.muscle_i)
-        self.free = np.arange(1, self.N) if pin_first else np.arange(self.N)
+        if free is not None:
+            self.free = np.asarray(free, dtype=np.int64)
+        else:
+            self.free = np.arange(1, self.N) if pin_first else np.arange(self.N)
         self.col = np.full(self.N, -1)
         self.col[self.free] = np.arange(len(self.free)) * 6
         self.n = 6 * len(self.free)
@@ -321,6 +337,78 @@ def _minimise(prob: _Problem, L, reg: float = None, lu_of=None) -> int:
     return it
 
 
+def _sub_arrays(A, bodies: np.ndarray, bonds: np.ndarray, muscles: np.ndarray):
+    """The arrays of the part of a scene made of ``bodies`` (sorted indices), the bonds and
+    the muscles listed (each joins two of those bodies), numbered afresh."""
+    from mlc.scene.model import SceneArrays
+
+    local = np.full(len(A.pos), -1, dtype=np.int64)
+    local[bodies] = np.arange(len(bodies))
+    keep = np.nonzero(local[A.site_body] >= 0)[0]
+    site_local = np.full(len(A.site_body), -1, dtype=np.int64)
+    site_local[keep] = np.arange(len(keep))
+    z = np.zeros(0)
+    return SceneArrays(
+        pos=A.pos[bodies], quat=A.quat[bodies], site_body=local[A.site_body[keep]], site_local=A.site_local[keep],
+        bond_i=site_local[A.bond_i[bonds]], bond_j=site_local[A.bond_j[bonds]], bond_k=A.bond_k[bonds],
+        bond_rest=A.bond_rest[bonds], bond_tol=A.bond_tol[bonds],
+        muscle_i=site_local[A.muscle_i[muscles]], muscle_j=site_local[A.muscle_j[muscles]],
+        muscle_k=A.muscle_k[muscles], muscle_rest=A.muscle_rest[muscles], muscle_act=A.muscle_act[muscles],
+        muscle_input=A.muscle_input[muscles], probe_i=z.astype(np.int64), probe_j=z.astype(np.int64),
+        probe_rest=z, probe_act=z, site_index={})
+
+
+def _staged(prob: _Problem, levels: np.ndarray, L0, L1, steps: int, lu_of=None) -> int:
+    """Move ``prob`` from the start state (muscles at ``L0``) to the target (``L1``) one
+    level at a time; returns the iteration count.
+
+    ``levels[b]`` is body b's place in the order (a circuit's logic depth,
+    :func:`mlc.circuit.levels.body_levels`).  Level by level, in increasing order, the
+    bodies of that level move and those of the levels before are held; the bonds and muscles
+    that reach a later level are left out.  The held bodies next to the moving ones go from
+    their start poses to the poses solved for them in ``steps`` continuation steps (the
+    translation linearly, the rotation along its geodesic), the muscles of the level from
+    ``L0`` to ``L1`` in the same steps.  In a feed-forward circuit each level is then a small
+    problem whose inputs are already right, so the whole minimisation that follows starts
+    next to its equilibrium instead of carrying the signal through every level at once
+    (docs/circuits.md, "Level by level")."""
+    from scipy.spatial.transform import Rotation
+
+    A = prob.A
+    levels = np.asarray(levels)
+    sb = A.site_body
+    bl_i, bl_j = levels[sb[A.bond_i]], levels[sb[A.bond_j]]
+    ml_i, ml_j = levels[sb[A.muscle_i]], levels[sb[A.muscle_j]]
+    pos0, R0 = prob.pos.copy(), prob.R.copy()
+    ts = np.linspace(0.0, 1.0, steps + 1)[1:]
+    nit = 0
+    for lev in np.unique(levels):
+        bonds = np.nonzero((np.maximum(bl_i, bl_j) == lev))[0]
+        muscles = np.nonzero((np.maximum(ml_i, ml_j) == lev))[0]
+        moving = np.nonzero(levels == lev)[0]
+        touched = np.concatenate([sb[A.bond_i[bonds]], sb[A.bond_j[bonds]],
+                                  sb[A.muscle_i[muscles]], sb[A.muscle_j[muscles]], moving])
+        bodies = np.unique(touched)
+        held = levels[bodies] < lev
+        if not len(bonds) and not len(muscles):
+            continue
+        sub = _sub_arrays(A, bodies, bonds, muscles)
+        sp_ = _Problem(sub, prob.pos[bodies], None, free=np.nonzero(~held)[0], R0=prob.R[bodies])
+        sp_.bond_k = prob.bond_k[bonds]                 # the continuation's (possibly softened) stiffness
+        hb = bodies[held]
+        p_a, p_b = pos0[hb], prob.pos[hb]
+        rot = Rotation.from_matrix(prob.R[hb] @ np.transpose(R0[hb], (0, 2, 1))).as_rotvec() if len(hb) else None
+        for t in ts:
+            if len(hb):
+                sp_.pos[held] = p_a + t * (p_b - p_a)
+                sp_.R[held] = Rotation.from_rotvec(t * rot).as_matrix() @ R0[hb]
+            Lm = L0[muscles] + t * (L1[muscles] - L0[muscles])
+            nit += _minimise(sp_, Lm, lu_of=lu_of)
+        free = bodies[~held]
+        prob.pos[free], prob.R[free] = sp_.pos[~held], sp_.R[~held]
+    return nit
+
+
 def _state_bits(scene: Scene, state: str) -> np.ndarray:
     n = len(scene.inputs)
     if len(state) != n or set(state) - {"0", "1"}:
@@ -330,7 +418,7 @@ def _state_bits(scene: Scene, state: str) -> np.ndarray:
 
 def equilibrium(scene: Scene, state: str, start_state: str | None = None,
                 steps: int = CONTINUATION_STEPS, pos=None, quat=None, lu_of=None, progress=None,
-                polish: bool | None = True) -> Equilibrium:
+                polish: bool | None = True, levels=None) -> Equilibrium:
     """Equilibrium of ``scene`` with its inputs in ``state``, reached by continuation from
     the scene's own poses (or ``pos``/``quat``), taken to be the equilibrium of
     ``start_state`` (default all 0).  ``lu_of``: the factorisation of the normal equations
@@ -357,7 +445,14 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
     few 1e-6 sigma); a minimisation that crawled along a long curved valley keeps most of
     its energy in the bonds (the 200-gate mesh's all-ones row, docs/circuits.md,
     "Scaling").  So does a jammed mechanism at its true equilibrium: False means one of the
-    two, and only the dynamic check tells which."""
+    two, and only the dynamic check tells which.
+
+    ``levels`` (one integer per body, or None): the continuation goes level by level
+    (:func:`_staged`), and the minimisations of the whole scene at the target follow only
+    when a joint is left stretched or a muscle strained by more than ``POLISH_ABOVE``: a
+    pose with every bond met has zero energy, the least there is, so it is an equilibrium
+    whatever the stiffnesses (the polish still runs when ``polish`` is True).  A circuit's
+    static check passes its logic depths (:func:`mlc.circuit.levels.body_levels`)."""
     A = scene.arrays()
     target = _state_bits(scene, state)
     start = _state_bits(scene, start_state or "0" * len(scene.inputs))
@@ -370,19 +465,29 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
         stiff = bool(np.any(prob.bond_k > k_cap))
         if stiff:                                       # stiffness homotopy (module docstring)
             prob.bond_k = np.minimum(prob.bond_k, k_cap)
-        total, done = len(path) + stiff + (polish is not False), 0
+        staged = levels is not None and len(np.unique(levels)) > 1 and len(path) > 1
+        if staged:
+            path = [1.0]
+        total, done = len(path) + staged + stiff + (polish is not False), 0
 
         def tick():
             nonlocal done
             done += 1
             if progress is not None:
                 progress(done / total)
+        closed = False
+        if staged:
+            nit += _staged(prob, levels, L0, L1, steps, lu_of=lu_of)
+            tick()
+            closed = max(_strains(prob, L1)) <= POLISH_ABOVE      # every bond met: already an equilibrium
         for t in path:
-            nit += _minimise(prob, L0 + t * (L1 - L0), lu_of=lu_of)
+            if not closed:
+                nit += _minimise(prob, L0 + t * (L1 - L0), lu_of=lu_of)
             tick()
         if stiff:
             prob.bond_k = np.array(A.bond_k, float)
-            nit += _minimise(prob, L1, lu_of=lu_of)
+            if not closed:
+                nit += _minimise(prob, L1, lu_of=lu_of)
             tick()
         if polish or (polish is None and max(_strains(prob, L1)) > POLISH_ABOVE):
             nit += _minimise(prob, L1, reg=REG_POLISH, lu_of=lu_of)     # the least-motion bias removed
