@@ -27,7 +27,12 @@ parts without feet), with that file's mlc bed contact beside them (``mlc_contact
 same geometry when it equals this row's ``before``).  ``--annotate`` only adds these to the rows
 already in ``--out``.
 
-Writes benchmarks/results/mesh_bed_feet.json (``--out``; ``--append`` keeps rows of other cases).
+Each row records ``commit`` (the HEAD it ran on, with ``mlc_dirty``: files under ``mlc/`` that
+differed from it), ``export_s`` (``export_assembly``), ``slice_s`` (the three PrusaSlicer runs) and
+``wall_s`` (the whole row).
+
+Writes benchmarks/results/mesh_bed_feet.json (``--out``; ``--append`` keeps rows of other cases and
+replaces, in place, the rows of the cases it runs again).
 """
 from __future__ import annotations
 
@@ -36,6 +41,7 @@ import json
 import os
 import platform
 import shutil
+import subprocess
 import sys
 import tempfile
 import time
@@ -78,6 +84,18 @@ def prusa_before(row: dict, ref: dict) -> dict | None:
     return None
 
 
+def _git_state() -> tuple[str | None, list]:
+    """The HEAD this runs on and the files under mlc/ that differ from it."""
+    try:
+        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
+                              text=True, check=True).stdout.strip()
+        dirty = subprocess.run(["git", "status", "--porcelain", "--", "mlc"], cwd=ROOT, capture_output=True,
+                               text=True, check=True).stdout.split("\n")
+        return head, sorted(line[3:] for line in dirty if line.strip())
+    except (OSError, subprocess.CalledProcessError):
+        return None, []
+
+
 def _write(path: Path, rows: list) -> None:
     ref_path = RESULTS / "slicer_gates.json"
     ref = json.loads(ref_path.read_text()) if ref_path.exists() else {}
@@ -118,6 +136,7 @@ def main() -> int:
             scene = gate_scene(name, signal)
             for prof in args.profiles:
                 profile = load_profile(prof)
+                head, dirty = _git_state()
                 t0 = time.perf_counter()
                 asm, rep = export_assembly(scene, profile)
                 wall = time.perf_counter() - t0
@@ -138,15 +157,24 @@ def main() -> int:
                        "motion_clearance": _check(rep, "motion_clearance"), "min_gap": _check(rep, "min_gap"),
                        "states": _check(rep, "states"), "wall_thickness": _check(rep, "wall_thickness"),
                        "notes": [n for n in rep.notes if n.startswith("feet") or "up is" in n][:4],
-                       "export_s": round(wall, 1)}
+                       "export_s": round(wall, 1), "commit": head, "mlc_dirty": dirty}
                 if exe:
                     f = tmp / f"{name}_{signal}_{prof}.3mf"
+                    t1 = time.perf_counter()
                     row["prusa_after"] = pose_row(exe, asm, R, up, f, f"{name} {prof}", LAYER[prof])
-                rows = [r for r in rows if (r["gate"], r["signal"], r["profile"]) != (name, signal, prof)]
-                rows.append(row)
+                    row["slice_s"] = round(time.perf_counter() - t1, 1)
+                row["wall_s"] = round(time.perf_counter() - t0, 1)
+                key = (name, signal, prof)
+                same = [i for i, r in enumerate(rows) if (r["gate"], r["signal"], r["profile"]) == key]
+                if same:        # a case run again replaces its old row, in place
+                    rows[same[0]] = row
+                    rows = [r for i, r in enumerate(rows) if i not in same[1:]]
+                else:
+                    rows.append(row)
                 print(json.dumps({k: row[k] for k in ("gate", "signal", "profile", "ok", "feet_total_mm3", "up")}
                                  | {"contact": [row["before"]["bed"]["contact_fraction"],
                                                 row["after"]["bed"]["contact_fraction"]],
+                                    "wall_s": row["wall_s"],
                                     "support": [row["before"]["bed"]["support_fraction"],
                                                 row["after"]["bed"]["support_fraction"]],
                                     "motion_gap": row["motion_clearance"]["value"],
