@@ -25,13 +25,14 @@ from mlc.scene.model import Scene
 INPUT_LEVERS = ("a_lo", "a_hi", "b_lo", "b_hi")
 
 
-def body_levels(scene: Scene) -> np.ndarray | None:
+def body_levels(scene: Scene, arrays=None) -> np.ndarray | None:
     """Level of every body (int array in body order), or None when ``scene`` is not a
-    circuit (no ``meta.gates`` with depths)."""
+    circuit (no ``meta.gates`` with depths).  ``arrays``: ``scene.arrays()`` when the caller
+    has it already."""
     gates = scene.meta.get("gates") if isinstance(scene.meta, dict) else None
     if not gates or any("depth" not in g for g in gates.values()):
         return None
-    A = scene.arrays()
+    A = scene.arrays() if arrays is None else arrays
     N = len(A.pos)
     depth = np.full(N, -1, dtype=np.int64)            # the gate's depth for gate bodies
     is_input = np.zeros(N, dtype=bool)

@@ -47,7 +47,6 @@ def run(args) -> int:
             check_mesh_file(args.mesh, max_triangles=400_000)
             render_mesh(args.mesh, png.tmp)
         else:
-            from mlc.circuit.levels import body_levels
             from mlc.draw import draw_scene_states
             from mlc.io.progress import Progress
             from mlc.verify.static import equilibrium
@@ -60,9 +59,8 @@ def run(args) -> int:
             # a compiled circuit takes minutes (1328 bodies: about 3 min); a gate about a second
             with Progress(f"mlc draw: solving and drawing {scene.name}", total=len(states) + 1) as bar:
                 equilibria = {}
-                levels = body_levels(scene)             # a circuit: as its static check solves it
                 for k, st in enumerate(states):         # mlc.verify.static.solve_states, one state at a time
-                    equilibria[st] = equilibrium(scene, st, levels=levels)
+                    equilibria[st] = equilibrium(scene, st, levels="depth")   # a circuit: as its static check
                     bar.update(k + 1)
                 draw_scene_states(scene, equilibria, png.tmp)
                 bar.update(len(states) + 1)

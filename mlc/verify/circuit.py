@@ -94,20 +94,18 @@ def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_s
     within a row (``done`` fractional: ``ROW_SHARES`` of the row after its equilibrium's
     minimisations, its thermal spread and its clearance), so that one row of a large circuit,
     minutes long, moves its progress bar."""
-    from mlc.circuit.levels import body_levels
     from mlc.verify.dynamic import probe_thermal_sd
     from mlc.verify.overlap import clearance as clear
     from mlc.verify.static import equilibrium
 
     states = select_rows(scene, rows)
-    levels = body_levels(scene)
     t0 = time.perf_counter()
     rep = Report(scene.name, "static", params={"tol_length": tol_length, "tol_stretch": tol_stretch,
                                                "require_clearance": require_clearance, "kT": kT,
                                                "joint_k": scene.meta.get("connector", {}).get("joint_k", 1.0)})
     for i, state in enumerate(states):
         t_row = time.perf_counter()
-        eq = equilibrium(scene, state, polish=polish, levels=levels, progress=None if not progress else
+        eq = equilibrium(scene, state, polish=polish, levels="depth", progress=None if not progress else
                          (lambda f, i=i: progress(i + ROW_SHARES[0] * f, len(states))))
         want = scene.truth_table.get(state)
         row_ok = eq.max_joint_stretch <= tol_stretch

@@ -343,7 +343,6 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
     reused, so a later call on the same row and kT gives the same numbers without redoing it
     (a fifth of a 4-to-1 multiplexer's run).  Only for one scene: the keys do not name it."""
     from mlc.io.progress import Progress
-    from mlc.circuit.levels import body_levels
     from mlc.verify.static import equilibrium
 
     from mlc.verify.circuit import select_rows
@@ -373,7 +372,6 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
     window = max(WINDOW, tau / 20.0) if window is None else float(window)
     rest = "0" * len(scene.inputs)
     names = [p.name for p in scene.probes]
-    levels = body_levels(scene)                 # a circuit's rows solved as its static check solves them
     total = len(states) * len(seed_list)
     out = []
     show = None if progress is None else (progress if isinstance(progress, bool) else False)
@@ -391,7 +389,7 @@ def check_scene_dynamic_multi(scene, kT: float = 1e-5, seeds=3, scheme: str = "s
                 sd, tau_row = cache[key]
             else:
                 try:
-                    eq = equilibrium(scene, state, levels=levels)
+                    eq = equilibrium(scene, state, levels="depth")   # as the static check solves it
                     sd = probe_thermal_sd(scene, kT, eq.pos, eq.quat)
                     if tau_given:
                         tau_row = tau

@@ -49,7 +49,8 @@ from dataclasses import dataclass, field
 import numpy as np
 import scipy.sparse as sp
 
-from mlc.errors import MlcError
+from mlc.circuit.levels import body_levels
+from mlc.errors import InternalError, MlcError
 from mlc.geometry.rotation import matrix_to_quat
 from mlc.scene.model import Scene
 
@@ -385,13 +386,13 @@ def _staged(prob: _Problem, levels: np.ndarray, L0, L1, steps: int, lu_of=None) 
     for lev in np.unique(levels):
         bonds = np.nonzero((np.maximum(bl_i, bl_j) == lev))[0]
         muscles = np.nonzero((np.maximum(ml_i, ml_j) == lev))[0]
+        if not len(bonds) and not len(muscles):         # nothing pulls on this level's bodies
+            continue
         moving = np.nonzero(levels == lev)[0]
         touched = np.concatenate([sb[A.bond_i[bonds]], sb[A.bond_j[bonds]],
                                   sb[A.muscle_i[muscles]], sb[A.muscle_j[muscles]], moving])
         bodies = np.unique(touched)
         held = levels[bodies] < lev
-        if not len(bonds) and not len(muscles):
-            continue
         sub = _sub_arrays(A, bodies, bonds, muscles)
         sp_ = _Problem(sub, prob.pos[bodies], None, free=np.nonzero(~held)[0], R0=prob.R[bodies])
         sp_.bond_k = prob.bond_k[bonds]                 # the continuation's (possibly softened) stiffness
@@ -447,13 +448,18 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
     "Scaling").  So does a jammed mechanism at its true equilibrium: False means one of the
     two, and only the dynamic check tells which.
 
-    ``levels`` (one integer per body, or None): the continuation goes level by level
+    ``levels`` (one integer per body, ``"depth"`` or None): the continuation goes level by level
     (:func:`_staged`), and the minimisations of the whole scene at the target follow only
     when a joint is left stretched or a muscle strained by more than ``POLISH_ABOVE``: a
     pose with every bond met has zero energy, the least there is, so it is an equilibrium
     whatever the stiffnesses (the polish still runs when ``polish`` is True).  A circuit's
-    static check passes its logic depths (:func:`mlc.circuit.levels.body_levels`)."""
+    static check passes ``"depth"``: its bodies' logic depths
+    (:func:`mlc.circuit.levels.body_levels`), None for a scene that is not a circuit."""
     A = scene.arrays()
+    if isinstance(levels, str):
+        if levels != "depth":
+            raise InternalError(f"equilibrium: levels={levels!r}, expected 'depth', an array or None")
+        levels = body_levels(scene, A)
     target = _state_bits(scene, state)
     start = _state_bits(scene, start_state or "0" * len(scene.inputs))
     prob = _Problem(scene, A.pos if pos is None else pos, A.quat if quat is None else quat, pin_first=False)
