@@ -278,7 +278,13 @@ def load(text, filename: str = "<input>", max_bytes: int | None = None):
     if len(text) > max_bytes:
         raise MlcError(f"YAML input is larger than {max_bytes // 2 ** 20} MB", Loc(filename),
                        "mlc reads YAML files up to that size")
-    if _CLoader is not None and not yaml.reader.Reader.NON_PRINTABLE.search(text):
+    printable = not yaml.reader.Reader.NON_PRINTABLE.search(text)
+    if printable:          # the block YAML mlc writes, read line by line (mlc.io.yamlfast)
+        from mlc.io import yamlfast
+        data = yamlfast.parse(text, filename)
+        if data is not None:
+            return data
+    if _CLoader is not None and printable:
         loader = _CLoader(text, filename)
         try:
             return loader.get_single_data()
