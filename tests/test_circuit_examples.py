@@ -17,6 +17,7 @@ import pytest
 import yaml
 
 from mlc.cli import main
+from mlc.io import yamlemit, yamlfast, yamlsrc
 from mlc.scene import io
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -57,6 +58,12 @@ def test_every_example_becomes_a_circuit_that_verifies(example, tmp_path, capsys
     if yaml.__with_libyaml__:                   # libyaml's emitter writes what the Python one would
         data = io.scene_to_data(io.load_scene(scene))
         assert io._emit(data, io._CDumper) == io._emit(data, io._PyDumper)
+        # mlc's writer wrote PyYAML's text, and mlc's line reader reads it as PyYAML does
+        text = scene.read_text(encoding="utf-8")
+        assert text.endswith(io._emit(data, io._CDumper)) and yamlemit.dump(data) is not None
+        fast = yamlfast.parse(text, "c.yaml")
+        ref = yamlsrc._CLoader(text, "c.yaml").get_single_data()
+        assert fast is not None and fast == ref and yamlsrc.locations(fast) == yamlsrc.locations(ref)
     rows = _rows(n_inputs)
     rc = main(["verify", str(scene), "--json"] + (["--rows", *rows] if rows else []))
     rep = json.loads(capsys.readouterr().out)

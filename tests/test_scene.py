@@ -23,6 +23,7 @@ def test_libyaml_writes_the_same_scene_text_as_the_python_emitter():
     import yaml
 
     from mlc.gates.library import GATE_NAMES, SIGNALS
+    from mlc.io import yamlemit
     from mlc.scene import io
 
     if not yaml.__with_libyaml__:
@@ -32,6 +33,7 @@ def test_libyaml_writes_the_same_scene_text_as_the_python_emitter():
         for conv in SIGNALS:
             data = io.scene_to_data(gate_scene(gate, conv))
             assert io._emit(data, io._CDumper) == io._emit(data, io._PyDumper), (gate, conv)
+            assert yamlemit.dump(data) == io._emit(data, io._CDumper), (gate, conv)   # what dump_scene writes
 
 
 def test_arrays_shapes():
