@@ -26,6 +26,7 @@ values have the right widths.
 """
 from __future__ import annotations
 
+import math
 import re
 from dataclasses import dataclass, field
 
@@ -211,8 +212,7 @@ class Scene:
             if not b.boxes:
                 raise MlcError(f"body {b.name} has no box", loc, "give it at least one slab")
             for box in b.boxes:
-                _finite(box.size, 3, f"body {b.name}: box size", loc)
-                if np.any(np.asarray(box.size) <= 0):
+                if min(_finite(box.size, 3, f"body {b.name}: box size", loc)) <= 0:
                     raise MlcError(f"body {b.name}: box sizes must be positive, got {list(box.size)}", loc)
                 _finite(box.center, 3, f"body {b.name}: box center", loc)
                 _unit_quat(box.orientation, f"body {b.name}: box orientation", loc)
@@ -321,15 +321,17 @@ def check_row(key: str, val: str, n_inputs: int, n_outputs: int, where) -> None:
         raise MlcError(f"truth table value {val!r} for {key} is not {n_outputs} output bits", where)
 
 
-def _finite(v, n, what, loc):
-    a = np.asarray(v, dtype=float).ravel()
-    if a.size != n or not np.all(np.isfinite(a)):
+def _finite(v, n, what, loc) -> list:
+    """``v`` as a list of ``n`` finite floats (scalar tests: a scene checks hundreds of
+    thousands of these small vectors)."""
+    vals = np.asarray(v, dtype=float).ravel().tolist()
+    if len(vals) != n or not all(map(math.isfinite, vals)):
         raise MlcError(f"{what} must be {n} finite number(s), got {list(np.asarray(v).ravel())}", loc)
+    return vals
 
 
 def _unit_quat(q, what, loc):
-    _finite(q, 4, what, loc)
-    nrm = float(np.linalg.norm(np.asarray(q, float)))
+    nrm = math.sqrt(sum(x * x for x in _finite(q, 4, what, loc)))
     if abs(nrm - 1.0) > 1e-6:
         raise MlcError(f"{what} is not a unit quaternion (norm {nrm:.6g})", loc,
                        "normalise it: [w, x, y, z] / |q|")
