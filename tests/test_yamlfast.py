@@ -110,6 +110,17 @@ def test_what_is_read_fast_is_what_pyyaml_resolves():
     assert d.loc_of("e") == yamlsrc.Loc("s.yaml", 5, 4) and d["e"].loc_of(2) == yamlsrc.Loc("s.yaml", 5, 11)
 
 
+def test_lists_of_long_lists_are_read():
+    """A circuit's meta lists its predicted contacts as lists of five items, which the
+    emitter writes as block sequences inside a block sequence (``- - w_a``): the 200-gate
+    scene has them, and refusing them left its read to PyYAML."""
+    text = ("meta:\n  state_contacts:\n  - - w_a\n    - 3\n    - w_b\n    - 4\n    - -0.05\n"
+            "  - - w_c\n    - 1\n    - - x\n      - y\n    - k: v\n      k2: [1, 2]\n  n: 1\nbodies: []\n")
+    fast = yamlfast.parse(text, "s.yaml")
+    assert fast is not None and fast["meta"]["state_contacts"][1][2] == ["x", "y"]
+    assert _agrees(text)
+
+
 def test_nesting_deeper_than_the_limit_is_left_to_pyyaml():
     deep = "".join(" " * i + f"k{i}:\n" for i in range(yamlsrc.MAX_DEPTH + 5)) + " " * (yamlsrc.MAX_DEPTH + 5) + "v: 1\n"
     assert yamlfast.parse(deep, "s.yaml") is None

@@ -16,7 +16,8 @@ Grammar accepted (one document; indentation by spaces)::
     block     := mapping | sequence
     mapping   := (KEY ':' (' ' inline | NEWLINE nested))+         at one indentation
     nested    := mapping (deeper) | sequence (deeper, or at the key's indentation)
-    sequence  := ('- ' (inline | KEY ':' ... the item's mapping, indented 2 more))+
+    sequence  := ('- ' (inline | KEY ':' ... | '- ' ...: the item's mapping or sequence,
+                        its next lines indented 2 more))+
     inline    := '[' [item (', ' item)*] ']' | '{}' | scalar     on one line
     scalar    := 'single-quoted' | plain
 
@@ -208,9 +209,9 @@ class _Reader:
                 raise _Refuse                  # "-" alone: a null item
             item = content[2:]
             col = ind + 2
-            if not item or item[0] == " " or item.startswith("- ") or item == "-":
+            if not item or item[0] == " " or item == "-":
                 raise _Refuse
-            if _KEY.match(item):
+            if item.startswith("- ") or _KEY.match(item):     # a sequence or mapping begins on this line
                 locs.append(Loc(fn, self.i + 1, col + 1))
                 out.append(self.block(col, depth + 1, item))
             else:
