@@ -84,7 +84,7 @@ def test_the_compiled_schemas_accept_exactly_what_the_checker_accepts():
             None, [], {}, [1, 2], [1.0, 2.0, 3.0], {"zz": 1}, "0101", "01-"]
     for name, data in _schema_cases():
         s = load_schema(name)
-        ok = sch._compiled(id(s), s)
+        ok = sch._compiled(s)
         assert ok(data), name
         paths = list(_nodes(data))
         seen = set()

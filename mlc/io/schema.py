@@ -54,10 +54,11 @@ def validate(data, schema: dict, filename: str = "<input>") -> None:
     """Raise :class:`MlcError` at ``file:line`` if ``data`` does not match ``schema``.
 
     The data is first checked by the schema compiled into closures (:func:`_compiled`,
-    which only says yes or no, about ten times faster on a circuit's scene); only data it
+    which only says yes or no, about three times faster on a circuit's scene,
+    benchmarks/results/scene_io.json); only data it
     refuses is walked again by :func:`_check`, which finds and words the first error."""
     root = schema
-    if _compiled(id(schema), schema)(data):
+    if _compiled(schema)(data):
         return
     try:
         _check(data, schema, root, [], getattr(data, "loc", None) or Loc(filename))
@@ -172,12 +173,12 @@ def _describe(v) -> str:
 _COMPILED: dict = {}
 
 
-def _compiled(key, schema: dict):
+def _compiled(schema: dict):
     """``schema`` as one predicate ``ok(data)``, True exactly where :func:`_check` raises
     nothing (the same keywords in the same meaning; cached per schema object)."""
-    fn = _COMPILED.get(key)
+    fn = _COMPILED.get(id(schema))
     if fn is None or fn[0] is not schema:
-        fn = _COMPILED[key] = (schema, _compile(schema, schema, {}))
+        fn = _COMPILED[id(schema)] = (schema, _compile(schema, schema, {}))
     return fn[1]
 
 
@@ -201,11 +202,8 @@ def _compile(s: dict, root: dict, done: dict):
             checks.append(preds[0])
         else:
             checks.append(lambda v: any(p(v) for p in preds))
-    bounds = [(k, s[k]) for k in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum") if k in s]
-    lo = max([b for k, b in bounds if k == "minimum"], default=None)
-    hi = min([b for k, b in bounds if k == "maximum"], default=None)
-    xlo = s.get("exclusiveMinimum")
-    xhi = s.get("exclusiveMaximum")
+    lo, hi = s.get("minimum"), s.get("maximum")
+    xlo, xhi = s.get("exclusiveMinimum"), s.get("exclusiveMaximum")
     isfinite = math.isfinite
 
     def number(v):
