@@ -1,6 +1,6 @@
 """A fast reader for the block YAML that mlc writes (scenes: ``mlc.scene.io.dump_scene``).
 
-PyYAML reads a compiled circuit's scene at about 0.1 to 0.3 MB/s, even on libyaml's
+PyYAML reads a compiled circuit's scene at about 0.1 to 0.6 MB/s, even on libyaml's
 parser, because its composer and constructors are Python calls per node (a 200-gate
 circuit's 184 MB scene took 755 s, benchmarks/results/circuit_scaling.json).  This module
 reads the subset of YAML that PyYAML's emitter writes for such data, line by line, into the
