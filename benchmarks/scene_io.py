@@ -122,7 +122,7 @@ def measure(name: str, scene) -> dict:
     c_data, c_r = _timed(lambda: yamlsrc._CLoader(text, name).get_single_data())
     same_data = py_data == c_data and yamlsrc.locations(py_data) == yamlsrc.locations(c_data)
     fast_data, fast_r = _timed(lambda: yamlfast.parse(text, name))
-    same_fast = fast_data is not None and _same(fast_data, c_data) and \
+    same_fast = fast_data is not None and yamlsrc.same_data(fast_data, c_data) and \
         yamlsrc.locations(fast_data) == yamlsrc.locations(c_data)
     sch = load_schema("scene")
     checked, check_s = _timed(lambda: schema._check(c_data, sch, sch, [], c_data.loc))
@@ -180,17 +180,6 @@ dw = time.perf_counter() - t0
 print(json.dumps({"load_scene_s": dt, "bodies": len(sc.bodies), "load_scene_peak_mb": peak / 1024,
                   "dump_scene_s": dw, "dump_same_text": out == text}))
 """
-
-
-def _same(a, b) -> bool:
-    """Equal data of equal types, keys in the same order."""
-    if type(a) is not type(b):
-        return False
-    if isinstance(a, dict):
-        return list(a) == list(b) and all(_same(a[k], b[k]) for k in a)
-    if isinstance(a, list):
-        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
-    return a == b
 
 
 @contextmanager

@@ -22,17 +22,6 @@ def _pyyaml(text, loader=yamlsrc._Loader):
         ld.dispose()
 
 
-def _same(a, b) -> bool:
-    """Equal data of equal types (1 == 1.0 == True in Python; not here), same key order."""
-    if type(a) is not type(b):
-        return False
-    if isinstance(a, dict):
-        return list(a) == list(b) and all(_same(a[k], b[k]) for k in a)
-    if isinstance(a, list):
-        return len(a) == len(b) and all(_same(x, y) for x, y in zip(a, b))
-    return a == b or (a != a and b != b)
-
-
 def _agrees(text) -> bool:
     """yamlfast refuses ``text``, or reads the data and locations PyYAML reads."""
     fast = yamlfast.parse(text, "s.yaml")
@@ -42,7 +31,7 @@ def _agrees(text) -> bool:
         ref = _pyyaml(text)
     except (MlcError, Exception):
         return False                                 # fast read what PyYAML refuses
-    return _same(fast, ref) and yamlsrc.locations(fast) == yamlsrc.locations(ref)
+    return yamlsrc.same_data(fast, ref) and yamlsrc.locations(fast) == yamlsrc.locations(ref)
 
 
 def _scene_texts():
@@ -65,11 +54,11 @@ def test_a_scene_mlc_writes_is_read_as_pyyaml_reads_it(name):
     assert fast is not None, "the reader refused a scene mlc wrote"
     for loader in filter(None, (yamlsrc._Loader, yamlsrc._CLoader)):
         ref = _pyyaml(text, loader)
-        assert _same(fast, ref)
+        assert yamlsrc.same_data(fast, ref)
         assert yamlsrc.locations(fast) == yamlsrc.locations(ref)
     assert len(yamlsrc.locations(fast)) > 100
     # and yamlsrc.load, which every reader of mlc's files calls, gives the same
-    assert _same(yamlsrc.load(text, "s.yaml"), fast)
+    assert yamlsrc.same_data(yamlsrc.load(text, "s.yaml"), fast)
 
 
 @pytest.mark.parametrize("text", [

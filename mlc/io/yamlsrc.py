@@ -75,6 +75,18 @@ def locations(data) -> list:
     return out
 
 
+def same_data(a, b) -> bool:
+    """``a`` and ``b`` equal with equal types throughout (``1 == 1.0 == True`` in Python, not
+    here) and their keys in the same order (to compare two readers)."""
+    if type(a) is not type(b):
+        return False
+    if isinstance(a, dict):
+        return list(a) == list(b) and all(same_data(a[k], b[k]) for k in a)
+    if isinstance(a, list):
+        return len(a) == len(b) and all(same_data(x, y) for x, y in zip(a, b))
+    return a == b or (a != a and b != b)
+
+
 def _at(filename, mark) -> Loc:
     return Loc(filename, mark.line + 1, mark.column + 1) if mark is not None else Loc(filename)
 
