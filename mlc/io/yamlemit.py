@@ -25,10 +25,11 @@ import re
 
 import yaml
 
+from mlc.io.yamlfast import _BOOL, _NULL
+
 WIDTH = 120
 _IDENT = re.compile(r"[A-Za-z_][A-Za-z0-9_.]*\Z")
-_RESERVED = {"yes", "Yes", "YES", "no", "No", "NO", "true", "True", "TRUE", "false", "False", "FALSE",
-             "on", "On", "ON", "off", "Off", "OFF", "null", "Null", "NULL"}
+_RESERVED = set(_BOOL) | _NULL         # the words YAML 1.1 reads as booleans and nulls
 _STR_TAG = "tag:yaml.org,2002:str"
 
 

@@ -52,7 +52,7 @@ import scipy.sparse as sp
 from mlc.circuit.levels import body_levels
 from mlc.errors import InternalError, MlcError
 from mlc.geometry.rotation import matrix_to_quat
-from mlc.scene.model import Scene
+from mlc.scene.model import Scene, SceneArrays
 
 CONTINUATION_STEPS = 4
 GN_MAX_ITER = 60            # Gauss-Newton iterations per continuation step
@@ -341,8 +341,6 @@ def _minimise(prob: _Problem, L, reg: float = None, lu_of=None) -> int:
 def _sub_arrays(A, bodies: np.ndarray, bonds: np.ndarray, muscles: np.ndarray):
     """The arrays of the part of a scene made of ``bodies`` (sorted indices), the bonds and
     the muscles listed (each joins two of those bodies), numbered afresh."""
-    from mlc.scene.model import SceneArrays
-
     local = np.full(len(A.pos), -1, dtype=np.int64)
     local[bodies] = np.arange(len(bodies))
     keep = np.nonzero(local[A.site_body] >= 0)[0]
@@ -495,7 +493,7 @@ def equilibrium(scene: Scene, state: str, start_state: str | None = None,
             if not closed:
                 nit += _minimise(prob, L1, lu_of=lu_of)
             tick()
-        if polish or (polish is None and max(_strains(prob, L1)) > POLISH_ABOVE):
+        if polish or (polish is None and not closed and max(_strains(prob, L1)) > POLISH_ABOVE):
             nit += _minimise(prob, L1, reg=REG_POLISH, lu_of=lu_of)     # the least-motion bias removed
         if polish is not False:
             tick()
