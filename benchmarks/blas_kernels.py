@@ -17,6 +17,7 @@ import sys
 from pathlib import Path
 
 from mlc.io.atomic import atomic_path
+from gitstate import commit as git_commit      # benchmarks/gitstate.py
 
 ROOT = Path(__file__).resolve().parents[1]
 CODE = """
@@ -44,7 +45,7 @@ def main() -> int:
         r = {"OPENBLAS_CORETYPE": ct or "unset (mlc pins)", **json.loads(out)}
         rows.append(r)
         print(r, flush=True)
-    git = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True, text=True).stdout.strip()
+    git = git_commit()
     res = {"what": "full adder at joint_k 100 built under each OpenBLAS kernel choice", "git": git,
            "machine": {"platform": platform.platform(), "cpus": os.cpu_count()}, "rows": rows}
     with atomic_path(ROOT / "benchmarks" / "results" / "blas_kernels.json") as tmp:

@@ -20,13 +20,13 @@ import argparse
 import json
 import os
 import platform
-import subprocess
 import time
 from pathlib import Path
 
 from mlc.circuit.build import CircuitOptions
 from mlc.pipeline import build, compile_spec, load
 from mlc.verify.circuit import verify_dynamic, verify_static
+from gitstate import commit as git_commit      # benchmarks/gitstate.py
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results"
@@ -59,8 +59,7 @@ def main():
     ap.add_argument("--joint-k", nargs="*", type=float, default=[1.0, 100.0])
     ap.add_argument("--no-dynamic", action="store_true")
     args = ap.parse_args()
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                            text=True).stdout.strip()
+    commit = git_commit()
     points = []
     for expr in args.expr:
         for k in args.joint_k:

@@ -26,7 +26,6 @@ import argparse
 import json
 import os
 import platform
-import subprocess
 import time
 from pathlib import Path
 
@@ -38,6 +37,7 @@ from mlc.io.atomic import atomic_path
 from mlc.pipeline import build, compile_spec, load
 from mlc.verify.circuit import verify_static
 from mlc.verify.dynamic import check_scene_dynamic_multi
+from gitstate import commit as git_commit      # benchmarks/gitstate.py
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results" / "circuit_dt.json"
@@ -79,8 +79,7 @@ def main():
     ap.add_argument("--kT", type=float, default=1e-5)
     ap.add_argument("--out", type=Path, default=OUT)
     args = ap.parse_args()
-    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
+    commit = git_commit()
     out = args.out
     res = json.loads(out.read_text()) if out.exists() else {"runs": [], "static": {}}
     for name in args.only:

@@ -31,7 +31,6 @@ import hashlib
 import json
 import os
 import platform
-import subprocess
 import time
 from pathlib import Path
 
@@ -40,6 +39,7 @@ from mlc.io.atomic import atomic_path
 from mlc.pipeline import build, compile_spec, load
 from mlc.scene.io import dump_scene
 from mlc.verify.dynamic import check_scene_dynamic_multi
+from gitstate import commit as git_commit      # benchmarks/gitstate.py
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results" / "circuit_dynamic.json"
@@ -96,8 +96,7 @@ def main():
     ap.add_argument("--reuse-tau", action="store_true",
                     help="use the scene's tau recorded by an earlier run (default: the verifier's signal_time)")
     args = ap.parse_args()
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                            text=True).stdout.strip()
+    commit = git_commit()
     out = args.out
     res = json.loads(out.read_text()) if out.exists() else {"runs": [], "scenes": {}}
     main_runs = json.loads(OUT.read_text())["runs"] if out != OUT and OUT.exists() else []

@@ -23,13 +23,13 @@ import argparse
 import json
 import os
 import platform
-import subprocess
 import time
 from pathlib import Path
 
 from mlc.circuit.build import CircuitOptions
 from mlc.pipeline import build, compile_spec, load
 from mlc.verify.circuit import verify_static
+from gitstate import commit as git_commit      # benchmarks/gitstate.py
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results"
@@ -71,11 +71,7 @@ def main():
     paths = sorted(p for p in (ROOT / "examples").iterdir() if p.suffix in SUFFIXES)
     if args.only:
         paths = [p for p in paths if p.name in args.only]
-    try:
-        commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                                text=True).stdout.strip()
-    except OSError:
-        commit = "?"
+    commit = git_commit()
     points = []
     OUT.mkdir(parents=True, exist_ok=True)
     old = {}

@@ -21,7 +21,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import subprocess
 import time
 from pathlib import Path
 
@@ -30,6 +29,7 @@ from mlc.circuit.build import CircuitOptions
 from mlc.pipeline import build, compile_spec, load
 from mlc.verify.circuit import THERMAL_SDS, verify_dynamic, verify_static
 from mlc.verify.dynamic import signal_time
+from gitstate import commit as git_commit      # benchmarks/gitstate.py
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results" / "circuit_joint_k.json"
@@ -65,8 +65,7 @@ def main():
     ap.add_argument("--dynamic", nargs="*", default=[], help="rows to verify by Brownian dynamics (seed 0)")
     a = ap.parse_args()
     res = json.loads(OUT.read_text()) if OUT.exists() else {"examples": {}}
-    res.update({"commit": subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                                         text=True).stdout.strip(), "kT": KT, "load_start": list(os.getloadavg())})
+    res.update({"commit": git_commit(), "kT": KT, "load_start": list(os.getloadavg())})
     for name in a.only:
         ex = res["examples"].setdefault(name, {})
         for K in a.k:

@@ -16,7 +16,6 @@ import argparse
 import hashlib
 import json
 import os
-import subprocess
 import time
 from pathlib import Path
 
@@ -29,6 +28,7 @@ from mlc.logic.library import ripple_adder
 from mlc.pipeline import compile_spec
 from mlc.scene.io import dump_scene
 from mlc.verify.circuit import verify_static
+from gitstate import commit as git_commit      # benchmarks/gitstate.py
 
 OUT = Path(__file__).resolve().parent / "results"
 
@@ -68,8 +68,7 @@ def main():
             done |= {r["row"] for r in d["rows"]}
         rows = [format(i, f"0{n}b") for i in range(2 ** n) if format(i, f"0{n}b") not in done]
         print(f"{len(done)} rows done in {', '.join(f.name for f in done_files)}; {len(rows)} to check", flush=True)
-    git = subprocess.run(["git", "rev-parse", "--short", "HEAD"], capture_output=True, text=True,
-                         cwd=Path(__file__).resolve().parent).stdout.strip()
+    git = git_commit()
     out = []
 
     def result():

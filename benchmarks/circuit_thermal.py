@@ -25,7 +25,6 @@ import copy
 import json
 import math
 import os
-import subprocess
 import time
 from pathlib import Path
 
@@ -36,6 +35,7 @@ from mlc.gates.connector import chain_scene
 from mlc.pipeline import build, compile_spec, load
 from mlc.scene.model import Probe
 from mlc.verify.dynamic import probe_thermal_sd, relaxation_time, signal_time
+from gitstate import commit as git_commit      # benchmarks/gitstate.py
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results" / "circuit_thermal.json"
@@ -73,8 +73,7 @@ def main():
     ap.add_argument("--only", nargs="*", default=["tetris.tt", "full_adder.expr"])
     ap.add_argument("--drift", type=float, default=0.0, help="t0 of Brownian dynamics at rest (first example)")
     a = ap.parse_args()
-    res = {"commit": subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                                    text=True).stdout.strip(), "kT": KT, "load": list(os.getloadavg()),
+    res = {"commit": git_commit(), "kT": KT, "load": list(os.getloadavg()),
            "examples": {}, "chains": []}
     for u in (5, 10, 20):
         sc = chain_scene(u, "contract")

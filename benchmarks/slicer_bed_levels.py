@@ -23,7 +23,6 @@ from __future__ import annotations
 import argparse
 import json
 import platform
-import subprocess
 import sys
 import time
 from pathlib import Path
@@ -41,6 +40,7 @@ from mlc.mesh.build import _orientation, transform_solid  # noqa: E402
 from mlc.mesh.checks import bed_checks  # noqa: E402
 from mlc.mesh.profiles import load_profile  # noqa: E402
 from slicer_configs import printed  # noqa: E402
+from gitstate import commit as git_commit      # benchmarks/gitstate.py
 
 
 def main() -> int:
@@ -50,8 +50,7 @@ def main() -> int:
     ap.add_argument("--profiles", default="fdm")
     ap.add_argument("-o", "--out", default=str(ROOT / "benchmarks/results/slicer_bed_levels.json"))
     a = ap.parse_args()
-    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
+    commit = git_commit()
     rows = []
     for g in a.gates.split(","):
         scene = gate_scene(g, a.signal)

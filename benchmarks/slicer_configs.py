@@ -39,7 +39,6 @@ import collections
 import json
 import platform
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -58,6 +57,7 @@ from mlc.mesh.build import Part, build_assembly, transform_solid  # noqa: E402
 from mlc.mesh.configs import Clearance, Evaluator, Kinematics, scan  # noqa: E402
 from mlc.mesh.pipeline import _dense_poses, state_poses  # noqa: E402
 from mlc.mesh.profiles import load_profile  # noqa: E402
+from gitstate import commit as git_commit      # benchmarks/gitstate.py
 
 
 def printed(scene, prof):
@@ -132,8 +132,7 @@ def main() -> int:
     ap.add_argument("--append", action="store_true")
     a = ap.parse_args()
     exe = None if a.no_slicer else shutil.which("prusa-slicer")
-    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
+    commit = git_commit()
     rows = json.loads(Path(a.out).read_text()).get("rows", []) if a.append and Path(a.out).exists() else []
     tmp = Path(tempfile.mkdtemp(prefix="mlc_configs_"))
     every = max(1, int(round(a.eval_step / a.step)))

@@ -62,6 +62,7 @@ from mlc.mesh.pipeline import export_assembly  # noqa: E402
 from mlc.mesh.pose import report_grid  # noqa: E402
 from mlc.mesh.printability import bed_stats  # noqa: E402
 from mlc.mesh.profiles import load_profile  # noqa: E402
+from gitstate import commit as git_commit      # benchmarks/gitstate.py
 
 LAYER = {"mjp": 0.1, "sla": 0.1, "fdm": 0.2}
 FIRST_LAYER = 0.2      # PrusaSlicer's first layer height here (mm)
@@ -198,8 +199,7 @@ def main() -> int:
         return 1
     ver = subprocess.run([exe, "--help"], capture_output=True, text=True).stdout.split("\n")
     ver = next((x for x in ver if x.startswith("PrusaSlicer")), "?")
-    commit = subprocess.run(["git", "-C", str(ROOT), "rev-parse", "--short", "HEAD"], capture_output=True,
-                            text=True).stdout.strip()
+    commit = git_commit()
     rows = []
     if a.append and Path(a.out).exists():
         rows = json.loads(Path(a.out).read_text()).get("rows", [])

@@ -34,7 +34,6 @@ import json
 import os
 import platform
 import random
-import subprocess
 import time
 from pathlib import Path
 
@@ -44,6 +43,7 @@ import numpy as np
 from circuit_examples import SUFFIXES      # the example files circuit_examples.py compiles
 from mlc.verify import static
 from mlc.verify.overlap import clearance
+from gitstate import commit as git_commit      # benchmarks/gitstate.py
 
 ROOT = Path(__file__).resolve().parents[1]
 OUT = ROOT / "benchmarks" / "results"
@@ -160,8 +160,7 @@ def main():
         (OUT / "static_polish.json").write_text(json.dumps(res, indent=1))
         print(json.dumps(res["summary"], indent=1))
         return
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                            text=True).stdout.strip()
+    commit = git_commit()
     paths = sorted(p for p in (ROOT / "examples").iterdir() if p.suffix in SUFFIXES)
     if args.only is not None:
         paths = [p for p in paths if p.name in args.only]

@@ -43,6 +43,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from gitstate import commit as git_commit      # benchmarks/gitstate.py
 
 ROOT = Path(__file__).resolve().parents[1]
 EPFL = ROOT.parent / "shared" / "benchmarks" / "epfl"
@@ -413,8 +414,7 @@ def profile(names: list[str]) -> int:
         print(f"{name:10s} {d['cpu_s']:6.2f} s CPU, {d['ands']} ANDs, kernels {d['kernel_s']:.2f} s in "
               f"{d['kernel_calls']} calls; " + ", ".join(f"{k} {v:.2f}" for k, v in top), flush=True)
     res["load_after"] = [round(x, 1) for x in os.getloadavg()]
-    res["git_head"] = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                                     text=True).stdout.strip()
+    res["git_head"] = git_commit()
     RESULTS.mkdir(parents=True, exist_ok=True)
     stem = "synthesis_epfl_profile" if len(names) == len(CIRCUITS) else "synthesis_epfl_profile_subset"
     (RESULTS / f"{stem}.json").write_text(json.dumps(res, indent=1) + "\n")
@@ -527,8 +527,7 @@ def main(argv=None) -> int:
             mlc_ands_total=sum(r["mlc"]["ands"] for r in both),
             abc_ands_total=sum(r["abc"]["ands"] for r in both),
         )
-    commit = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                            text=True).stdout.strip()
+    commit = git_commit()
     res = {
         "benchmark": "synthesis_epfl",
         "date": time.strftime("%Y-%m-%d %H:%M UTC", time.gmtime()),
