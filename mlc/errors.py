@@ -43,6 +43,10 @@ class MlcError(Exception):
         self.fix = fix
         super().__init__(self.format())
 
+    def __reduce__(self):
+        # pickled whole (from a worker process, say), not as the formatted text alone
+        return (type(self), (self.message, self.where, self.fix))
+
     def format(self) -> str:
         s = f"{self.where}: " if self.where else ""
         s += self.message

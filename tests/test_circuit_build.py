@@ -65,6 +65,35 @@ def test_every_row_verifies_statically_and_reports_clearance(tetris):
     assert tetris[2].scene.meta["connector"]["tight_chains"] == []
 
 
+def test_rows_in_processes_give_the_same_report_number_for_number(tetris):
+    """--jobs: each row in a forked process of its own; every row starts from the scene's
+    pose, so the report must not depend on how many run at once (only the seconds may)."""
+    import multiprocessing
+    if "fork" not in multiprocessing.get_all_start_methods():
+        pytest.skip("no fork here: rows run one at a time whatever --jobs says")
+    seen = []
+    one = verify_static(tetris[2].scene)
+    two = verify_static(tetris[2].scene, jobs=3, progress=lambda done, total: seen.append((done, total)))
+    for rep in (one, two):
+        for row in rep.rows:
+            row.pop("seconds")
+    assert [r["state"] for r in two.rows] == tetris[2].scene.states()     # in the truth table's order
+    assert two.rows == one.rows and two.entries == one.entries
+    assert seen == [(k, 4) for k in range(1, 5)]
+
+
+def test_an_error_in_a_row_process_reaches_the_caller_whole(tetris, monkeypatch):
+    from mlc.errors import MlcError
+    from mlc.verify import circuit
+
+    def boom(scene, state, **kw):
+        raise MlcError(f"row {state} refused", "--rows", "pick another")
+    monkeypatch.setattr(circuit, "_static_row", boom)
+    with pytest.raises(MlcError) as e:
+        verify_static(tetris[2].scene, jobs=2)
+    assert e.value.where == "--rows" and e.value.fix == "pick another" and "refused" in e.value.message
+
+
 def test_static_check_reports_the_thermal_spread(tetris):
     """Each probe's harmonic thermal spread at kT (mlc.verify.dynamic.probe_thermal_sd, checked
     against the integrator in test_verify_dynamic): a row is thermal_ok when every margin is

@@ -14,6 +14,7 @@ from __future__ import annotations
 import json
 import sys
 
+from mlc.commands.verify import add_jobs, check_jobs
 from mlc.errors import MlcError
 
 MAX_JOINT_K = 1e4          # --joint-k upper bound (k0); the stiff scheme's stages grow as sqrt(k)
@@ -88,6 +89,7 @@ def register(sub):
     p.add_argument("--kT", type=float, default=1e-5, help="thermal energy for --dynamic (k0 sigma^2, default 1e-5)")
     p.add_argument("--seeds", type=int, default=3, help="seeds per row for --dynamic (default 3)")
     p.add_argument("--scheme", choices=("stiff", "euler"), default="stiff", help="integrator for --dynamic")
+    add_jobs(p)
     p.add_argument("--stl", metavar="STL", help="printable mesh of the whole circuit (through mlc stl)")
     p.add_argument("--3mf", dest="threemf", metavar="3MF", help="3MF of the circuit with named parts (through mlc stl)")
     p.add_argument("--profile", default="mjp", help="printer profile for --stl/--3mf (mjp, sla, fdm or a file)")
@@ -237,6 +239,9 @@ def run(args) -> int:
         raise MlcError("--verify, --stl and --3mf need the circuit", "--no-circuit", "drop --no-circuit")
     if args.dynamic and not args.verify:
         raise MlcError("--dynamic only applies to --verify", "--dynamic", "add --verify")
+    if args.jobs != 1 and not args.verify:
+        raise MlcError("--jobs only applies to --verify", "--jobs", "add --verify")
+    check_jobs(args.jobs, args.dynamic)
     if not 1 <= args.seeds <= 1000:
         raise MlcError(f"--seeds must be between 1 and 1000, got {args.seeds}", "--seeds")
     from mlc.sim import check_kT
@@ -301,7 +306,7 @@ def run(args) -> int:
             if args.dynamic:
                 from mlc.io.warmup import notice
                 notice(args.scheme)
-            report = verify_scene_file(scene, args.dynamic, args.kT, args.seeds, args.scheme)
+            report = verify_scene_file(scene, args.dynamic, args.kT, args.seeds, args.scheme, jobs=args.jobs)
     with outs:
         for name, data in files.items():
             if name == "<draw>":

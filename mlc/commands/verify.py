@@ -9,6 +9,7 @@ MAX_SEEDS = 1000            # seeds per row for --dynamic
 MAX_DT = 1e3          # --dt upper bound (t0): the slowest rows relax in about 100 t0 (the Tetris robot)
 MIN_DT = 1e-6         # --dt lower bound (t0): a run of 20 t0 is then 2e7 steps
 MAX_TAU = 1e4         # --tau upper bound (t0): a run lasts several tau; the Tetris robot's is 100 t0
+MAX_JOBS = 256        # --jobs upper bound: rows verified at once, one process each
 
 
 def register(sub):
@@ -35,15 +36,38 @@ def register(sub):
     p.add_argument("--rows", metavar="BITS", nargs="+", help="verify only these rows (bit strings in input order)")
     p.add_argument("--require-clearance", action="store_true",
                    help="static: also fail a row whose slabs interpenetrate (reported as a warning otherwise)")
+    add_jobs(p)
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(func=run)
 
 
+def add_jobs(p) -> None:
+    """The ``--jobs`` option (``mlc verify``, ``mlc compile --verify``)."""
+    p.add_argument("--jobs", type=int, default=1, metavar="N",
+                   help="static check of a circuit: N rows at once, each in a process of its own (default 1; the "
+                        "report is the same for any N; memory grows with N). --dynamic runs use the integrator's "
+                        "threads instead")
+
+
+def check_jobs(jobs: int, dynamic: bool) -> None:
+    """--jobs is a whole number of at least 1, and only for the static check."""
+    from mlc.errors import MlcError
+    if jobs < 1 or jobs > MAX_JOBS:
+        raise MlcError(f"--jobs must be between 1 and {MAX_JOBS}, got {jobs}", "--jobs",
+                       "e.g. --jobs 2 on a 2-core machine")
+    if jobs > 1 and dynamic:
+        raise MlcError("--jobs applies to the static check; Brownian dynamics (--dynamic) already runs on the "
+                       "integrator's threads (NUMBA_NUM_THREADS)", "--jobs", "drop --jobs or --dynamic")
+
+
 def verify_scene_file(scene, dynamic: bool = False, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
-                      rows=None, require_clearance: bool = False, tau: float | None = None, dt: float | None = None):
+                      rows=None, require_clearance: bool = False, tau: float | None = None, dt: float | None = None,
+                      jobs: int = 1):
     """The report for an already loaded scene (used by ``mlc compile --verify`` too).  ``tau``
     and ``dt`` (t0, dynamic only): the relaxation time a run lasts at least 3 times and the
-    integrator's step; None: the robot's or the verifier's defaults."""
+    integrator's step; None: the robot's or the verifier's defaults.  ``jobs``: rows of a
+    circuit's static check solved at once (:func:`mlc.verify.circuit.verify_static`; a
+    robot's rows run one at a time)."""
     from mlc.io.progress import Progress
     from mlc.verify.circuit import select_rows, verify_dynamic, verify_static
 
@@ -55,7 +79,7 @@ def verify_scene_file(scene, dynamic: bool = False, kT: float = 1e-5, seeds: int
         return verify_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme, tau=tau, dt=dt)
     with Progress(f"static verification of {scene.name}", total=n) as bar:
         return verify_static(scene, rows, progress=lambda done, total: bar.update(done),
-                             require_clearance=require_clearance, kT=kT)
+                             require_clearance=require_clearance, kT=kT, jobs=jobs)
 
 
 def run(args) -> int:
@@ -65,6 +89,7 @@ def run(args) -> int:
 
     from mlc.sim import check_kT
     check_kT(args.kT)
+    check_jobs(args.jobs, args.dynamic)
     if args.dynamic and not 1 <= args.seeds <= MAX_SEEDS:
         raise MlcError(f"--seeds must be between 1 and {MAX_SEEDS}, got {args.seeds} (each seed of each row is a "
                        f"Brownian-dynamics run of minutes on a circuit)", "--seeds")
@@ -93,7 +118,7 @@ def run(args) -> int:
         from mlc.io.warmup import notice
         notice(args.scheme)
     rep = verify_scene_file(scene, args.dynamic, args.kT, args.seeds, args.scheme, args.rows,
-                            args.require_clearance, tau=args.tau, dt=args.dt)
+                            args.require_clearance, tau=args.tau, dt=args.dt, jobs=args.jobs)
     if isinstance(scene.meta, dict) and scene.meta.get("element") == "robot":
         from mlc.robot.verify import format_robot_report as format_report
     print(json.dumps(rep.as_dict()) if args.json else format_report(rep))

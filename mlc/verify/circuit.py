@@ -77,7 +77,7 @@ def select_rows(scene: Scene, rows=None) -> list[str]:
 
 def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_stretch: float = TOL_STRETCH,
                   clearance: bool = True, progress=None, require_clearance: bool = False,
-                  kT: float | None = 1e-5, polish: bool | None = None) -> Report:
+                  kT: float | None = 1e-5, polish: bool | None = None, jobs: int = 1) -> Report:
     """Static check of every row in ``rows`` (default all), see the module docstring.  With
     ``kT`` (k0 sigma^2; None: skipped) each entry also gets ``thermal_sd``, the probe's
     harmonic thermal spread in that row's equilibrium (sigma,
@@ -90,65 +90,132 @@ def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_s
     than ``POLISH_ABOVE``.  A circuit's continuation goes level by level in logic depth
     (:func:`mlc.circuit.levels.body_levels`; docs/circuits.md, "Level by level").
 
-    ``progress(done, total)``: called as rows finish (``done`` whole rows of ``total``) and
-    within a row (``done`` fractional: ``ROW_SHARES`` of the row after its equilibrium's
-    minimisations, its thermal spread and its clearance), so that one row of a large circuit,
-    minutes long, moves its progress bar."""
-    from mlc.verify.dynamic import probe_thermal_sd
-    from mlc.verify.overlap import clearance as clear
-    from mlc.verify.static import equilibrium
+    ``jobs``: rows solved at once, each in a process of its own (forked, so the scene is
+    not copied up front; each process is single-threaded, as OpenBLAS is under mlc).  Every
+    row starts from the scene's own pose, so the report is the same, number for number, for
+    any ``jobs``; only the order in which rows finish changes.  Memory grows with ``jobs``:
+    each process holds one row's solve.  Where processes cannot be forked (not Linux or
+    macOS) rows run one at a time.
 
+    ``progress(done, total)``: called as rows finish (``done`` whole rows of ``total``) and,
+    with one job, within a row (``done`` fractional: ``ROW_SHARES`` of the row after its
+    equilibrium's minimisations, its thermal spread and its clearance), so that one row of
+    a large circuit, minutes long, moves its progress bar."""
     states = select_rows(scene, rows)
+    jobs = int(jobs)
+    if jobs < 1:
+        raise MlcError(f"--jobs must be at least 1, got {jobs}", "--jobs", "e.g. --jobs 2 on a 2-core machine")
     t0 = time.perf_counter()
     rep = Report(scene.name, "static", params={"tol_length": tol_length, "tol_stretch": tol_stretch,
                                                "require_clearance": require_clearance, "kT": kT,
                                                "joint_k": scene.meta.get("connector", {}).get("joint_k", 1.0)})
-    for i, state in enumerate(states):
-        t_row = time.perf_counter()
-        eq = equilibrium(scene, state, polish=polish, levels="depth", progress=None if not progress else
-                         (lambda f, i=i: progress(i + ROW_SHARES[0] * f, len(states))))
-        want = scene.truth_table.get(state)
-        row_ok = eq.max_joint_stretch <= tol_stretch
-        sd = probe_thermal_sd(scene, kT, eq.pos, eq.quat) if kT is not None and kT > 0 else {}
-        if progress and clearance:
-            progress(i + ROW_SHARES[1], len(states))
-        thermal_ok = True
-        for pr in scene.probes:
-            k = scene.outputs.index(pr.output)
-            bit = None if want is None or want[k] == "-" else int(want[k])
-            L = eq.probes[pr.name]
-            ideal = None if bit is None else (pr.actuated if bit else pr.rest)
-            ok = bit is None or (pr.bit(L) == bit and abs(L - ideal) <= tol_length)
-            row_ok &= ok
-            margin = None if bit is None else float(pr.margin(L, bit))
-            entry = {"state": state, "output": pr.output, "expected": bit, "measured": L,
-                     "bit": pr.bit(L), "margin": margin,
-                     "error": None if ideal is None else float(abs(L - ideal)), "ok": bool(ok)}
-            if pr.name in sd:
-                entry["thermal_sd"] = float(sd[pr.name])
-                if margin is not None and not margin >= THERMAL_SDS * sd[pr.name]:
-                    thermal_ok = False
-            rep.entries.append(entry)
-        row = {"state": state, "joint_stretch": eq.max_joint_stretch, "muscle_strain": eq.max_muscle_strain,
-               "iterations": eq.iterations, "converged": eq.converged, "seconds": 0.0}
-        if sd:
-            row["thermal_ok"] = thermal_ok
-        if clearance:
-            c = clear(scene, eq.pos, eq.quat)
-            row["clearance"] = c.min_clearance
-            row["clearance_pair"] = list(c.pair)
-            row["overlaps"] = [list(o) for o in c.overlaps[:10]]
-            row["n_overlaps"] = len(c.overlaps)
-            row["clearance_ok"] = bool(c.ok())
-            if require_clearance:
-                row_ok &= c.ok()
-        row["ok"] = bool(row_ok)
-        row["seconds"] = time.perf_counter() - t_row
+    kw = dict(tol_length=tol_length, tol_stretch=tol_stretch, clearance=clearance,
+              require_clearance=require_clearance, kT=kT, polish=polish)
+    if jobs > 1 and len(states) > 1 and _can_fork():
+        results = _rows_in_processes(scene, states, kw, min(jobs, len(states)), progress)
+    else:
+        results = []
+        for i, state in enumerate(states):
+            within = None if not progress else (lambda f, i=i: progress(i + f, len(states)))
+            results.append(_static_row(scene, state, within=within, **kw))
+            if progress:
+                progress(i + 1, len(states))
+    for entries, row in results:
+        rep.entries.extend(entries)
         rep.rows.append(row)
-        if progress:
-            progress(i + 1, len(states))
     rep.seconds = time.perf_counter() - t0
     return rep
+
+
+def _static_row(scene: Scene, state: str, tol_length: float, tol_stretch: float, clearance: bool,
+                require_clearance: bool, kT: float | None, polish: bool | None, within=None) -> tuple[list, dict]:
+    """One row of :func:`verify_static`: its entries (one per probe) and its summary.
+    ``within(f)``: the fraction ``f`` of the row done (``ROW_SHARES``)."""
+    from mlc.verify.dynamic import probe_thermal_sd
+    from mlc.verify.overlap import clearance as clear
+    from mlc.verify.static import equilibrium
+
+    t_row = time.perf_counter()
+    eq = equilibrium(scene, state, polish=polish, levels="depth",
+                     progress=None if not within else (lambda f: within(ROW_SHARES[0] * f)))
+    want = scene.truth_table.get(state)
+    row_ok = eq.max_joint_stretch <= tol_stretch
+    sd = probe_thermal_sd(scene, kT, eq.pos, eq.quat) if kT is not None and kT > 0 else {}
+    if within and clearance:
+        within(ROW_SHARES[1])
+    thermal_ok = True
+    entries = []
+    for pr in scene.probes:
+        k = scene.outputs.index(pr.output)
+        bit = None if want is None or want[k] == "-" else int(want[k])
+        L = eq.probes[pr.name]
+        ideal = None if bit is None else (pr.actuated if bit else pr.rest)
+        ok = bit is None or (pr.bit(L) == bit and abs(L - ideal) <= tol_length)
+        row_ok &= ok
+        margin = None if bit is None else float(pr.margin(L, bit))
+        entry = {"state": state, "output": pr.output, "expected": bit, "measured": L,
+                 "bit": pr.bit(L), "margin": margin,
+                 "error": None if ideal is None else float(abs(L - ideal)), "ok": bool(ok)}
+        if pr.name in sd:
+            entry["thermal_sd"] = float(sd[pr.name])
+            if margin is not None and not margin >= THERMAL_SDS * sd[pr.name]:
+                thermal_ok = False
+        entries.append(entry)
+    row = {"state": state, "joint_stretch": eq.max_joint_stretch, "muscle_strain": eq.max_muscle_strain,
+           "iterations": eq.iterations, "converged": eq.converged, "seconds": 0.0}
+    if sd:
+        row["thermal_ok"] = thermal_ok
+    if clearance:
+        c = clear(scene, eq.pos, eq.quat)
+        row["clearance"] = c.min_clearance
+        row["clearance_pair"] = list(c.pair)
+        row["overlaps"] = [list(o) for o in c.overlaps[:10]]
+        row["n_overlaps"] = len(c.overlaps)
+        row["clearance_ok"] = bool(c.ok())
+        if require_clearance:
+            row_ok &= c.ok()
+    row["ok"] = bool(row_ok)
+    row["seconds"] = time.perf_counter() - t_row
+    return entries, row
+
+
+def _can_fork() -> bool:
+    import multiprocessing
+    return "fork" in multiprocessing.get_all_start_methods()
+
+
+_FORKED: tuple | None = None         # (scene, row options) for the forked row processes
+
+
+def _forked_row(state: str) -> tuple[list, dict]:
+    scene, kw = _FORKED
+    return _static_row(scene, state, **kw)
+
+
+def _rows_in_processes(scene: Scene, states: list[str], kw: dict, jobs: int, progress) -> list:
+    """:func:`_static_row` of every state in ``jobs`` forked processes; results in the order
+    of ``states``.  A process that dies (out of memory, say) is reported as an MlcError
+    naming ``--jobs``."""
+    import multiprocessing
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+    from concurrent.futures.process import BrokenProcessPool
+
+    global _FORKED
+    _FORKED = (scene, kw)
+    out: list = [None] * len(states)
+    try:
+        with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("fork")) as ex:
+            futures = {ex.submit(_forked_row, s): k for k, s in enumerate(states)}
+            for done, fut in enumerate(as_completed(futures), 1):
+                out[futures[fut]] = fut.result()
+                if progress:
+                    progress(done, len(states))
+    except BrokenProcessPool:
+        raise MlcError(f"a process verifying rows of {scene.name} died (out of memory?)", "--jobs",
+                       "run with fewer --jobs (each holds one row's solve)") from None
+    finally:
+        _FORKED = None
+    return out
 
 
 def verify_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
