@@ -206,10 +206,14 @@ def _rows_in_processes(scene: Scene, states: list[str], kw: dict, jobs: int, pro
     try:
         with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("fork")) as ex:
             futures = {ex.submit(_forked_row, s): k for k, s in enumerate(states)}
-            for done, fut in enumerate(as_completed(futures), 1):
-                out[futures[fut]] = fut.result()
-                if progress:
-                    progress(done, len(states))
+            try:
+                for done, fut in enumerate(as_completed(futures), 1):
+                    out[futures[fut]] = fut.result()
+                    if progress:
+                        progress(done, len(states))
+            except BaseException:            # a row's error or Ctrl-C: the rows not started are dropped
+                ex.shutdown(wait=False, cancel_futures=True)
+                raise
     except BrokenProcessPool:
         raise MlcError(f"a process verifying rows of {scene.name} died (out of memory?)", "--jobs",
                        "run with fewer --jobs (each holds one row's solve)") from None
