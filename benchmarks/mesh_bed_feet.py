@@ -14,7 +14,10 @@ poses, the motion trims, the feet, the orientation, the printability report).  R
   pose of every library gate before the feet (fdm ``orient: auto`` chose the model's z; mjp and
   sla print ``as_is``) -- by the report's own bed statistics (``mlc.mesh.printability.bed_stats``
   on the report's grid);
-* ``feet_mm3``: the material the feet add, per part.
+* ``feet_mm3``: the material the feet add, per part;
+* ``support_by_part`` (in ``after`` and ``before``): the support of each part's overhangs by the
+  same statistics, ``{part: [overhang mm^2, support mm^3, of it between parts mm^3]}`` (which parts
+  the support is for: the output lever, ``out_lo`` and ``out_hi``, gets no feet).
 
 ``--slice`` (needs ``prusa-slicer`` on PATH): the ``after`` pose is also sliced by PrusaSlicer
 (``benchmarks/slicer_gates.py``'s ``pose_row``: the 3MF, slices without supports, with supports
@@ -69,6 +72,11 @@ def _check(rep, name) -> dict:
     return {"ok": c.ok, "value": c.value, "limit": c.limit, "detail": c.detail}
 
 
+def _by_part(b) -> dict:
+    """{part: [overhang mm^2, support mm^3, of it between parts mm^3]} of bed statistics ``b``."""
+    return {n: [round(float(x), 1) for x in v] for n, v in (b.per_part or {}).items()}
+
+
 def prusa_before(row: dict, ref: dict) -> dict | None:
     """PrusaSlicer's figures before the feet for ``row``'s case, from slicer_gates.json rows."""
     for r in ref.get("rows", []):
@@ -121,6 +129,13 @@ def main() -> int:
         path = Path(args.out)
         _write(path, json.loads(path.read_text())["rows"])
         return 0
+    from mlc.errors import MlcError
+    try:        # bad names: one message, before any case runs
+        scenes = {(g, s): gate_scene(g, s) for s in args.signals for g in args.gates}
+        profiles = {p: load_profile(p) for p in args.profiles}
+    except MlcError as e:
+        print(f"mesh_bed_feet: {e}", file=sys.stderr)
+        return 2
     from slicer_gates import pose_row, stats   # noqa: E402 (benchmarks/slicer_gates.py)
     exe = shutil.which("prusa-slicer") if args.slice else None
     if args.slice and exe is None:
@@ -133,9 +148,9 @@ def main() -> int:
     tmp = Path(tempfile.mkdtemp(prefix="mlc_feet_"))
     for signal in args.signals:
         for name in args.gates:
-            scene = gate_scene(name, signal)
+            scene = scenes[(name, signal)]
             for prof in args.profiles:
-                profile = load_profile(prof)
+                profile = profiles[prof]
                 head, dirty = _git_state()
                 t0 = time.perf_counter()
                 asm, rep = export_assembly(scene, profile)
@@ -152,8 +167,8 @@ def main() -> int:
                        "feet_mm3": asm.feet, "feet_total_mm3": round(sum(asm.feet.values()), 1),
                        "up": [round(float(x), 4) for x in up],
                        "after": {"bed_contact": _check(rep, "bed_contact"), "supports": _check(rep, "supports"),
-                                 "bed": asm.bed.to_dict()},
-                       "before": {"up": [0.0, 0.0, 1.0], "bed": b0.to_dict()},
+                                 "bed": asm.bed.to_dict(), "support_by_part": _by_part(asm.bed)},
+                       "before": {"up": [0.0, 0.0, 1.0], "bed": b0.to_dict(), "support_by_part": _by_part(b0)},
                        "motion_clearance": _check(rep, "motion_clearance"), "min_gap": _check(rep, "min_gap"),
                        "states": _check(rep, "states"), "wall_thickness": _check(rep, "wall_thickness"),
                        "notes": [n for n in rep.notes if n.startswith("feet") or "up is" in n][:4],
