@@ -3,7 +3,8 @@
 ``commit()`` is the short hash of HEAD, with ``-dirty`` appended (as ``git describe
 --dirty`` does) when a file under ``mlc/`` differs from it, so that a figure measured on
 uncommitted code says so; ``"?"`` where git or the repository is not there (a copy of
-the scripts outside a checkout).  ``dirty()`` lists those files.
+the scripts outside a checkout).  ``dirty()`` lists those files, ``head()`` is HEAD alone
+(for a script that records the list itself).
 """
 from __future__ import annotations
 
@@ -28,9 +29,15 @@ def dirty(paths: tuple[str, ...] = ("mlc",)) -> list[str]:
     return sorted(line[3:] for line in (out or "").split("\n") if line.strip())
 
 
+def head() -> str | None:
+    """The short hash of HEAD; None without git."""
+    out = _git("rev-parse", "--short", "HEAD")
+    return None if out is None else out.strip()
+
+
 def commit(paths: tuple[str, ...] = ("mlc",)) -> str:
     """Short HEAD, ``-dirty`` when :func:`dirty` lists a file; ``"?"`` without git."""
-    head = _git("rev-parse", "--short", "HEAD")
-    if head is None:
+    h = head()
+    if h is None:
         return "?"
-    return head.strip() + ("-dirty" if dirty(paths) else "")
+    return h + ("-dirty" if dirty(paths) else "")

@@ -44,7 +44,6 @@ import json
 import os
 import platform
 import shutil
-import subprocess
 import sys
 import tempfile
 import time
@@ -55,6 +54,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "benchmarks"))
 
+import gitstate  # noqa: E402 (benchmarks/gitstate.py)
 import numpy as np  # noqa: E402
 
 from mlc.gates.library import GATE_NAMES, gate_scene  # noqa: E402
@@ -93,15 +93,8 @@ def prusa_before(row: dict, ref: dict) -> dict | None:
 
 
 def _git_state() -> tuple[str | None, list]:
-    """The HEAD this runs on and the files under mlc/ that differ from it."""
-    try:
-        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT, capture_output=True,
-                              text=True, check=True).stdout.strip()
-        dirty = subprocess.run(["git", "status", "--porcelain", "--", "mlc"], cwd=ROOT, capture_output=True,
-                               text=True, check=True).stdout.split("\n")
-        return head, sorted(line[3:] for line in dirty if line.strip())
-    except (OSError, subprocess.CalledProcessError):
-        return None, []
+    """The HEAD this runs on and the files under mlc/ that differ from it (benchmarks/gitstate.py)."""
+    return gitstate.head(), gitstate.dirty()
 
 
 def _write(path: Path, rows: list) -> None:
