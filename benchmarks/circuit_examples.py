@@ -7,13 +7,15 @@ the router flagged tight, the build and verification wall times, the rows read r
 the largest joint stretch and the smallest slab clearance per row (exact oriented-box
 test) with the pair of bodies that sets it.
 
-    python benchmarks/circuit_examples.py [--only tetris.tt ...] [--joint-k K] [--direct]
+    python benchmarks/circuit_examples.py [--only tetris.tt ...] [--joint-k K] [--direct] [--jobs N]
 
 With ``--only`` the other examples' last entries are kept (each entry names its commit).
 ``--joint-k K`` builds with connector joints K times k0 (``mlc compile --joint-k``);
 ``--direct`` with direct gate-to-gate connections (``mlc compile --direct``; the nets made
 direct and those dropped as crossed are recorded), into ``circuit_examples_direct.json``.
 
+``--jobs N`` verifies N rows at once (``mlc verify --jobs``: the same results; the
+verification's wall time is then not one core's).
 Writes benchmarks/results/circuit_examples.json (``circuit_examples_jointk{K}.json`` with ``--joint-k``).  Wall seconds on this machine in one
 run (shared, noisy): compare ratios, not absolute numbers across machines.
 """
@@ -36,7 +38,7 @@ OUT = ROOT / "benchmarks" / "results"
 SUFFIXES = (".tt", ".pla", ".expr", ".blif", ".aag")
 
 
-def example_point(path: Path, joint_k: float | None = None, direct: bool = False) -> dict:
+def example_point(path: Path, joint_k: float | None = None, direct: bool = False, jobs: int = 1) -> dict:
     t0 = time.perf_counter()
     compiled = compile_spec(load(str(path)))
     t1 = time.perf_counter()
@@ -45,7 +47,7 @@ def example_point(path: Path, joint_k: float | None = None, direct: bool = False
     t2 = time.perf_counter()
     circ = compiled.circuit
     sc = circ.scene
-    rep = verify_static(sc)
+    rep = verify_static(sc, jobs=jobs)
     t3 = time.perf_counter()
     rows = [{"state": r["state"], "ok": r["ok"], "clearance": r.get("clearance"),
              "clearance_pair": r.get("clearance_pair"), "joint_stretch": r["joint_stretch"]} for r in rep.rows]
@@ -65,6 +67,8 @@ def main():
     ap.add_argument("--only", nargs="*", help="example file names (default: all)")
     ap.add_argument("--joint-k", type=float, default=None, help="connector joint stiffness, in k0 (default: mlc's)")
     ap.add_argument("--direct", action="store_true", help="direct gate-to-gate connections (mlc compile --direct)")
+    ap.add_argument("--jobs", type=int, default=1,
+                    help="rows verified at once (mlc verify --jobs; the same results, less wall time)")
     args = ap.parse_args()
     res_path = OUT / ("circuit_examples_direct.json" if args.direct else "circuit_examples.json" if args.joint_k is None
                       else f"circuit_examples_jointk{args.joint_k:g}.json")
@@ -79,8 +83,9 @@ def main():
         prev = json.loads(res_path.read_text())
         old = {e["example"]: e for e in prev.get("examples", []) if e["example"] not in args.only}
     for p in paths:
-        pt = example_point(p, args.joint_k, args.direct)
+        pt = example_point(p, args.joint_k, args.direct, args.jobs)
         pt["commit"] = commit
+        pt["jobs"] = args.jobs
         points.append(pt)
         print(f"{pt['example']:>18}: {pt['gates']} gates, {pt['bodies']} bodies, build {pt['build_s']:.1f} s, "
               f"{pt['rows_ok']}/{pt['rows']} rows right in {pt['verify_all_rows_s']:.1f} s, "

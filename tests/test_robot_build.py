@@ -43,6 +43,22 @@ def test_static_verify_reads_the_shapes(robot, capsys):
     assert rows["1"]["max_dof_error_deg"] < 0.01
 
 
+def test_static_verify_with_jobs_gives_the_same_report(robot, capsys):
+    """--jobs 2: the rows in forked processes (mlc.verify.circuit.map_rows), the same report."""
+    import multiprocessing
+    if "fork" not in multiprocessing.get_all_start_methods():
+        pytest.skip("no fork here: rows run one at a time whatever --jobs says")
+    reps = []
+    for jobs in ("1", "2"):
+        assert main(["verify", str(robot / "out" / "robot.yaml"), "--jobs", jobs, "--json"]) == 0
+        rep = json.loads(capsys.readouterr().out)
+        rep.pop("seconds")
+        for row in rep["rows"]:
+            row.pop("seconds")
+        reps.append(rep)
+    assert len(reps[0]["rows"]) == 2 and reps[1] == reps[0]
+
+
 def test_altered_expected_pose_is_a_wrong_shape(robot, capsys):
     sc = load_scene(robot / "out" / "robot.yaml")
     sc.meta["robot"]["poses"]["1"]["turns"] = [90, 90]

@@ -44,7 +44,7 @@ def register(sub):
 def add_jobs(p) -> None:
     """The ``--jobs`` option (``mlc verify``, ``mlc compile --verify``)."""
     p.add_argument("--jobs", type=int, default=1, metavar="N",
-                   help="static check of a circuit: N rows at once, each in a process of its own (default 1; the "
+                   help="static check: N rows at once, each in a process of its own (default 1; the "
                         "report is the same for any N; memory grows with N). --dynamic runs use the integrator's "
                         "threads instead")
 
@@ -65,15 +65,14 @@ def verify_scene_file(scene, dynamic: bool = False, kT: float = 1e-5, seeds: int
                       jobs: int = 1):
     """The report for an already loaded scene (used by ``mlc compile --verify`` too).  ``tau``
     and ``dt`` (t0, dynamic only): the relaxation time a run lasts at least 3 times and the
-    integrator's step; None: the robot's or the verifier's defaults.  ``jobs``: rows of a
-    circuit's static check solved at once (:func:`mlc.verify.circuit.verify_static`; a
-    robot's rows run one at a time)."""
+    integrator's step; None: the robot's or the verifier's defaults.  ``jobs``: rows of the
+    static check solved at once (:func:`mlc.verify.circuit.map_rows`)."""
     from mlc.io.progress import Progress
     from mlc.verify.circuit import select_rows, verify_dynamic, verify_static
 
     if isinstance(scene.meta, dict) and scene.meta.get("element") == "robot":     # docs/robot.md
         from mlc.robot.verify import verify_robot
-        return verify_robot(scene, dynamic, kT, seeds, scheme, rows, tau=tau, dt=dt)
+        return verify_robot(scene, dynamic, kT, seeds, scheme, rows, tau=tau, dt=dt, jobs=jobs)
     n = len(select_rows(scene, rows))
     if dynamic:
         return verify_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme, tau=tau, dt=dt)

@@ -244,11 +244,13 @@ def _clearance_row(scene: Scene, pos=None, quat=None) -> dict:
 
 
 def verify_robot_static(scene: Scene, rows=None, steps: int = STEPS, progress=None, keep_poses: bool = False,
-                        clearance: bool = True) -> Report:
+                        clearance: bool = True, jobs: int = 1) -> Report:
     """Static check of every row (see the module doc).  With ``clearance`` each row's
     equilibrium and the scene as built also get the slab-overlap test (docs/robot.md 3):
-    reported, a warning when slabs interpenetrate, not part of a row's verdict."""
-    from mlc.verify.static import equilibrium
+    reported, a warning when slabs interpenetrate, not part of a row's verdict.  ``jobs``:
+    rows solved at once, each in a forked process (:func:`mlc.verify.circuit.map_rows`;
+    the same report for any ``jobs``)."""
+    from mlc.verify.circuit import map_rows
 
     rm = robot_meta(scene)
     states = select_rows(scene, rows)
@@ -258,36 +260,44 @@ def verify_robot_static(scene: Scene, rows=None, steps: int = STEPS, progress=No
     if clearance:
         rep.params["as_built"] = _clearance_row(scene)
     poses = {}
-    for i, state in enumerate(states):
-        t_row = time.perf_counter()
-        eq = equilibrium(scene, state, steps=steps)
-        want = scene.truth_table.get(state)
-        row_ok = eq.max_joint_stretch <= TOL_STRETCH
-        for pr in scene.probes:
-            k = scene.outputs.index(pr.output)
-            bit = None if want is None or want[k] == "-" else int(want[k])
-            L = eq.probes[pr.name]
-            ideal = None if bit is None else (pr.actuated if bit else pr.rest)
-            ok = bit is None or (pr.bit(L) == bit and abs(L - ideal) <= TOL_LENGTH * max(1.0, abs(pr.actuated - pr.rest) / 0.5))
-            row_ok &= ok
-            rep.entries.append({"state": state, "output": pr.name if pr.name.startswith("dof_") else pr.output,
-                                "expected": bit, "measured": L, "bit": pr.bit(L),
-                                "margin": None if bit is None else float(pr.margin(L, bit)),
-                                "error": None if ideal is None else float(abs(L - ideal)), "ok": bool(ok)})
-        row = {"state": state, "joint_stretch": eq.max_joint_stretch}
-        row.update(_shape_row(scene, rm, state, eq.pos, eq.quat))
-        if clearance:                      # slab overlap in the row's pose (a printability check, not the shape's)
-            row.update(_clearance_row(scene, eq.pos, eq.quat))
-        row["ok"] = bool(row_ok and row["shape_ok"])
-        row["seconds"] = time.perf_counter() - t_row
+    for entries, row, pose in map_rows(lambda state: _static_row(scene, rm, state, steps, clearance), states, jobs,
+                                       progress):
+        rep.entries.extend(entries)
         rep.rows.append(row)
-        poses[state] = (eq.pos, eq.quat)
-        if progress:
-            progress(i + 1, len(states))
+        poses[row["state"]] = pose
     rep.seconds = time.perf_counter() - t0
     if keep_poses:
         rep.poses = poses
     return rep
+
+
+def _static_row(scene: Scene, rm, state: str, steps: int, clearance: bool) -> tuple[list, dict, tuple]:
+    """One row of :func:`verify_robot_static`: its entries, its summary and its pose (pos, quat)."""
+    from mlc.verify.static import equilibrium
+
+    t_row = time.perf_counter()
+    eq = equilibrium(scene, state, steps=steps)
+    want = scene.truth_table.get(state)
+    row_ok = eq.max_joint_stretch <= TOL_STRETCH
+    entries = []
+    for pr in scene.probes:
+        k = scene.outputs.index(pr.output)
+        bit = None if want is None or want[k] == "-" else int(want[k])
+        L = eq.probes[pr.name]
+        ideal = None if bit is None else (pr.actuated if bit else pr.rest)
+        ok = bit is None or (pr.bit(L) == bit and abs(L - ideal) <= TOL_LENGTH * max(1.0, abs(pr.actuated - pr.rest) / 0.5))
+        row_ok &= ok
+        entries.append({"state": state, "output": pr.name if pr.name.startswith("dof_") else pr.output,
+                        "expected": bit, "measured": L, "bit": pr.bit(L),
+                        "margin": None if bit is None else float(pr.margin(L, bit)),
+                        "error": None if ideal is None else float(abs(L - ideal)), "ok": bool(ok)})
+    row = {"state": state, "joint_stretch": eq.max_joint_stretch}
+    row.update(_shape_row(scene, rm, state, eq.pos, eq.quat))
+    if clearance:                      # slab overlap in the row's pose (a printability check, not the shape's)
+        row.update(_clearance_row(scene, eq.pos, eq.quat))
+    row["ok"] = bool(row_ok and row["shape_ok"])
+    row["seconds"] = time.perf_counter() - t_row
+    return entries, row, (eq.pos, eq.quat)
 
 
 def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
@@ -381,9 +391,9 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
 
 
 def verify_robot(scene: Scene, dynamic: bool = False, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
-                 rows=None, tau: float | None = None, dt: float | None = None) -> Report:
-    """``mlc verify`` of a robot scene: static (default) or by Brownian dynamics (``tau``
-    and ``dt`` in t0, defaults ``ROBOT_TAU`` and ``ROBOT_DT``)."""
+                 rows=None, tau: float | None = None, dt: float | None = None, jobs: int = 1) -> Report:
+    """``mlc verify`` of a robot scene: static (default; ``jobs`` rows at once) or by
+    Brownian dynamics (``tau`` and ``dt`` in t0, defaults ``ROBOT_TAU`` and ``ROBOT_DT``)."""
     from mlc.io.progress import Progress
 
     robot_meta(scene)
@@ -391,7 +401,7 @@ def verify_robot(scene: Scene, dynamic: bool = False, kT: float = 1e-5, seeds: i
         return verify_robot_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme, tau=tau, dt=dt)
     n = len(select_rows(scene, rows))
     with Progress(f"static verification of {scene.name}", total=n) as bar:
-        return verify_robot_static(scene, rows, progress=lambda done, total: bar.update(done))
+        return verify_robot_static(scene, rows, progress=lambda done, total: bar.update(done), jobs=jobs)
 
 
 def format_robot_report(rep: Report) -> str:

@@ -102,24 +102,21 @@ def verify_static(scene: Scene, rows=None, tol_length: float = TOL_LENGTH, tol_s
     equilibrium's minimisations, its thermal spread and its clearance), so that one row of
     a large circuit, minutes long, moves its progress bar."""
     states = select_rows(scene, rows)
-    jobs = int(jobs)
-    if jobs < 1:
-        raise MlcError(f"--jobs must be at least 1, got {jobs}", "--jobs", "e.g. --jobs 2 on a 2-core machine")
     t0 = time.perf_counter()
     rep = Report(scene.name, "static", params={"tol_length": tol_length, "tol_stretch": tol_stretch,
                                                "require_clearance": require_clearance, "kT": kT,
                                                "joint_k": scene.meta.get("connector", {}).get("joint_k", 1.0)})
     kw = dict(tol_length=tol_length, tol_stretch=tol_stretch, clearance=clearance,
               require_clearance=require_clearance, kT=kT, polish=polish)
-    if jobs > 1 and len(states) > 1 and _can_fork():
-        results = _rows_in_processes(scene, states, kw, min(jobs, len(states)), progress)
-    else:
-        results = []
-        for i, state in enumerate(states):
-            within = None if not progress else (lambda f, i=i: progress(i + f, len(states)))
-            results.append(_static_row(scene, state, within=within, **kw))
-            if progress:
-                progress(i + 1, len(states))
+    if int(jobs) > 1:
+        results = map_rows(lambda state: _static_row(scene, state, **kw), states, jobs, progress)
+    else:                   # one at a time, the progress bar moving within each row too
+        index = {s: i for i, s in enumerate(states)}
+
+        def row_with_progress(state):
+            within = None if not progress else (lambda f: progress(index[state] + f, len(states)))
+            return _static_row(scene, state, within=within, **kw)
+        results = map_rows(row_with_progress, states, jobs, progress)
     for entries, row in results:
         rep.entries.extend(entries)
         rep.rows.append(row)
@@ -184,27 +181,40 @@ def _can_fork() -> bool:
     return "fork" in multiprocessing.get_all_start_methods()
 
 
-_FORKED: tuple | None = None         # (scene, row options) for the forked row processes
+_FORKED = None            # the row function of map_rows, for its forked processes
 
 
-def _forked_row(state: str) -> tuple[list, dict]:
-    scene, kw = _FORKED
-    return _static_row(scene, state, **kw)
+def _forked_row(state: str):
+    return _FORKED(state)
 
 
-def _rows_in_processes(scene: Scene, states: list[str], kw: dict, jobs: int, progress) -> list:
-    """:func:`_static_row` of every state in ``jobs`` forked processes; results in the order
-    of ``states``.  A process that dies (out of memory, say) is reported as an MlcError
-    naming ``--jobs``."""
+def map_rows(fn, states: list[str], jobs: int = 1, progress=None) -> list:
+    """``[fn(s) for s in states]``, with ``jobs`` > 1 in that many forked processes (each
+    inherits ``fn`` and what it holds, so nothing is copied up front; results come back
+    pickled).  ``progress(done, total)`` after each row, as rows finish.  Where processes
+    cannot be forked rows run one at a time.  A process that dies (out of memory, say) is
+    reported as an MlcError naming ``--jobs``; a row's error, or Ctrl-C, drops the rows not
+    yet started.  The rows of ``mlc verify --jobs N`` (circuits and robots)."""
+    jobs = int(jobs)
+    if jobs < 1:
+        raise MlcError(f"--jobs must be at least 1, got {jobs}", "--jobs", "e.g. --jobs 2 on a 2-core machine")
+    if jobs == 1 or len(states) < 2 or not _can_fork():
+        out = []
+        for i, state in enumerate(states):
+            out.append(fn(state))
+            if progress:
+                progress(i + 1, len(states))
+        return out
     import multiprocessing
     from concurrent.futures import ProcessPoolExecutor, as_completed
     from concurrent.futures.process import BrokenProcessPool
 
     global _FORKED
-    _FORKED = (scene, kw)
-    out: list = [None] * len(states)
+    _FORKED = fn
+    out = [None] * len(states)
     try:
-        with ProcessPoolExecutor(max_workers=jobs, mp_context=multiprocessing.get_context("fork")) as ex:
+        with ProcessPoolExecutor(max_workers=min(jobs, len(states)),
+                                 mp_context=multiprocessing.get_context("fork")) as ex:
             futures = {ex.submit(_forked_row, s): k for k, s in enumerate(states)}
             try:
                 for done, fut in enumerate(as_completed(futures), 1):
@@ -215,7 +225,7 @@ def _rows_in_processes(scene: Scene, states: list[str], kw: dict, jobs: int, pro
                 ex.shutdown(wait=False, cancel_futures=True)
                 raise
     except BrokenProcessPool:
-        raise MlcError(f"a process verifying rows of {scene.name} died (out of memory?)", "--jobs",
+        raise MlcError("a process verifying rows died (out of memory?)", "--jobs",
                        "run with fewer --jobs (each holds one row's solve)") from None
     finally:
         _FORKED = None
