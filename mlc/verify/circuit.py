@@ -135,7 +135,6 @@ def _static_row(scene: Scene, state: str, tol_length: float, tol_stretch: float,
     t_row = time.perf_counter()
     eq = equilibrium(scene, state, polish=polish, levels="depth",
                      progress=None if not within else (lambda f: within(ROW_SHARES[0] * f)))
-    want = scene.truth_table.get(state)
     row_ok = eq.max_joint_stretch <= tol_stretch
     sd = probe_thermal_sd(scene, kT, eq.pos, eq.quat) if kT is not None and kT > 0 else {}
     if within and clearance:
@@ -143,19 +142,11 @@ def _static_row(scene: Scene, state: str, tol_length: float, tol_stretch: float,
     thermal_ok = True
     entries = []
     for pr in scene.probes:
-        k = scene.outputs.index(pr.output)
-        bit = None if want is None or want[k] == "-" else int(want[k])
-        L = eq.probes[pr.name]
-        ideal = None if bit is None else (pr.actuated if bit else pr.rest)
-        ok = bit is None or (pr.bit(L) == bit and abs(L - ideal) <= tol_length)
-        row_ok &= ok
-        margin = None if bit is None else float(pr.margin(L, bit))
-        entry = {"state": state, "output": pr.output, "expected": bit, "measured": L,
-                 "bit": pr.bit(L), "margin": margin,
-                 "error": None if ideal is None else float(abs(L - ideal)), "ok": bool(ok)}
+        entry = probe_entry(scene, pr, state, eq.probes[pr.name], tol_length)
+        row_ok &= entry["ok"]
         if pr.name in sd:
             entry["thermal_sd"] = float(sd[pr.name])
-            if margin is not None and not margin >= THERMAL_SDS * sd[pr.name]:
+            if entry["margin"] is not None and not entry["margin"] >= THERMAL_SDS * sd[pr.name]:
                 thermal_ok = False
         entries.append(entry)
     row = {"state": state, "joint_stretch": eq.max_joint_stretch, "muscle_strain": eq.max_muscle_strain,
@@ -174,6 +165,20 @@ def _static_row(scene: Scene, state: str, tol_length: float, tol_stretch: float,
     row["ok"] = bool(row_ok)
     row["seconds"] = time.perf_counter() - t_row
     return entries, row
+
+
+def probe_entry(scene: Scene, pr, state: str, L: float, tol_length: float) -> dict:
+    """Probe ``pr`` read at length ``L`` (sigma) in row ``state`` against the truth table:
+    expected bit (None where the table says ``-``), the bit read, margin, distance from the
+    ideal length, and ``ok`` (the right bit within ``tol_length`` of the ideal)."""
+    want = scene.truth_table.get(state)
+    k = scene.outputs.index(pr.output)
+    bit = None if want is None or want[k] == "-" else int(want[k])
+    ideal = None if bit is None else (pr.actuated if bit else pr.rest)
+    ok = bit is None or (pr.bit(L) == bit and abs(L - ideal) <= tol_length)
+    return {"state": state, "output": pr.output, "expected": bit, "measured": L, "bit": pr.bit(L),
+            "margin": None if bit is None else float(pr.margin(L, bit)),
+            "error": None if ideal is None else float(abs(L - ideal)), "ok": bool(ok)}
 
 
 def _can_fork() -> bool:
