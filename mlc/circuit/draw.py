@@ -1,6 +1,8 @@
 """A picture of a circuit scene: the mechanism seen from the front (x, z) and from the
 side (y, z), gates labelled with their id and type, input muscles marked in their input's
-colour, output probes named.  Units on the axes: sigma."""
+colour, output probes named.  Labels of one kind whose anchors fall within ``MERGE_FRACTION``
+of the view's span of each other (gates stacked behind one another in the side view, probes
+of outputs wired to one pair) are written once, their names joined.  Units on the axes: sigma."""
 from __future__ import annotations
 
 import numpy as np
@@ -9,6 +11,30 @@ from mlc.draw import INPUT_COLOURS, box_faces
 
 _WIRE = "#7a8793"
 _GATE = "#3b4a57"
+MERGE_FRACTION = 0.03       # labels this close (a fraction of the view's larger span) are merged
+
+
+def merge_labels(labels: list, span: float, sep: str = ", ") -> list:
+    """Labels ``(x, y, text)`` whose anchors lie within ``MERGE_FRACTION * span`` of the first
+    label of a group (in order) become one label at that first anchor, their texts joined by
+    ``sep`` (each text once, in order).  Returns ``[(x, y, text)]``."""
+    tol = MERGE_FRACTION * max(float(span), 1e-9)
+    groups: list = []
+    for x, y, text in labels:
+        for g in groups:
+            if abs(g[0] - x) <= tol and abs(g[1] - y) <= tol:
+                if text not in g[2]:
+                    g[2].append(text)
+                break
+        else:
+            groups.append([x, y, [text]])
+    return [(x, y, sep.join(texts)) for x, y, texts in groups]
+
+
+def _merged(ax, labels: list, prefix: str, span: float, sep: str = ", ", **style) -> None:
+    """Annotate ``ax`` with the merged labels: ``prefix`` once, then the names."""
+    for x, y, text in merge_labels(labels, span, sep):
+        ax.annotate(f"{prefix}{text}", (x, y), **style)
 
 
 def render_circuit(scene, pos=None, quat=None, title: str | None = None) -> bytes:
@@ -48,26 +74,37 @@ def render_circuit(scene, pos=None, quat=None, title: str | None = None) -> byte
             if polys:
                 ax.add_collection(PolyCollection(polys, facecolors=colour, edgecolors=colour, linewidths=lw,
                                                  alpha=0.55 if kind == "wire" else 0.8))
+        c = [0, 2] if k == 0 else [1, 2]
+        view_span = max(float(np.ptp(pos[:, c[0]])) if len(pos) else 1.0,
+                        float(np.ptp(pos[:, c[1]])) if len(pos) else 1.0)
+        gate_labels = []
         for gid, g in gates.items():
             o = np.asarray(g["origin"], float)
             xy = (o[0], o[2] - 1.2) if k == 0 else (o[1] + 1.2, o[2] - 1.2)
-            ax.annotate(f"{gid} {g['type']}", xy, ha="center", va="top", fontsize=8, color="#b03a2e",
-                        fontweight="bold")
-        for i, m in enumerate(scene.muscles):
+            gate_labels.append((xy[0], xy[1], f"{gid} {g['type']}"))
+        _merged(ax, gate_labels, "", view_span, "\n", ha="center", va="top", fontsize=8, color="#b03a2e",
+                fontweight="bold")
+        in_labels, colour_of = [], {}
+        for m in scene.muscles:
             colour = INPUT_COLOURS[scene.inputs.index(m.input) % len(INPUT_COLOURS)]
+            colour_of[m.input] = colour
             p1, p2 = scene_point(scene, pos, quat, m.a), scene_point(scene, pos, quat, m.b)
-            c = [0, 2] if k == 0 else [1, 2]
             ax.plot([p1[c[0]], p2[c[0]]], [p1[c[1]], p2[c[1]]], color=colour, lw=3.0, solid_capstyle="round")
             mid = 0.5 * (p1 + p2)
-            ax.annotate(f"in {m.input}", (mid[c[0]], mid[c[1]]), xytext=(0, -12), textcoords="offset points",
-                        ha="center", fontsize=8, color=colour, fontweight="bold")
+            in_labels.append((mid[c[0]], mid[c[1]], m.input))
+        for x, y, names in merge_labels(in_labels, view_span, "\n"):
+            # muscles drawn on one spot (seen end on): one line per input, each in its colour
+            for j, name in enumerate(names.split("\n")):
+                ax.annotate(f"in {name}", (x, y), xytext=(0, -12 * (j + 1)), textcoords="offset points",
+                            ha="center", fontsize=8, color=colour_of[name], fontweight="bold")
+        probe_labels = []
         for pr in scene.probes:
             p1, p2 = scene_point(scene, pos, quat, pr.a), scene_point(scene, pos, quat, pr.b)
-            c = [0, 2] if k == 0 else [1, 2]
             ax.plot([p1[c[0]], p2[c[0]]], [p1[c[1]], p2[c[1]]], color="#2a9d3a", lw=2.0, ls="--")
             mid = 0.5 * (p1 + p2)
-            ax.annotate(f"out {pr.output}", (mid[c[0]], mid[c[1]]), xytext=(0, 6), textcoords="offset points",
-                        ha="center", fontsize=7, color="#2a9d3a")
+            probe_labels.append((mid[c[0]], mid[c[1]], pr.output))
+        _merged(ax, probe_labels, "out ", view_span, xytext=(0, 6), textcoords="offset points", ha="center",
+                fontsize=7, color="#2a9d3a")
         ax.set_aspect("equal")
         ax.autoscale_view()
         ax.margins(0.05)
