@@ -82,6 +82,38 @@ def test_rows_in_processes_give_the_same_report_number_for_number(tetris):
     assert seen == [(k, 4) for k in range(1, 5)]
 
 
+def test_routing_with_jobs_takes_solves_started_ahead_and_builds_the_same_scene(tetris, monkeypatch):
+    """--jobs for the build: the next chains' first solves start in another process; the
+    router takes one only for bit-identical arguments, so the scene is the same text; a
+    started solve whose arguments differ from what the router asks (a wrong guess of its
+    plane) is never taken, and the scene is still the same."""
+    import multiprocessing
+
+    from mlc.circuit import route
+    from mlc.circuit.build import CircuitOptions
+    if "fork" not in multiprocessing.get_all_start_methods():
+        pytest.skip("no fork here: nothing is started ahead")
+    spec, c, circ = tetris
+    want = dump_scene(circ.scene)
+    monkeypatch.setattr(route, "_CACHE", {})
+    started, taken = route.PREFETCH
+    two = build_circuit(c.netlist, spec, CircuitOptions(jobs=2))
+    assert route.PREFETCH[1] - taken > 0 and route.PREFETCH[0] - started >= route.PREFETCH[1] - taken
+    assert dump_scene(two.scene) == want
+
+    submit = route.Prefetch.submit
+
+    def off_by_a_hair(self, owner, *args, **kw):            # a wrong guess: other waypoints
+        kw["waypoints"] = [(x + 1e-9, y, z) for x, y, z in kw["waypoints"]]
+        return submit(self, owner, *args, **kw)
+    monkeypatch.setattr(route.Prefetch, "submit", off_by_a_hair)
+    monkeypatch.setattr(route, "_CACHE", {})
+    started, taken = route.PREFETCH
+    wrong = build_circuit(c.netlist, spec, CircuitOptions(jobs=2))
+    assert route.PREFETCH[0] > started and route.PREFETCH[1] == taken
+    assert dump_scene(wrong.scene) == want
+
+
 def test_an_error_in_a_row_process_reaches_the_caller_whole(tetris, monkeypatch):
     from mlc.errors import MlcError
     from mlc.verify import circuit

@@ -782,7 +782,9 @@ def test_kernel_compile_notice_once(monkeypatch):
     (["verify", ""], ["empty scene file name"]),
     (["verify", "{scene}", "--jobs", "0"], ["--jobs", "between 1 and 256"]),
     (["verify", "{scene}", "--dynamic", "--jobs", "2"], ["--jobs", "static check", "drop --jobs or --dynamic"]),
-    (["compile", "-e", "y = a & b", "-o", "{d}/o", "--jobs", "2"], ["--jobs", "only applies to --verify"]),
+    (["compile", "-e", "y = a & b", "-o", "{d}/o", "--no-circuit", "--jobs", "2"],
+     ["--jobs only applies to the circuit", "drop --no-circuit"]),
+    (["compile", "-e", "y = a & b", "-o", "{d}/o", "--jobs", "0"], ["--jobs", "between 1 and 256"]),
     (["gate", "NAND", "-o", "/dev/full"], ["-o", "/dev/full"]),
     # a step over 1e9 averaging windows made no step: the rest pose was reported as a wrong bit (exit 1)
     (["verify", "{scene}", "--dynamic", "--seeds", "1", "--dt", "1e308"], ["--dt", "longer than any run needs"]),

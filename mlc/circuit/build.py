@@ -110,6 +110,8 @@ class CircuitOptions:
     direct: bool = False             # join a gate's single-sink net by one full unit (mlc.circuit.direct)
     direct_skip: tuple = ()          # ... except into these sinks (build_circuit fills it: see there)
     max_gates: int | None = None     # refuse larger netlists before the work (None: MAX_GATES)
+    jobs: int = 1                    # processes that route: each chain's first solve is started ahead
+                                     # (route.Prefetch); the scene is the same, bit for bit, for any jobs
 
 
 @dataclass
@@ -499,9 +501,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     _check_reach(netlist, taps, consumers, by_name, level, geo)
     wires = [w for w in taps if consumers.get(w)]
     wires.sort(key=lambda w: w[1] not in first_wires)          # stable: the rest keep their order
-    for wi, wire in enumerate(wires):
-        if progress:
-            progress(wi, len(wires))
+    chains: list[_Chain] = []               # in routing order (routed after the loop, see _route_all)
+    for wire in wires:
         tap, pol = taps[wire]
         cons = consumers[wire]
         wname = wire[1]
@@ -606,12 +607,10 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                              start_bend_max=sbm),
                         skip, others, _gap_fn(space, tag, skip, others_tree, geo, ext, space_clear), (geo, ext),
                         (wire, start, tap, spol, sstate, stop_at_tap, t_up, target, ext))
-            _route_chain(ch, lanes, space, space_clear)
-            if ch.route is None:
-                raise MlcError(f"cannot route wire {wname} to {gid}.{pin_name}: no connector chain reaches it",
-                               netlist.source, "this is a placement limit of mlc; please report the netlist")
-            routed[tag] = ch
+            ch.sink = f"{gid}.{pin_name}"
+            chains.append(ch)
             deferred.append(tag)
+    _route_all(chains, routed, lanes, space, space_clear, opt.jobs, netlist.source, progress)
     t_rip = time.perf_counter()
     rip_ups = _rip_up(routed, lanes, space, space_clear)
     contact_rips, contacts = _rip_up_contacts(routed, lanes, space, space_clear, geo)
@@ -729,6 +728,7 @@ class _Chain:
     route: object = None
     gap: float = -math.inf
     plane: int = 0
+    sink: str = ""                   # "gate.pin" (for messages)
 
     def layers(self, route=None) -> np.ndarray:
         """Layer centres of ``route`` (default the chain's own) as this chain's layers."""
@@ -801,22 +801,64 @@ def _gap_fn(space, tag: str, skip: int, others_tree, geo, ext: float, space_clea
     return gap_of
 
 
-def _route_chain(ch: _Chain, lanes, space, space_clear: float) -> None:
+def _route_all(chains: list, routed: dict, lanes, space, space_clear: float, jobs: int, source, progress) -> None:
+    """Route ``chains`` in order (:func:`_route_chain`) into ``routed``; with ``jobs`` > 1
+    the first solves of the next ``jobs - 1`` chains, in the planes the lanes would give
+    them were the chains before them in their first planes, start in other processes
+    meanwhile (:class:`mlc.circuit.route.Prefetch`: the routes are the same for any jobs)."""
+    from mlc.circuit.lanes import Lanes
+    from mlc.circuit.route import Prefetch
+    ahead = max(int(jobs), 1) - 1
+    with Prefetch(jobs) as pf:
+        for i, ch in enumerate(chains):
+            if progress:
+                progress(i, len(chains))
+            if ahead:
+                guess = Lanes(lanes.sep)
+                guess.placed = list(lanes.placed)
+                for nxt in chains[i:i + 1 + ahead]:
+                    plane = guess.assign(nxt.lane)
+                    if nxt is not ch:
+                        pf.submit(nxt.tag, *nxt.solve, waypoints=_plane_waypoints(nxt, plane), **nxt.kw)
+                    guess.take(nxt.lane, plane)
+            _route_chain(ch, lanes, space, space_clear, pf)
+            pf.drop(ch.tag)
+            if ch.route is None:
+                wire = ch.ctx[0]
+                raise MlcError(f"cannot route wire {wire[1]} to {ch.sink}: no connector chain reaches it",
+                               source, "this is a placement limit of mlc; please report the netlist")
+            routed[ch.tag] = ch
+
+
+def _plane_waypoints(ch: _Chain, plane: int) -> list:
+    """The points ``ch`` is pulled towards in routing plane ``plane``: its lane's corners, rounded (sigma)."""
+    from mlc.circuit.lanes import plane_y, rounded
+    lane = ch.lane
+    y_k = plane_y(plane)
+    corners = [(lane.x_r, y_k, lane.z_a), (lane.x_r, y_k, lane.z_run), (lane.x_in, y_k, lane.z_run),
+               (lane.x_in, y_k, lane.z_in), (lane.x_end, ch.yp - 1.0, lane.z_end)]
+    return [tuple(p) for p in rounded(corners, TURN_RADIUS, WAYPOINT_STEP)]
+
+
+def _route_chain(ch: _Chain, lanes, space, space_clear: float, pf=None) -> None:
     """Route ``ch`` and place it (``lanes``, ``space``): in up to PLANE_TRIES planes from
     the first its lane fits, pulled towards the lane's rounded corners, keeping the route
     farthest from the placed chains and gates (the first that keeps ``space_clear``); if
     none keeps it, that plane's route again pushed away from them (kept if farther); if no
-    lane closes, a straight route.  ``ch.route`` stays None if nothing closes."""
-    from mlc.circuit.lanes import plane_y, rounded
+    lane closes, a straight route.  ``ch.route`` stays None if nothing closes.  The planes
+    depend on the lanes alone, so with a :class:`~mlc.circuit.route.Prefetch` ``pf`` the
+    solve in the next plane starts in another process while this one solves a plane (not
+    needed when this plane keeps the chain apart: the caller drops it)."""
     from mlc.circuit.route import solve_route
     lane = ch.lane
-    plane = lanes.assign(lane)
-    best = (-math.inf, None, plane, ())
-    for _ in range(PLANE_TRIES):
-        y_k = plane_y(plane)
-        corners = [(lane.x_r, y_k, lane.z_a), (lane.x_r, y_k, lane.z_run), (lane.x_in, y_k, lane.z_run),
-                   (lane.x_in, y_k, lane.z_in), (lane.x_end, ch.yp - 1.0, lane.z_end)]
-        wps = [tuple(p) for p in rounded(corners, TURN_RADIUS, WAYPOINT_STEP)]
+    planes = [lanes.assign(lane)]
+    for _ in range(PLANE_TRIES - 1):
+        planes.append(lanes.assign(lane, planes[-1] + 1))
+    best = (-math.inf, None, planes[0], ())
+    for k, plane in enumerate(planes):
+        if pf is not None and k + 1 < len(planes):      # the next plane, in case this one is too close
+            pf.submit(ch.tag, *ch.solve, waypoints=_plane_waypoints(ch, planes[k + 1]), **ch.kw)
+        wps = _plane_waypoints(ch, plane)
         r = solve_route(*ch.solve, waypoints=wps, **ch.kw)
         if r is not None:
             g = ch.gap_of(r)
@@ -824,7 +866,6 @@ def _route_chain(ch: _Chain, lanes, space, space_clear: float) -> None:
                 best = (g, r, plane, wps)
             if g >= space_clear:
                 break
-        plane = lanes.assign(lane, plane + 1)
     gap, route, plane, wps = best
     if route is not None and gap < space_clear:
         # no plane keeps it apart: the best plane's route again, pushed away from the

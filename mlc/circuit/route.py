@@ -175,6 +175,8 @@ class blas_single_thread:
 CACHE_SIZE = 512            # solves remembered (see solve_route); 0: none
 _CACHE: dict = {}
 CACHE_HITS = [0, 0]        # [hits, misses] since import (benchmarks report them)
+_PENDING: dict = {}        # key -> Future of the same solve started ahead in another process (Prefetch)
+PREFETCH = [0, 0]          # [solves started ahead, of them taken by solve_route] since import
 
 
 def _key(v):
@@ -215,9 +217,12 @@ def solve_route(*args, **kw) -> Route | None:
             r = _CACHE[key]
             return None if r is None else Route(r.centre.copy(), r.axis.copy(), r.tangent.copy(), list(r.bends),
                                                 r.error, r.approach_error)
-    with np.errstate(all="ignore"), warnings.catch_warnings(), blas_single_thread():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        r = _solve_route(*args, **kw)
+    fut = _PENDING.pop(key, None) if key is not None else None
+    r = _taken(fut)
+    if r is _NOT_TAKEN:
+        with np.errstate(all="ignore"), warnings.catch_warnings(), blas_single_thread():
+            warnings.simplefilter("ignore", RuntimeWarning)
+            r = _solve_route(*args, **kw)
     if key is not None:
         CACHE_HITS[1] += 1
         if len(_CACHE) >= CACHE_SIZE:
@@ -225,6 +230,89 @@ def solve_route(*args, **kw) -> Route | None:
         _CACHE[key] = None if r is None else Route(r.centre.copy(), r.axis.copy(), r.tangent.copy(),
                                                    list(r.bends), r.error, r.approach_error)
     return r
+
+
+_NOT_TAKEN = object()
+
+
+def _taken(fut):
+    """The result of a solve started ahead (:class:`Prefetch`), waiting for it if it runs;
+    ``_NOT_TAKEN`` where there is none, where it has not started (it is cancelled), or where
+    it failed (the caller then solves it here: the same pure function, so the same route)."""
+    if fut is None or fut.cancel():     # none, or not started yet: quicker here than queued
+        return _NOT_TAKEN
+    try:
+        r = fut.result()
+    except BaseException as e:          # cancelled, or its process died: solve it here
+        if isinstance(e, (KeyboardInterrupt, SystemExit)):
+            raise
+        return _NOT_TAKEN
+    PREFETCH[1] += 1
+    return r
+
+
+def _solve_ahead(args, kw):
+    """A solve in a forked process of :class:`Prefetch` (its own cache is not shared back)."""
+    return solve_route(*args, **kw)
+
+
+class Prefetch:
+    """Solves started ahead, each in a forked process, while this one routes.
+
+    The router is sequential: a chain's route depends on the chains placed before it (its
+    plane, the layers it keeps away from).  But the first solve of a chain, in the plane
+    the lanes would give it, depends only on its own geometry and that plane, so the
+    builder starts it (:meth:`submit`) for the next ``jobs - 1`` chains while it routes the
+    current one, guessing their planes from the lanes taken so far.  :func:`solve_route`
+    takes a started solve only for bit-identical arguments (the cache's key): a wrong
+    guess costs the other process's time, never a different route, so the scene is the
+    same, bit for bit, for any ``jobs``.  ``jobs`` = 1, or where processes cannot be
+    forked: nothing is started ahead."""
+
+    def __init__(self, jobs: int = 1):
+        self.jobs = max(int(jobs), 1)
+        self.ex = None
+        self.mine: dict = {}            # owner tag -> the keys it started
+
+    def __enter__(self):
+        from mlc.verify.circuit import _can_fork
+        if self.jobs > 1 and CACHE_SIZE > 0 and _can_fork():
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor
+            self.ex = ProcessPoolExecutor(max_workers=self.jobs - 1, mp_context=multiprocessing.get_context("fork"))
+        return self
+
+    def submit(self, owner: str, *args, **kw) -> None:
+        """Start ``solve_route(*args, **kw)`` in another process (once per key) for ``owner``."""
+        if self.ex is None:
+            return
+        try:
+            key = (_key(args), _key(kw))
+        except TypeError:
+            return
+        if key in _CACHE or key in _PENDING:
+            return
+        try:
+            _PENDING[key] = self.ex.submit(_solve_ahead, args, kw)
+        except RuntimeError:            # the pool is broken (a process died): route without it
+            self.ex = None
+            return
+        PREFETCH[0] += 1
+        self.mine.setdefault(owner, []).append(key)
+
+    def drop(self, owner: str) -> None:
+        """``owner`` is routed: its solves not taken are of no more use (cancelled where not started)."""
+        for key in self.mine.pop(owner, []):
+            fut = _PENDING.pop(key, None)
+            if fut is not None:
+                fut.cancel()
+
+    def __exit__(self, *exc):
+        for owner in list(self.mine):
+            self.drop(owner)
+        if self.ex is not None:             # a solve still running ends on its own, unwaited for
+            self.ex.shutdown(wait=False, cancel_futures=True)
+        return False
 
 
 def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int, *,
@@ -625,4 +713,4 @@ def _jac_kernel(cs, us, ts, e1, e2, has_app, wp_k, w_soft, wp_weight, J):
             J[r + i - 1, i] = w_soft * 0.05
 
 
-__all__ = ["BEND_FRACTION", "Route", "solve_route"]
+__all__ = ["BEND_FRACTION", "Prefetch", "Route", "solve_route"]

@@ -89,7 +89,7 @@ def register(sub):
     p.add_argument("--kT", type=float, default=1e-5, help="thermal energy for --dynamic (k0 sigma^2, default 1e-5)")
     p.add_argument("--seeds", type=int, default=3, help="seeds per row for --dynamic (default 3)")
     p.add_argument("--scheme", choices=("stiff", "euler"), default="stiff", help="integrator for --dynamic")
-    add_jobs(p)
+    add_jobs(p, compile_=True)
     p.add_argument("--stl", metavar="STL", help="printable mesh of the whole circuit (through mlc stl)")
     p.add_argument("--3mf", dest="threemf", metavar="3MF", help="3MF of the circuit with named parts (through mlc stl)")
     p.add_argument("--profile", default="mjp", help="printer profile for --stl/--3mf (mjp, sla, fdm or a file)")
@@ -239,9 +239,9 @@ def run(args) -> int:
         raise MlcError("--verify, --stl and --3mf need the circuit", "--no-circuit", "drop --no-circuit")
     if args.dynamic and not args.verify:
         raise MlcError("--dynamic only applies to --verify", "--dynamic", "add --verify")
-    if args.jobs != 1 and not args.verify:
-        raise MlcError("--jobs only applies to --verify", "--jobs", "add --verify")
-    check_jobs(args.jobs, args.dynamic)
+    if args.jobs != 1 and not want_circuit:
+        raise MlcError("--jobs only applies to the circuit (routing, --verify)", "--no-circuit", "drop --no-circuit")
+    check_jobs(args.jobs, False)                    # with --dynamic it routes; the runs take the integrator's threads
     if not 1 <= args.seeds <= 1000:
         raise MlcError(f"--seeds must be between 1 and 1000, got {args.seeds}", "--seeds")
     from mlc.sim import check_kT
@@ -289,7 +289,8 @@ def run(args) -> int:
         from mlc.pipeline import build
         from mlc.scene.io import dump_scene
         extra = {} if joint_k is None else {"joint_k": joint_k}
-        opts = CircuitOptions(direct=bool(getattr(args, "direct", False)), max_gates=max_gates, **extra)
+        opts = CircuitOptions(direct=bool(getattr(args, "direct", False)), max_gates=max_gates, jobs=args.jobs,
+                              **extra)
         with Progress("placing and routing", total=1) as bar:
             build(c, progress=lambda done, total: (setattr(bar, "total", total), bar.update(done)), options=opts)
         scene = c.circuit.scene
@@ -306,7 +307,8 @@ def run(args) -> int:
             if args.dynamic:
                 from mlc.io.warmup import notice
                 notice(args.scheme)
-            report = verify_scene_file(scene, args.dynamic, args.kT, args.seeds, args.scheme, jobs=args.jobs)
+            report = verify_scene_file(scene, args.dynamic, args.kT, args.seeds, args.scheme,
+                                       jobs=1 if args.dynamic else args.jobs)
     with outs:
         for name, data in files.items():
             if name == "<draw>":
