@@ -15,6 +15,8 @@ poses, the motion trims, the feet, the orientation, the printability report).  R
   sla print ``as_is``) -- by the report's own bed statistics (``mlc.mesh.printability.bed_stats``
   on the report's grid);
 * ``feet_mm3``: the material the feet add, per part;
+* ``holes``: the attachment holes drilled inside slabs, per part: ``round`` or ``teardrop``
+  (``mlc.mesh.build.hole_kind``: across the layers of the feet's up, fdm);
 * ``support_by_part`` (in ``after`` and ``before``): the support of each part's overhangs by the
   same statistics, ``{part: [overhang mm^2, support mm^3, of it between parts mm^3]}`` (which parts
   the support is for: the output lever, ``out_lo`` and ``out_hi``, gets no feet).
@@ -22,7 +24,10 @@ poses, the motion trims, the feet, the orientation, the printability report).  R
 ``--slice`` (needs ``prusa-slicer`` on PATH): the ``after`` pose is also sliced by PrusaSlicer
 (``benchmarks/slicer_gates.py``'s ``pose_row``: the 3MF, slices without supports, with supports
 and with supports on the build plate only): first-layer filament (about the first layer's area)
-and support volume, as an outside check.
+and support volume, as an outside check; with supports, also the support filament by the part
+it holds up (``prusa_after["all"]["support_by_part_mm3"]``: each support extrusion of the G-code
+is given to the first part above it, straight up or within 3 mm sideways, ``none`` if no part is;
+PrusaSlicer's counterpart of ``support_by_part``).
 
 Every row also gets ``prusa_before``: PrusaSlicer's figures for the same gate and profile before
 the feet (the pose ``before`` of ``benchmarks/results/slicer_gates.json``: the model's z up, the
@@ -158,6 +163,7 @@ def main() -> int:
                        "failed": {c.name: c.failures[:3] for c in rep.checks if not c.ok and c.blocking},
                        "goals_not_met": sorted(c.name for c in rep.checks if not c.ok and not c.blocking),
                        "feet_mm3": asm.feet, "feet_total_mm3": round(sum(asm.feet.values()), 1),
+                       "holes": {n: k for n, _, _, k in getattr(asm, "holes", [])},
                        "up": [round(float(x), 4) for x in up],
                        "after": {"bed_contact": _check(rep, "bed_contact"), "supports": _check(rep, "supports"),
                                  "bed": asm.bed.to_dict(), "support_by_part": _by_part(asm.bed)},
@@ -169,7 +175,7 @@ def main() -> int:
                 if exe:
                     f = tmp / f"{name}_{signal}_{prof}.3mf"
                     t1 = time.perf_counter()
-                    row["prusa_after"] = pose_row(exe, asm, R, up, f, f"{name} {prof}", LAYER[prof])
+                    row["prusa_after"] = pose_row(exe, asm, R, up, f, f"{name} {prof}", LAYER[prof], by_part=True)
                     row["slice_s"] = round(time.perf_counter() - t1, 1)
                 row["wall_s"] = round(time.perf_counter() - t0, 1)
                 key = (name, signal, prof)

@@ -113,8 +113,92 @@ def _first_layer_mm3(txt: str, mm3_per_mm: float) -> float | None:
     return round(tot * mm3_per_mm, 2)
 
 
-def slice_once(exe, path: Path, layer: float, supports: str) -> dict:
-    """``supports``: "none", "all" or "buildplate"."""
+def extrusions(txt: str) -> list:
+    """Every extruding move of a G-code: ``(x, y, z, filament mm, type)`` at the middle of the
+    move (``;TYPE:`` and ``;Z:`` comments; absolute or relative E, G92 resets followed)."""
+    rel = bool(re.search(r"^M83", txt, re.M))
+    typ, x, y, z, e0, out = None, 0.0, 0.0, 0.0, 0.0, []
+    for line in txt.splitlines():
+        if line.startswith(";TYPE:"):
+            typ = line[6:].strip()
+        elif line.startswith(";Z:"):
+            z = float(line[3:])
+        elif line.startswith("G92"):
+            m = re.search(r" E([-\d.]+)", line)
+            if m:
+                e0 = float(m.group(1))
+        elif line.startswith(("G1 ", "G0 ")):
+            mx, my, me = (re.search(rf" {c}([-\d.]+)", line) for c in "XYE")
+            nx, ny = (float(mx.group(1)) if mx else x), (float(my.group(1)) if my else y)
+            if me:
+                e = float(me.group(1))
+                de = e if rel else e - e0
+                if not rel:
+                    e0 = e
+                if de > 0 and (mx or my):
+                    out.append((0.5 * (x + nx), 0.5 * (y + ny), z, de, typ))
+            x, y = nx, ny
+    return out
+
+
+#: a support extrusion is held up for the first part above it within this distance (mm) sideways
+HOLD_SEARCH_MM = 3.0
+
+
+def support_by_part(txt: str, sol, mm3_per_mm: float, grid: float = 0.3) -> dict:
+    """PrusaSlicer's support filament (mm^3) by the part it holds up: for every support extrusion
+    (``;TYPE:Support material`` and its interface) of the G-code ``txt``, the first surface of
+    the print-frame solids ``sol`` (``[(name, manifold)]``, as written to the 3MF) straight above
+    it, else the nearest one above within :data:`HOLD_SEARCH_MM` sideways (a slicer's support
+    reaches past the overhang it holds); ``"none"`` when nothing is above.  PrusaSlicer puts the
+    object's box centre where the model's is, moved by an offset found from the printed
+    extrusions (the skirt left out) against the model's box."""
+    from mlc.mesh.printability import _raster, merged_mesh
+    ext = extrusions(txt)
+    V, F, own = merged_mesh(sol)
+    pts = np.array([(a, b) for a, b, _, _, t in ext if t and "skirt" not in t.lower()
+                    and "support" not in t.lower()])
+    if len(pts) == 0:
+        return {}
+    off = 0.5 * (pts.min(0) + pts.max(0)) - 0.5 * (V[:, :2].min(0) + V[:, :2].max(0))
+    S = np.array([(a - off[0], b - off[1], z, de * mm3_per_mm) for a, b, z, de, t in ext
+                  if t and "support" in t.lower()])
+    if len(S) == 0:
+        return {}
+    lo = V[:, :2].min(0) - HOLD_SEARCH_MM - grid
+    A, B, C = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    flat = np.abs(np.cross(B - A, C - A)[:, 2]) > 1e-12      # vertical triangles cross no column
+    col, zc, _, tri = _raster(A[flat], B[flat], C[flat], lo, grid)
+    tri = np.nonzero(flat)[0][tri]
+    nx = int(np.ceil((V[:, 0].max() - lo[0]) / grid)) + int(2 * HOLD_SEARCH_MM / grid) + 4
+    key = col[:, 1] * nx + col[:, 0]
+    order = np.lexsort((zc, key))
+    key, zc, tri = key[order], zc[order], tri[order]
+    top = float(V[:, 2].max()) + 1.0
+    comb = key * top * 4 + zc
+    who = np.full(len(S), -1)
+    for r in [0.0] + list(np.arange(grid, HOLD_SEARCH_MM + 1e-9, grid)):
+        angs = [0.0] if r == 0 else np.linspace(0.0, 2 * np.pi, 12, endpoint=False)
+        for a in angs:
+            todo = who < 0
+            if not todo.any():
+                break
+            ix = np.floor((S[:, 0] + r * np.cos(a) - lo[0]) / grid).astype(np.int64)
+            iy = np.floor((S[:, 1] + r * np.sin(a) - lo[1]) / grid).astype(np.int64)
+            k = iy * nx + ix
+            pos = np.searchsorted(comb, k * top * 4 + S[:, 2] + 0.05)
+            q = np.minimum(pos, len(key) - 1)
+            hit = todo & (pos < len(key)) & (key[q] == k)
+            who[hit] = own[tri[q[hit]]]
+    names = [n for n, _ in sol]
+    out = {n: round(float(S[who == i, 3].sum()), 1) for i, n in enumerate(names)}
+    out["none"] = round(float(S[who < 0, 3].sum()), 1)
+    return out
+
+
+def slice_once(exe, path: Path, layer: float, supports: str, sol=None) -> dict:
+    """``supports``: "none", "all" or "buildplate"; ``sol`` (the print-frame solids written to
+    ``path``): also the support filament by the part it holds up (:func:`support_by_part`)."""
     out = path.with_suffix(f".{supports}.gcode")
     cmd = [exe, "--export-gcode", "--layer-height", str(layer), "--first-layer-height", str(FIRST_LAYER),
            "-o", str(out), str(path)]
@@ -131,10 +215,13 @@ def slice_once(exe, path: Path, layer: float, supports: str) -> dict:
     ratio = float(cm3.group(1)) * 1000 / float(mm.group(1)) if cm3 and mm and float(mm.group(1)) > 0 else None
     fl = _first_layer_mm3(txt, ratio) if ratio else None
     out.unlink()
-    return {"ok": True, "layers": txt.count(";LAYER_CHANGE"), "print_time_s": _time_s(txt),
-            "filament_mm3": round(float(cm3.group(1)) * 1000, 1) if cm3 else None,
-            "first_layer_mm3": fl, "first_layer_mm2": round(fl / FIRST_LAYER, 1) if fl is not None else None,
-            "slice_s": round(dt, 2)}
+    row = {"ok": True, "layers": txt.count(";LAYER_CHANGE"), "print_time_s": _time_s(txt),
+           "filament_mm3": round(float(cm3.group(1)) * 1000, 1) if cm3 else None,
+           "first_layer_mm3": fl, "first_layer_mm2": round(fl / FIRST_LAYER, 1) if fl is not None else None,
+           "slice_s": round(dt, 2)}
+    if sol is not None and ratio:
+        row["support_by_part_mm3"] = support_by_part(txt, sol, ratio)
+    return row
 
 
 def info(exe, path: Path) -> dict:
@@ -166,7 +253,10 @@ def stats(asm, R, config: bool = False):
                           island_mm=island_side(asm.profile))
 
 
-def pose_row(exe, asm, R, up, f: Path, title: str, layer: float, config: bool = False) -> dict:
+def pose_row(exe, asm, R, up, f: Path, title: str, layer: float, config: bool = False, by_part: bool = False) -> dict:
+    """mlc's bed statistics and PrusaSlicer's three slices of the parts posed by ``R``;
+    ``by_part``: also PrusaSlicer's support by the part it holds up (``all``'s
+    ``support_by_part_mm3``, :func:`support_by_part`)."""
     sol, bs = stats(asm, R, config)
     f.write_bytes(threemf_bytes([(n, to_trimesh(s)) for n, s in sol], title))
     row = {"up": [round(float(x), 4) for x in up], "mlc_bed": bs.to_dict(),
@@ -174,7 +264,7 @@ def pose_row(exe, asm, R, up, f: Path, title: str, layer: float, config: bool = 
            "mlc_parts_off_bed": sum(1 for z in bs.lowest_mm.values() if z > 0.05),
            "prusa_info": info(exe, f)}
     for k in ("none", "all", "buildplate"):
-        row[k] = slice_once(exe, f, layer, k)
+        row[k] = slice_once(exe, f, layer, k, sol if by_part and k == "all" else None)
     n, s, b = row["none"], row["all"], row["buildplate"]
     if all(x.get("ok") and x.get("filament_mm3") is not None for x in (n, s, b)):
         row["prusa_support_mm3"] = round(s["filament_mm3"] - n["filament_mm3"], 1)

@@ -154,3 +154,50 @@ def test_feet_go_down_only_where_the_print_can_have_up():
     asm, Ts = _toy()
     asm.profile = replace(asm.profile, orient="axes_flat")
     assert FT.add_feet(asm, Ts) == [] and asm.feet == {}
+
+
+def test_nand_fdm_attachment_holes_are_teardrops_without_a_flat_ceiling(nand_fdm):
+    """In ``mlc stl``'s fdm print (the feet's up, the model's z) every attachment hole inside a
+    slab runs across the layers (the input levers' slabs stand vertical, the output lever's lean
+    at about 48 degrees), so each is a teardrop pointing up: measured on the finished part in the
+    print frame, no downward face within the hole's reach is flatter than the overhang limit.
+    A round hole there (as before) has its ceiling flatter than the limit."""
+    from mlc.mesh.build import TEARDROP_SIDE_DEG, cylinder, transform_solid
+    from mlc.mesh.checks import OVERHANG_DEG
+    asm, rep = nand_fdm
+    holes = {name: (c, nrm, kind) for name, c, nrm, kind in asm.holes}
+    assert set(holes) == {"a_lo", "a_hi", "b_lo", "b_hi", "out_lo", "out_hi"}, asm.holes
+    assert all(kind == "teardrop" for _, _, kind in holes.values())
+    lim = np.cos(np.radians(90.0 - OVERHANG_DEG))
+    r = max(asm.profile.min_feature, 0.08 * asm.profile.sigma_mm) / 2
+    reach = r / np.cos(np.radians(TEARDROP_SIDE_DEG)) + 0.3
+    for name, (c, nrm, _) in holes.items():
+        T = asm.print_T(name)
+        part = transform_solid(asm.part(name).solid, T)
+        pc = T[:3, :3] @ c + T[:3, 3]
+        nz, area = _down_near(part, pc, T[:3, :3] @ nrm, reach, asm.slab_thickness)
+        assert area.sum() > 0 and np.all(nz >= -lim - 1e-6), (name, nz.min())
+        # the same part with a round hole there instead: a ceiling flatter than the limit
+        t = asm.slab_thickness
+        plug = cylinder(pc, T[:3, :3] @ nrm, -t / 2, t / 2, reach, 32)
+        rnd = (part + plug) - cylinder(pc, T[:3, :3] @ nrm, -5, 5, r, 32, cutter=True)
+        nz, area = _down_near(rnd, pc, T[:3, :3] @ nrm, r + 0.3, t)
+        assert area[nz < -lim - 1e-6].sum() > 0.05, name
+
+
+def _down_near(solid, centre, axis, reach, t):
+    """(normal z, area) of the downward faces of ``solid`` within ``reach`` of the line through
+    ``centre`` along ``axis`` and within the slab (``t`` thick) around ``centre``."""
+    m = solid.to_mesh()
+    V = np.asarray(m.vert_properties, float)[:, :3]
+    F = np.asarray(m.tri_verts, np.int64)
+    A, B, C = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    n = np.cross(B - A, C - A)
+    area = 0.5 * np.linalg.norm(n, axis=1)
+    nz = n[:, 2] / np.maximum(2 * area, 1e-12)
+    q = (A + B + C) / 3 - centre
+    a = np.asarray(axis, float) / np.linalg.norm(axis)
+    along = q @ a
+    radial = np.linalg.norm(q - np.outer(along, a), axis=1)
+    keep = (radial < reach) & (np.abs(along) < t) & (nz < -1e-9) & (area > 1e-9)
+    return nz[keep], area[keep]

@@ -268,6 +268,8 @@ class Assembly:
     # print-only feet (mlc.mesh.feet): {part: volume added, mm^3}; empty: none
     feet: dict = field(default_factory=dict)
     feet_free: dict = field(default_factory=dict)    # {part: its solid before the feet} (measurements)
+    # attachment holes drilled inside slabs: (part, centre mm, axis, "round" or "teardrop"), rest frame
+    holes: list = field(default_factory=list)
 
     def print_T(self, name: str) -> np.ndarray:
         """Model rest frame -> print frame (4x4, mm) of part ``name``: its configuration, then
@@ -913,7 +915,11 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         if motion_T:
             _clear_motion(asm, protected, soft, list(motion_poses), motion_T)
     _log("final trims done; drilling")
-    _drill(asm, lugs, lug_hole, lug_out, t, motion_T)
+    # attachment holes shaped for the print's up where it is known now: the feet's (fdm's
+    # orient: auto; the as_is profiles, mjp and sla, print their own support and keep round holes)
+    _drill(asm, lugs, lug_hole, lug_out, t, motion_T,
+           up=_feet_up(asm, poses, motion_T) if resolve and motion_T and prof.orient in ("auto", "auto_config")
+           else None)
     if resolve and motion_T:
         # print-only feet under the parts that move in one plane (mlc.mesh.feet): clear of every
         # other part as printed, in the logic states and in the dense poses; before the orientation
@@ -1913,12 +1919,79 @@ def _ring_clear(asm: "Assembly", part: "Part", ring, motion_T=()) -> bool:
     return True
 
 
-def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t, motion_T=()) -> None:
+#: attachment holes for a known print up (issue 13): a hole whose axis rises less than this
+#: (degrees) from the bed has a ceiling flatter than the overhang limit (its ceiling rises as
+#: much as its axis) and is drilled as a teardrop with its point up, the usual FDM rule
+HOLE_TEARDROP_DEG = 45.0
+#: ... whose two sides rise at this angle (degrees; 45 is the usual rule, a little more keeps
+#: them off the limit on a polygon)
+TEARDROP_SIDE_DEG = 50.0
+
+
+def _feet_up(asm: "Assembly", poses, motion_T) -> np.ndarray | None:
+    """The up direction the print-only feet will be made for (:func:`mlc.mesh.feet.plan_feet`),
+    or None (no feet)."""
+    from mlc.mesh import feet
+    if not feet.BED_FEET:
+        return None
+    eye = {p.name: np.eye(4) for p in asm.parts}
+    plan = feet.plan_feet(asm, [eye] + [asm.part_transforms(*pq) for pq in (poses or {}).values()] + list(motion_T))
+    return None if plan is None else np.asarray(plan[0], float)
+
+
+def hole_kind(nrm, up) -> str:
+    """How an attachment hole of axis ``nrm`` is drilled for the print up ``up`` (None: not
+    known): "round", or "teardrop" when its axis rises less than :data:`HOLE_TEARDROP_DEG`."""
+    if up is None:
+        return "round"
+    c = abs(float(np.dot(nrm, up)) / (np.linalg.norm(nrm) * np.linalg.norm(up)))
+    elev = 90.0 - np.degrees(np.arccos(min(1.0, c)))      # the axis's angle above the bed
+    return "teardrop" if elev < HOLE_TEARDROP_DEG - 1e-9 else "round"
+
+
+def hole_shape(c, nrm, up, r, t, n, half, kind=None, grow=0.0) -> mf.Manifold:
+    """An attachment hole of radius ``r`` along ``nrm`` at ``c``, over ``|nrm . (p - c)| <=
+    half``; a teardrop (:func:`hole_kind`) is the circle with a 90-degree point towards ``up``
+    in the plane normal to ``nrm`` (its sides tangent to the circle, rising at
+    :data:`TEARDROP_SIDE_DEG` in that plane): its ceiling is two faces that rise at 45 degrees or
+    more.  ``grow``: the shape offset
+    by that much (mm; the wall around the hole).  ``n`` segments, the circle's inscribed radius
+    ``r + grow`` (as :func:`cylinder` with ``cutter``)."""
+    nrm = np.asarray(nrm, float) / np.linalg.norm(nrm)
+    kind = kind or hole_kind(nrm, up)
+    k = 1 / np.cos(np.pi / n)
+    r = r + grow
+    if kind == "round":
+        return cylinder(c, nrm, -half, half, r * k, n)
+    up = np.asarray(up, float) / np.linalg.norm(up)
+    v = up - np.dot(up, nrm) * nrm
+    v /= np.linalg.norm(v)
+    w = np.cross(v, nrm)
+    ang = np.linspace(0.0, 2 * np.pi, int(n), endpoint=False)
+    circ = [(r * k * np.cos(a), r * k * np.sin(a)) for a in ang]
+    p = np.radians(TEARDROP_SIDE_DEG)       # the sides touch the circle (of the polygon's outer radius)
+    tip = [(-r * k * np.sin(p), r * k * np.cos(p)), (r * k * np.sin(p), r * k * np.cos(p)), (0.0, r * k / np.cos(p))]
+    cs = mf.CrossSection([circ]) + mf.CrossSection([tip if _ccw(tip) else tip[::-1]])
+    F = np.column_stack([w, v, nrm])            # profile (x, y) -> w, v; extruded along nrm
+    return mf.Manifold.extrude(cs, 2 * half).translate([0.0, 0.0, -half]).transform(
+        _affine(F, np.asarray(c, float)))
+
+
+def _ccw(poly) -> bool:
+    a = 0.0
+    for (x0, y0), (x1, y1) in zip(poly, poly[1:] + poly[:1]):
+        a += x0 * y1 - x1 * y0
+    return a > 0
+
+
+def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t, motion_T=(), up=None) -> None:
     """Drill each attachment hole inside its slab, at the spot nearest to the site where a
     full ring of material (``min_wall``) surrounds the hole; where there is no room, on a ring lug
     at the site or further along the arm: the first that keeps the clearance in the dense poses
     ``motion_T`` too, else the first that meets no part in a logic state (the ``motion_clearance``
-    check then fails)."""
+    check then fails).  ``up`` (the print's up, when known before the orientation: the feet's):
+    a hole inside a slab is shaped to print without support (:func:`hole_shape`), and its wall
+    measured around that shape."""
     n = asm.profile.circular_segments
     for part in asm.parts:
         for site, nrm, ring, _, sb, label in lugs.get(part.name, []):
@@ -1938,15 +2011,25 @@ def _drill(asm: "Assembly", lugs, lug_hole, lug_out, t, motion_T=()) -> None:
             order = np.argsort(np.linalg.norm(cands - site, axis=1))
             # the hole needs its wall in the slab's plane; a face shaved by a trim is acceptable,
             # so the test disc is the middle half of the slab's thickness
-            disc = cylinder(np.zeros(3), nrm, -t / 4, t / 4, lug_out, n)
+            kind = hole_kind(nrm, up)
+            if kind == "round":
+                disc = cylinder(np.zeros(3), nrm, -t / 4, t / 4, lug_out, n)
+            else:       # the hole's shape grown by the wall, over the middle half of the slab
+                disc = hole_shape(np.zeros(3), nrm, up, lug_hole, t, n, t / 4, kind, grow=lug_out - lug_hole)
             full = disc.volume()
             for k in order[:400]:
                 c = cands[k]
                 if (disc.translate(c.tolist()) - part.solid).volume() <= 1e-3 * full:
-                    part.solid = subtract(part.solid, [cylinder(c, nrm, -t - 1, t + 1, lug_hole, n, cutter=True)])
+                    hole = (cylinder(c, nrm, -t - 1, t + 1, lug_hole, n, cutter=True) if kind == "round"
+                            else hole_shape(c, nrm, up, lug_hole, t, n, t + 1, kind))
+                    part.solid = subtract(part.solid, [hole])
+                    asm.holes.append((part.name, c.copy(), np.asarray(nrm, float), kind))
                     off = float(np.linalg.norm(c - site))
                     if off > 1e-6:
                         asm.notes.append(f"{label}: attachment hole {off:.2f} mm from the site, inside the slab")
+                    if kind != "round":
+                        asm.notes.append(f"{label}: attachment hole drilled as a teardrop pointing up "
+                                         "(a hole across the layers, to print without support)")
                     break
             else:
                 # no room inside the trimmed slab: a ring (lug) of full thickness around the site,
