@@ -802,18 +802,23 @@ def _gap_fn(space, tag: str, skip: int, others_tree, geo, ext: float, space_clea
 
 
 def _route_all(chains: list, routed: dict, lanes, space, space_clear: float, jobs: int, source, progress) -> None:
-    """Route ``chains`` in order (:func:`_route_chain`) into ``routed``; with ``jobs`` > 1
-    the first solves of the next ``jobs - 1`` chains, in the planes the lanes would give
-    them were the chains before them in their first planes, start in other processes
-    meanwhile (:class:`mlc.circuit.route.Prefetch`: the routes are the same for any jobs)."""
+    """Route ``chains`` in order (:func:`_route_chain`) into ``routed``; with ``jobs`` > 1,
+    while this process solves a chain, the first solves of the next ``jobs - 1`` chains, in
+    the planes the lanes would give them were the chains before them in their first planes,
+    run in other processes (:class:`mlc.circuit.route.Prefetch`: the routes are the same
+    for any jobs); this process then takes those and solves the chain after them itself.
+    (Starting the next chain's solve at every chain instead left this process waiting on
+    one solve after another: measured, no faster than one process.)"""
     from mlc.circuit.lanes import Lanes
     from mlc.circuit.route import Prefetch
     ahead = max(int(jobs), 1) - 1
+    started: set = set()                    # chains whose first solve was started ahead
     with Prefetch(jobs) as pf:
         for i, ch in enumerate(chains):
             if progress:
                 progress(i, len(chains))
-            if ahead:
+            if ahead and ch.tag not in started:     # this process solves this chain; the others the next ones
+                started.update(nxt.tag for nxt in chains[i + 1:i + 1 + ahead])
                 guess = Lanes(lanes.sep)
                 guess.placed = list(lanes.placed)
                 for nxt in chains[i:i + 1 + ahead]:
@@ -846,9 +851,11 @@ def _route_chain(ch: _Chain, lanes, space, space_clear: float, pf=None) -> None:
     farthest from the placed chains and gates (the first that keeps ``space_clear``); if
     none keeps it, that plane's route again pushed away from them (kept if farther); if no
     lane closes, a straight route.  ``ch.route`` stays None if nothing closes.  The planes
-    depend on the lanes alone, so with a :class:`~mlc.circuit.route.Prefetch` ``pf`` the
-    solve in the next plane starts in another process while this one solves a plane (not
-    needed when this plane keeps the chain apart: the caller drops it)."""
+    depend on the lanes alone, so with a :class:`~mlc.circuit.route.Prefetch` ``pf``, once
+    a plane has left the chain too close, the solve in the plane after the next one starts
+    in another process while this one solves the next (most chains keep their first plane:
+    starting its next one at once was measured to waste more than it saved; the caller
+    drops what is not needed)."""
     from mlc.circuit.route import solve_route
     lane = ch.lane
     planes = [lanes.assign(lane)]
@@ -856,7 +863,7 @@ def _route_chain(ch: _Chain, lanes, space, space_clear: float, pf=None) -> None:
         planes.append(lanes.assign(lane, planes[-1] + 1))
     best = (-math.inf, None, planes[0], ())
     for k, plane in enumerate(planes):
-        if pf is not None and k + 1 < len(planes):      # the next plane, in case this one is too close
+        if pf is not None and k and k + 1 < len(planes):    # this plane was too close: the next one too?
             pf.submit(ch.tag, *ch.solve, waypoints=_plane_waypoints(ch, planes[k + 1]), **ch.kw)
         wps = _plane_waypoints(ch, plane)
         r = solve_route(*ch.solve, waypoints=wps, **ch.kw)
