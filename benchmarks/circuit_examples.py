@@ -14,8 +14,9 @@ With ``--only`` the other examples' last entries are kept (each entry names its 
 ``--direct`` with direct gate-to-gate connections (``mlc compile --direct``; the nets made
 direct and those dropped as crossed are recorded), into ``circuit_examples_direct.json``.
 
-``--jobs N`` verifies N rows at once (``mlc verify --jobs``: the same results; the
-verification's wall time is then not one core's).
+``--jobs N`` routes in N processes and verifies N rows at once (``mlc compile --jobs``,
+``mlc verify --jobs``: the same scenes and results; the build's and the verification's wall
+time is then not one core's).
 Writes benchmarks/results/circuit_examples.json (``circuit_examples_jointk{K}.json`` with ``--joint-k``).  Wall seconds on this machine in one
 run (shared, noisy): compare ratios, not absolute numbers across machines.
 """
@@ -43,7 +44,7 @@ def example_point(path: Path, joint_k: float | None = None, direct: bool = False
     compiled = compile_spec(load(str(path)))
     t1 = time.perf_counter()
     kw = {} if joint_k is None else {"joint_k": joint_k}
-    compiled = build(compiled, options=CircuitOptions(direct=direct, **kw) if (kw or direct) else None)
+    compiled = build(compiled, options=CircuitOptions(direct=direct, jobs=jobs, **kw))
     t2 = time.perf_counter()
     circ = compiled.circuit
     sc = circ.scene
@@ -68,7 +69,8 @@ def main():
     ap.add_argument("--joint-k", type=float, default=None, help="connector joint stiffness, in k0 (default: mlc's)")
     ap.add_argument("--direct", action="store_true", help="direct gate-to-gate connections (mlc compile --direct)")
     ap.add_argument("--jobs", type=int, default=1,
-                    help="rows verified at once (mlc verify --jobs; the same results, less wall time)")
+                    help="processes that route, and rows verified at once (mlc compile/verify --jobs; the same "
+                         "scenes and results)")
     args = ap.parse_args()
     res_path = OUT / ("circuit_examples_direct.json" if args.direct else "circuit_examples.json" if args.joint_k is None
                       else f"circuit_examples_jointk{args.joint_k:g}.json")

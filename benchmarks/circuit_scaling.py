@@ -83,7 +83,7 @@ def save_scene(sc, path: Path) -> str:
 
 
 def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: float | None = None,
-                save_to: Path | None = None) -> dict:
+                save_to: Path | None = None, jobs: int = 1) -> dict:
     """One circuit of the series: the ``w``-bit ripple-carry adder, or (``family`` "multiplier")
     the ``w`` x ``w`` array multiplier (2w inputs: 6 bits are 222 gates on 12 inputs), or
     (``family`` "mesh") ``nand_mesh(MESH_WIDTH, w)``, compiled at -O0 (depth 29: 203 gates).  The
@@ -108,7 +108,7 @@ def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: flo
     load0 = os.getloadavg()[0]
     t0, c0 = time.perf_counter(), time.process_time()
     try:
-        circ = build_circuit(c.netlist, spec, CircuitOptions(max_gates=len(c.netlist.gates)))
+        circ = build_circuit(c.netlist, spec, CircuitOptions(max_gates=len(c.netlist.gates), jobs=jobs))
     except MlcError as e:
         if family == "adder":
             raise
@@ -118,7 +118,7 @@ def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: flo
     sc = circ.scene
     row = "1" * len(sc.inputs)
     point = {"family": family, "width": w, "gates": len(c.netlist.gates), "bodies": len(sc.bodies), "chains": circ.chains,
-            "half_units": circ.half_units, "build_s": t_build, "build_cpu_s": c_build, "load": load0,
+            "half_units": circ.half_units, "build_s": t_build, "build_cpu_s": c_build, "load": load0, "jobs": jobs,
             "route_solves": route.CACHE_HITS[1] - hits0[1], "route_repeats": route.CACHE_HITS[0] - hits0[0],
             "tight_chains": sc.meta["connector"]["tight_chains"], "build_parts_s": circ.seconds,
             "state_contacts": sc.meta["connector"].get("state_contacts", []),
@@ -357,6 +357,9 @@ def main():
                          "--save-scenes wrote to DIR (it must be the one the point records, scene_sha)")
     ap.add_argument("--skip-dynamic", action="store_true")
     ap.add_argument("--budget", type=float, default=1800.0, help="stop growing after this many seconds")
+    ap.add_argument("--jobs", type=int, default=1,
+                    help="processes that route (mlc compile --jobs: the same scenes; build_cpu_s is then this "
+                         "process's CPU only)")
     ap.add_argument("--dynamic-only", action="store_true",
                     help="only the full adder's per-scheme dynamic cost, into the committed JSON")
     ap.add_argument("--refit", action="store_true",
@@ -397,7 +400,8 @@ def main():
             if args.check_saved:
                 p = checked_saved(pts.get(w), args.check_saved, fam, w, args.verify_budget)
             else:                                        # a refusal: its reason
-                p = adder_point(w, fam, on_built=built, verify_budget=args.verify_budget, save_to=args.save_scenes)
+                p = adder_point(w, fam, on_built=built, verify_budget=args.verify_budget, save_to=args.save_scenes,
+                                jobs=args.jobs)
             pts[w] = p
             print(json.dumps({k: (round(v, 3) if isinstance(v, float) else v) for k, v in p.items()
                               if k != "build_parts_s"}), flush=True)
@@ -409,7 +413,7 @@ def main():
     points = []
     t_all = time.perf_counter()
     for w in widths:
-        p = adder_point(w)
+        p = adder_point(w, jobs=args.jobs)
         points.append(p)
         print(json.dumps({k: (round(v, 3) if isinstance(v, float) else v) for k, v in p.items()
                           if k != "build_parts_s"}), flush=True)
