@@ -858,13 +858,13 @@ def _route_chain(ch: _Chain, lanes, space, space_clear: float, pf=None) -> None:
     drops what is not needed)."""
     from mlc.circuit.route import solve_route
     lane = ch.lane
-    planes = [lanes.assign(lane)]
-    for _ in range(PLANE_TRIES - 1):
-        planes.append(lanes.assign(lane, planes[-1] + 1))
-    best = (-math.inf, None, planes[0], ())
-    for k, plane in enumerate(planes):
-        if pf is not None and k and k + 1 < len(planes):    # this plane was too close: the next one too?
-            pf.submit(ch.tag, *ch.solve, waypoints=_plane_waypoints(ch, planes[k + 1]), **ch.kw)
+    plane = lanes.assign(lane)
+    best = (-math.inf, None, plane, ())
+    for k in range(PLANE_TRIES):
+        after = None
+        if pf is not None and 0 < k < PLANE_TRIES - 1:     # the plane before was too close: this one too?
+            after = lanes.assign(lane, plane + 1)
+            pf.submit(ch.tag, *ch.solve, waypoints=_plane_waypoints(ch, after), **ch.kw)
         wps = _plane_waypoints(ch, plane)
         r = solve_route(*ch.solve, waypoints=wps, **ch.kw)
         if r is not None:
@@ -873,6 +873,7 @@ def _route_chain(ch: _Chain, lanes, space, space_clear: float, pf=None) -> None:
                 best = (g, r, plane, wps)
             if g >= space_clear:
                 break
+        plane = lanes.assign(lane, plane + 1) if after is None else after
     gap, route, plane, wps = best
     if route is not None and gap < space_clear:
         # no plane keeps it apart: the best plane's route again, pushed away from the
