@@ -100,6 +100,8 @@ def test_routing_with_jobs_takes_solves_started_ahead_and_builds_the_same_scene(
     two = build_circuit(c.netlist, spec, CircuitOptions(jobs=2))
     assert route.PREFETCH[1] - taken > 0 and route.PREFETCH[0] - started >= route.PREFETCH[1] - taken
     assert dump_scene(two.scene) == want
+    monkeypatch.setattr(route, "_CACHE", {})           # two other processes (forked as solves queue up)
+    assert dump_scene(build_circuit(c.netlist, spec, CircuitOptions(jobs=3)).scene) == want
 
     submit = route.Prefetch.submit
 

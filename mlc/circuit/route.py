@@ -204,8 +204,7 @@ def solve_route(*args, **kw) -> Route | None:
     The solve is a pure function of its arguments, so a repeated solve with bit-identical
     arguments (the circuit builder's second build re-routes most wires exactly as the
     first did) returns the remembered result (a copy) instead of solving again: the same
-    route, bit for bit."""
-    import warnings
+    route, bit for bit.  So does a solve started ahead in another process (:class:`Prefetch`)."""
     key = None
     if CACHE_SIZE > 0:
         try:
@@ -220,9 +219,7 @@ def solve_route(*args, **kw) -> Route | None:
     fut = _PENDING.pop(key, None) if key is not None else None
     r = _taken(fut)
     if r is _NOT_TAKEN:
-        with np.errstate(all="ignore"), warnings.catch_warnings(), blas_single_thread():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            r = _solve_route(*args, **kw)
+        r = _solve_plain(args, kw)
     if key is not None:
         CACHE_HITS[1] += 1
         if len(_CACHE) >= CACHE_SIZE:
@@ -251,9 +248,21 @@ def _taken(fut):
     return r
 
 
+def _solve_plain(args, kw):
+    """:func:`_solve_route` itself, without the cache or the solves started ahead (what both
+    :func:`solve_route` and the processes of :class:`Prefetch` run).  A chain steered far
+    off may overflow on the way, which only means that length does not close: the warnings
+    are not shown."""
+    import warnings
+    with np.errstate(all="ignore"), warnings.catch_warnings(), blas_single_thread():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        return _solve_route(*args, **kw)
+
+
 def _solve_ahead(args, kw):
-    """A solve in a forked process of :class:`Prefetch` (its own cache is not shared back)."""
-    return solve_route(*args, **kw)
+    """A solve in a forked process of :class:`Prefetch`.  It bypasses that process's copies of
+    the cache and of the started solves: a copy of a running solve's Future would never end."""
+    return _solve_plain(args, kw)
 
 
 class Prefetch:
