@@ -12,12 +12,14 @@ from mlc.draw import INPUT_COLOURS, box_faces
 _WIRE = "#7a8793"
 _GATE = "#3b4a57"
 MERGE_FRACTION = 0.03       # labels this close (a fraction of the view's larger span) are merged
+MERGE_SHOWN = 4             # names written in one merged label; the rest are counted
 
 
 def merge_labels(labels: list, span: float, sep: str = ", ") -> list:
     """Labels ``(x, y, text)`` whose anchors lie within ``MERGE_FRACTION * span`` of the first
     label of a group (in order) become one label at that first anchor, their texts joined by
-    ``sep`` (each text once, in order).  Returns ``[(x, y, text)]``."""
+    ``sep`` (each text once, in order; past ``MERGE_SHOWN`` names, "+N more").  Returns
+    ``[(x, y, text)]``."""
     tol = MERGE_FRACTION * max(float(span), 1e-9)
     groups: list = []
     for x, y, text in labels:
@@ -28,7 +30,9 @@ def merge_labels(labels: list, span: float, sep: str = ", ") -> list:
                 break
         else:
             groups.append([x, y, [text]])
-    return [(x, y, sep.join(texts)) for x, y, texts in groups]
+    return [(x, y, sep.join(texts if len(texts) <= MERGE_SHOWN
+                             else texts[:MERGE_SHOWN - 1] + [f"+{len(texts) - MERGE_SHOWN + 1} more"]))
+            for x, y, texts in groups]
 
 
 def _merged(ax, labels: list, prefix: str, span: float, sep: str = ", ", **style) -> None:
@@ -95,8 +99,9 @@ def render_circuit(scene, pos=None, quat=None, title: str | None = None) -> byte
         for x, y, names in merge_labels(in_labels, view_span, "\n"):
             # muscles drawn on one spot (seen end on): one line per input, each in its colour
             for j, name in enumerate(names.split("\n")):
-                ax.annotate(f"in {name}", (x, y), xytext=(0, -12 * (j + 1)), textcoords="offset points",
-                            ha="center", fontsize=8, color=colour_of[name], fontweight="bold")
+                ax.annotate(name if name.endswith(" more") else f"in {name}", (x, y), xytext=(0, -12 * (j + 1)),
+                            textcoords="offset points", ha="center", fontsize=8,
+                            color=colour_of.get(name, "black"), fontweight="bold")
         probe_labels = []
         for pr in scene.probes:
             p1, p2 = scene_point(scene, pos, quat, pr.a), scene_point(scene, pos, quat, pr.b)
