@@ -46,3 +46,18 @@ def random_aig(seed: int, n_in: int = 20, n_and: int = 400, n_out: int = 12, win
     for k in range(n_out):
         g.add_output(f"o{k}", lits[-1 - 3 * k] ^ (k & 1))
     return g.cleanup()
+
+
+def downward_faces(solid):
+    """The downward faces of a manifold3d ``solid``: (normal z, area, centroid (n, 3)) of each
+    triangle whose normal points down (z < 0, area > 0)."""
+    import numpy as np
+    m = solid.to_mesh()
+    V = np.asarray(m.vert_properties, float)[:, :3]
+    F = np.asarray(m.tri_verts, np.int64)
+    A, B, C = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
+    n = np.cross(B - A, C - A)
+    area = 0.5 * np.linalg.norm(n, axis=1)
+    nz = n[:, 2] / np.maximum(2 * area, 1e-12)
+    keep = (nz < -1e-9) & (area > 1e-9)
+    return nz[keep], area[keep], ((A + B + C) / 3)[keep]

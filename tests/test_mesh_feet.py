@@ -10,6 +10,8 @@ from mlc.mesh import feet as FT
 from mlc.mesh.build import Part, transform_solid
 from mlc.mesh.profiles import load_profile
 
+from helpers import downward_faces
+
 
 def _box(lo, hi):
     lo, hi = np.asarray(lo, float), np.asarray(hi, float)
@@ -188,16 +190,10 @@ def test_nand_fdm_attachment_holes_are_teardrops_without_a_flat_ceiling(nand_fdm
 def _down_near(solid, centre, axis, reach, t):
     """(normal z, area) of the downward faces of ``solid`` within ``reach`` of the line through
     ``centre`` along ``axis`` and within the slab (``t`` thick) around ``centre``."""
-    m = solid.to_mesh()
-    V = np.asarray(m.vert_properties, float)[:, :3]
-    F = np.asarray(m.tri_verts, np.int64)
-    A, B, C = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
-    n = np.cross(B - A, C - A)
-    area = 0.5 * np.linalg.norm(n, axis=1)
-    nz = n[:, 2] / np.maximum(2 * area, 1e-12)
-    q = (A + B + C) / 3 - centre
+    nz, area, mid = downward_faces(solid)
+    q = mid - centre
     a = np.asarray(axis, float) / np.linalg.norm(axis)
     along = q @ a
     radial = np.linalg.norm(q - np.outer(along, a), axis=1)
-    keep = (radial < reach) & (np.abs(along) < t) & (nz < -1e-9) & (area > 1e-9)
+    keep = (radial < reach) & (np.abs(along) < t)
     return nz[keep], area[keep]

@@ -8,6 +8,8 @@ from mlc.mesh.build import HOLE_TEARDROP_DEG, TEARDROP_SIDE_DEG, cylinder, hole_
 from mlc.mesh.checks import OVERHANG_DEG
 from mlc.mesh.printability import bed_stats
 
+from helpers import downward_faces
+
 UP = np.array([0.0, 0.0, 1.0])
 
 
@@ -27,16 +29,9 @@ def test_hole_kind_follows_the_overhang_limit():
 
 def _down_faces(solid, centre, reach):
     """(normal z, area) of the downward faces of ``solid`` within ``reach`` of ``centre``."""
-    m = solid.to_mesh()
-    V = np.asarray(m.vert_properties, float)[:, :3]
-    F = np.asarray(m.tri_verts, np.int64)
-    A, B, C = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
-    n = np.cross(B - A, C - A)
-    area = 0.5 * np.linalg.norm(n, axis=1)
-    nz = n[:, 2] / np.maximum(2 * area, 1e-12)
-    near = np.linalg.norm((A + B + C) / 3 - centre, axis=1) < reach
-    keep = near & (nz < -1e-9) & (area > 1e-9)
-    return nz[keep], area[keep]
+    nz, area, mid = downward_faces(solid)
+    near = np.linalg.norm(mid - centre, axis=1) < reach
+    return nz[near], area[near]
 
 
 @pytest.mark.parametrize("elev", [0.0, 20.0, 40.0])
