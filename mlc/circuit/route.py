@@ -249,20 +249,15 @@ def _taken(fut):
 
 
 def _solve_plain(args, kw):
-    """:func:`_solve_route` itself, without the cache or the solves started ahead (what both
-    :func:`solve_route` and the processes of :class:`Prefetch` run).  A chain steered far
-    off may overflow on the way, which only means that length does not close: the warnings
-    are not shown."""
+    """:func:`_solve_route` itself, without the cache or the solves started ahead: what both
+    :func:`solve_route` and the processes of :class:`Prefetch` run (these must bypass their
+    copies of the cache and of the started solves: a copy of a running solve's Future would
+    never end).  A chain steered far off may overflow on the way, which only means that
+    length does not close: the warnings are not shown."""
     import warnings
     with np.errstate(all="ignore"), warnings.catch_warnings(), blas_single_thread():
         warnings.simplefilter("ignore", RuntimeWarning)
         return _solve_route(*args, **kw)
-
-
-def _solve_ahead(args, kw):
-    """A solve in a forked process of :class:`Prefetch`.  It bypasses that process's copies of
-    the cache and of the started solves: a copy of a running solve's Future would never end."""
-    return _solve_plain(args, kw)
 
 
 class Prefetch:
@@ -302,7 +297,7 @@ class Prefetch:
         if key in _CACHE or key in _PENDING:
             return
         try:
-            _PENDING[key] = self.ex.submit(_solve_ahead, args, kw)
+            _PENDING[key] = self.ex.submit(_solve_plain, args, kw)
         except RuntimeError:            # the pool is broken (a process died): route without it
             self.ex = None
             return

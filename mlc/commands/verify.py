@@ -44,12 +44,10 @@ def register(sub):
 def add_jobs(p, compile_: bool = False) -> None:
     """The ``--jobs`` option (``mlc verify``; ``mlc compile``, where it also routes)."""
     what = ("routing: the next chains' first solves start in N-1 other processes, and with --verify the static "
-            "check runs N rows at once (default 1; the scene and the report are the same for any N; memory grows "
-            "with N). --dynamic runs use the integrator's threads instead" if compile_ else
-            "static check: N rows at once, each in a process of its own (default 1; the "
-            "report is the same for any N; memory grows with N). --dynamic runs use the integrator's "
-            "threads instead")
-    p.add_argument("--jobs", type=int, default=1, metavar="N", help=what)
+            "check runs N rows at once (default 1; the scene and the report are the same" if compile_ else
+            "static check: N rows at once, each in a process of its own (default 1; the report is the same")
+    p.add_argument("--jobs", type=int, default=1, metavar="N",
+                   help=what + " for any N; memory grows with N). --dynamic runs use the integrator's threads instead")
 
 
 def check_jobs(jobs: int, dynamic: bool) -> None:
