@@ -158,3 +158,27 @@ def test_a_scene_reads_through_the_fast_reader_and_errors_keep_their_lines():
     where = _pyyaml(bad)["bodies"][0]["position"].loc_of(1)     # where PyYAML puts the item
     assert (where.line, where.col) == (i + 1, 19)
     assert str(e.value).startswith(f"{where}: bodies[0].position[1]") and "finite" in str(e.value)
+
+
+def test_locations_made_when_asked_for_are_pyyamls_whichever_way_they_are_asked():
+    """The fast reader keeps its locations as numbers and makes a Loc only when one is asked
+    for (a big scene asks for few of its millions); every way of asking gives what PyYAML's
+    reader gives: a key's or an item's location, a missing key or index (the container's),
+    slices, lengths, items, values."""
+    text = SCENES["branch"]
+    fast, ref = yamlfast.parse(text, "s.yaml"), _pyyaml(text)
+    fb, rb = fast["bodies"], ref["bodies"]
+    assert fb.loc == rb.loc and fb.loc_of(1) == rb.loc_of(1) and fb.loc_of(10 ** 6) == rb.loc
+    assert fb.loc_of("x") == rb.loc                         # not an index: the list's own
+    assert list(fb.item_locs[1:3]) == list(rb.item_locs[1:3]) and len(fb.item_locs) == len(rb.item_locs)
+    body, rbody = fb[0], rb[0]
+    assert body.loc_of("position") == rbody.loc_of("position") and body.loc_of("nope") == rbody.loc
+    assert dict(body.item_locs.items()) == dict(rbody.item_locs.items())
+    assert list(body.item_locs.values()) == list(rbody.item_locs.values()) and list(body.item_locs) == list(rbody)
+    pos, rpos = body["position"], rbody["position"]         # a flow sequence of numbers
+    assert [pos.loc_of(k) for k in range(3)] == [rpos.loc_of(k) for k in range(3)]
+    assert pos.item_locs[0:2] == rpos.item_locs[0:2] and len(pos.item_locs) == 3
+    bond, rbond = fast["bonds"][0]["sites"], ref["bonds"][0]["sites"]     # a flow sequence of names
+    assert list(bond.item_locs) == list(rbond.item_locs) and bond.loc == rbond.loc
+    # what holds the data has no per-object dictionary (a scene has millions of these)
+    assert not hasattr(body, "__dict__") and not hasattr(pos, "__dict__")

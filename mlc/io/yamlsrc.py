@@ -41,8 +41,23 @@ MAX_BYTES = 64 * 2 ** 20
 _MAX_INT = 2 ** 1024
 
 
+# LocDict and LocList: ``__slots__`` (no dictionary per object: a scene has millions of
+# them) and ``loc`` a property, which :mod:`mlc.io.yamlfast` sets to a plain
+# ``(file, line, col)`` tuple that becomes a Loc when first read.
+def _get_loc(self) -> Loc:
+    v = self._loc
+    if type(v) is tuple:               # (file, line, col) from mlc.io.yamlfast: made when asked for
+        v = self._loc = Loc(*v)
+    return v
+
+
+def _set_loc(self, v) -> None:
+    self._loc = v
+
+
 class LocDict(dict):
-    loc: Loc
+    __slots__ = ("_loc", "item_locs")
+    loc = property(_get_loc, _set_loc)
     item_locs: dict
 
     def loc_of(self, key) -> Loc:
@@ -50,7 +65,8 @@ class LocDict(dict):
 
 
 class LocList(list):
-    loc: Loc
+    __slots__ = ("_loc", "item_locs")
+    loc = property(_get_loc, _set_loc)
     item_locs: list
 
     def loc_of(self, index) -> Loc:
