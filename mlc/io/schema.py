@@ -190,6 +190,10 @@ def _compile(s: dict, root: dict, done: dict):
         return cell[0] if cell[0] is not None else (lambda v: cell[0](v))    # recursion: late bound
     cell = [None]
     done[id(s)] = cell
+    fused = _fused(s, root)
+    if fused is not None:
+        cell[0] = fused
+        return fused
     checks = []
     if "$ref" in s:
         ref = s["$ref"]
@@ -215,7 +219,11 @@ def _compile(s: dict, root: dict, done: dict):
             if xlo is not None and v <= xlo or xhi is not None and v >= xhi:
                 return False
         return True
-    checks.append(number)
+    types = s.get("type")
+    types = set(types if isinstance(types, list) else [types]) if types is not None else None
+    pure_ref = "$ref" in s and not set(s) - {"$ref"} - _NOTES
+    if not pure_ref and (types is None or types & {"number", "integer"}):
+        checks.append(number)               # else the type or the $ref's own predicate decides it
     if "enum" in s:
         enum = s["enum"]
         checks.append(lambda v: v in enum)
@@ -241,6 +249,59 @@ def _compile(s: dict, root: dict, done: dict):
         fn = (lambda f, g: lambda v: f(v) and g(v))(fn, c)
     cell[0] = fn
     return fn
+
+
+_NOTES = {"description", "title", "$comment"}
+_BOUNDS = ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum")
+
+
+def _number_leaf(s: dict):
+    """``(lo, hi, xlo, xhi)`` when ``s`` is ``{"type": "number"}`` with bounds at most (and
+    notes), else None."""
+    if s.get("type") != "number" or set(s) - {"type", *_BOUNDS} - _NOTES:
+        return None
+    return tuple(s.get(k) for k in _BOUNDS)
+
+
+def _fused(s: dict, root: dict):
+    """One predicate without calls per value for the two shapes that make up most of a
+    scene: a bounded number, and an array of them with a length range (a vector); None for
+    any other schema.  The same verdict as the chained checks of :func:`_compile`."""
+    if s.get("type") == "array" and isinstance(s.get("items"), dict) and not set(s) - {
+            "type", "items", "minItems", "maxItems"} - _NOTES:
+        leaf = _number_leaf(s["items"])
+        if leaf is None:
+            return None
+        n_min, n_max = s.get("minItems"), s.get("maxItems")
+    else:
+        leaf = _number_leaf(s)
+        if leaf is None:
+            return None
+        n_min = n_max = False                # not an array
+    lo, hi, xlo, xhi = leaf
+    isfinite = math.isfinite
+
+    def ok_number(x) -> bool:
+        return (isinstance(x, (int, float)) and not isinstance(x, bool) and isfinite(x)
+                and not (lo is not None and x < lo or hi is not None and x > hi)
+                and not (xlo is not None and x <= xlo or xhi is not None and x >= xhi))
+    if n_min is False:
+        return ok_number
+
+    def ok_vector(v) -> bool:
+        if not isinstance(v, list):
+            return False
+        if n_min is not None and len(v) < n_min or n_max is not None and len(v) > n_max:
+            return False
+        for x in v:
+            if not (isinstance(x, (int, float)) and not isinstance(x, bool) and isfinite(x)):
+                return False
+            if lo is not None and x < lo or hi is not None and x > hi:
+                return False
+            if xlo is not None and x <= xlo or xhi is not None and x >= xhi:
+                return False
+        return True
+    return ok_vector
 
 
 def _compile_object(s: dict, root: dict, done: dict):
