@@ -12,7 +12,13 @@ Writes benchmarks/results/mesh_gates.json: per (gate, signal, profile) whether t
 passes, the failed checks (blocking, and the goals that do not block yet), part count, the
 number of dense poses, the smallest gap in motion and the pairs under the clearance, the
 measured walls (``thinnest_wall_mm``, ``thin_walls``: the ``wall_thickness`` goal), wall and
-CPU seconds.
+CPU seconds, and ``commit`` (benchmarks/gitstate.py: HEAD, ``-dirty`` when mlc/ differs from it).
+
+**Outside check of the web at hinge c** (``section_web``, session 36): the hinge's owner
+(core_cd) cut by planes normal to the axis in the middle of the other bodies' knuckles, each
+piece of the section near the axis other than the pin measured by the largest disc that fits
+in it (manifold3d's slice and Clipper2 polygon offsets, not the voxel grid of
+``mlc.mesh.walls``): ``web_mm``, the thinnest.
 
 **Outside check** (when ``python-fcl`` is installed, ``pip install python-fcl``; not an mlc
 dependency): the Flexible Collision Library's mesh-mesh distance (its own BVH and
@@ -42,8 +48,59 @@ from mlc.gates.library import GATE_NAMES, gate_scene  # noqa: E402
 from mlc.io.atomic import atomic_path  # noqa: E402
 from mlc.mesh.pipeline import export_assembly, state_poses  # noqa: E402
 from mlc.mesh.profiles import load_profile  # noqa: E402
+from gitstate import commit  # noqa: E402  (benchmarks/gitstate.py)
 
 RESULTS = ROOT / "benchmarks" / "results"
+
+
+def _inscribed(cs) -> float:
+    """Diameter (mm) of the largest disc inside the polygon ``cs`` (a manifold3d CrossSection),
+    by bisection on the inward offset (Clipper2) that empties it: 0.001 mm."""
+    import manifold3d as mf
+    lo, hi = 0.0, 0.5 * max(b - a for a, b in zip(cs.bounds()[:2], cs.bounds()[2:]))
+    while hi - lo > 5e-4:
+        r = 0.5 * (lo + hi)
+        if cs.offset(-r, mf.JoinType.Round).is_empty():
+            hi = r
+        else:
+            lo = r
+    return 2 * lo
+
+
+def section_webs(asm) -> dict:
+    """Outside check of the web at the three-body hinge (hinge c), independent of the voxel
+    measurement of ``mlc.mesh.walls``: core_cd (the hinge's owner) cut by planes normal to the
+    hinge axis at the middle of each stretch of the axis where the other bodies' knuckles are
+    (manifold3d ``slice``); every polygon of the section within the trim radius + 2 minimum walls
+    of the axis, except the one around the axis (the pin), is a web; its thickness is the
+    diameter of the largest disc that fits in it (:func:`_inscribed`, polygon offsets).
+    ``{"web_mm": thinnest, "webs": count}``; ``web_mm`` None where no web is cut."""
+    axes = [ax for ax in asm.axes if len(ax.bodies) == 3]
+    out = {"web_mm": None, "webs": 0}
+    for ax in axes:
+        own = ax.owner
+        solid = asm.part(own).solid
+        d = np.asarray(ax.direction, float)
+        e1 = np.cross(d, [1.0, 0, 0] if abs(d[0]) < 0.9 else [0, 1.0, 0])
+        e1 /= np.linalg.norm(e1)
+        R = np.vstack([e1, np.cross(d, e1), d])
+        M = np.hstack([R, (-R @ np.asarray(ax.origin, float))[:, None]])
+        local = solid.transform(M.tolist())
+        ivs = sorted(iv for bn, v in ax.intervals.items() if bn != own for iv in v)
+        for a0, a1 in ivs:
+            cs = local.slice(0.5 * (a0 + a1))
+            for piece in cs.decompose():
+                (x0, y0), (x1, y1) = piece.bounds()[:2], piece.bounds()[2:]
+                if x0 <= 0 <= x1 and y0 <= 0 <= y1:      # the pin through the axis
+                    continue
+                if min(np.hypot(x, y) for x in (x0, x1) for y in (y0, y1)) > ax.rho + 2 * asm.profile.min_wall:
+                    continue
+                w = _inscribed(piece)
+                out["webs"] += 1
+                out["web_mm"] = w if out["web_mm"] is None else min(out["web_mm"], w)
+    if out["web_mm"] is not None:
+        out["web_mm"] = round(out["web_mm"], 4)
+    return out
 
 
 def fcl_gaps(asm, poses: dict, clearance: float) -> tuple[float | None, int, int]:
@@ -128,10 +185,11 @@ def main() -> int:
                        "thinnest_wall_mm": rep.check("wall_thickness").value,
                        "min_wall_mm": profile.min_wall,
                        "thin_walls": rep.check("wall_thickness").failures,
-                       "export_s": round(wall, 2), "export_cpu_s": round(cpu, 2)}
+                       "section_web": section_webs(asm),
+                       "export_s": round(wall, 2), "export_cpu_s": round(cpu, 2), "commit": commit()}
                 rows.append(row)
                 print(json.dumps(row), flush=True)
-    out = {"benchmark": "mesh_gates", "python": platform.python_version(), "cpus": os.cpu_count(),
+    out = {"benchmark": "mesh_gates", "commit": commit(), "python": platform.python_version(), "cpus": os.cpu_count(),
            "load_average": [round(x, 2) for x in os.getloadavg()],
            "passed": sum(r["ok"] for r in rows), "total": len(rows), "rows": rows}
     path = Path(args.out)

@@ -157,8 +157,67 @@ def test_a_web_thinner_than_the_wall_is_carried_and_bridged():
     probe = mf.Manifold.cube([0.1, 0.1, 0.1], True).translate(p.tolist())
     assert (core ^ probe).volume() > 0.9e-3
     assert thin_walls("core_cd", core, prof.min_wall) == []
-    # with the logic states given, a_hi and b_hi swing through every direction the bridge could
-    # take: it is refused (it would have been trimmed away in motion), the plate is still carried
+    # with the logic states given, a_hi and b_hi swing through every direction about the axis but
+    # the joint's: the bridge runs towards the joint, through the joint's trim of core_cd (set by
+    # out_hi's slab in the logic states, not by the hub: test_the_web_at_hinge_c_is_bridged_towards_the_joint)
     posed = build_assembly(gate_scene("OR", "contract"), prof, gate_poses("OR", "contract"), resolve=False)
     notes = [n for n in posed.notes if "core_cd" in n and "thinner than the minimum wall" in n]
-    assert any("carried along" in n for n in notes) and not any("bridges" in n for n in notes), notes
+    assert any("carried along" in n for n in notes) and any("bridges" in n for n in notes), notes
+
+
+@pytest.mark.parametrize("name,signal", [("AND", "expand"), ("NAND", "contract")])
+def test_the_web_at_hinge_c_is_bridged_towards_the_joint(name, signal):
+    """core_cd at mjp (issue 13, session 36): hinge c is 5.79 mm from the universal joint at d; the
+    trim around a_hi's and b_hi's knuckles (1.3 mm) and the joint's trim of core_cd (4.26 mm: out_hi's
+    lower arm crosses core_cd near d in the logic states) left a web of 0.22 mm (0.14 mm in some
+    gates) against the 0.6 mm minimum.  a_hi and b_hi swing through every other direction about
+    the axis, so the bridge goes towards d, through the joint's trim, which spares it: 0.6 mm of
+    slab, kept clear of every other slab in every logic state (the dense paths: the benchmark,
+    benchmarks/results/mesh_gates_walls_s36.json), and outside what the hub and the yoke knuckles
+    sweep.  The web's walls measure at least the minimum; before, 0.22 mm."""
+    from mlc.mesh.walls import thin_walls
+    prof = load_profile("mjp")
+    asm = build_assembly(gate_scene(name, signal), prof, gate_poses(name, signal), resolve=False)
+    assert any("core_cd bridges" in n and "thinner than the minimum wall" in n for n in asm.notes), asm.notes
+    (c,) = [ax for ax in asm.axes if len(ax.bodies) == 3]
+    (uj,) = asm.ujoints
+    u = uj.center - c.origin
+    u -= np.dot(u, c.direction) * c.direction
+    dist = float(np.linalg.norm(u))
+    u /= dist
+    core = asm.part("core_cd").solid
+    assert len(core.decompose()) == 1
+    # material of the bridge inside the joint's trim radius, at mid-stack, towards the joint
+    r_in = dist - uj.rho[0]
+    assert r_in < c.rho + prof.min_wall           # the joint's trim would have cut the bridge
+    p = c.origin + u * (c.rho + prof.min_wall - 0.1)
+    probe = mf.Manifold.cube([0.1, 0.1, 0.1], True).translate(p.tolist())
+    assert (core ^ probe).volume() > 0.9e-3
+    # and nothing of the hub's or the yoke knuckles' sweep
+    sweep = float(np.hypot(uj.layouts[1].extent, uj.R)) + prof.clearance
+    assert dist - sweep > c.rho + prof.min_wall
+    assert thin_walls("core_cd", core, prof.min_wall) == []
+
+
+def test_no_sheet_past_the_pivot_cut():
+    """out_hi at sla (issue 13, session 36): the yoke plate at d widens out_hi's lower arm to the
+    yoke's knuckles (6 mm across) up to the pivot, whose knuckle span is the slab's 4 mm; the cut
+    around out_lo's knuckles ran 0.8 mm (one slab thickness) past the span's ends and left a sheet
+    0.2 mm thick at each end, measured 0.19 mm against the 0.5 mm minimum in every contracting gate.
+    The cut now runs past the plate where what it would leave is thinner than the minimum wall."""
+    from mlc.mesh.walls import thin_walls
+    prof = load_profile("sla")
+    asm = build_assembly(gate_scene("NAND", "contract"), prof, gate_poses("NAND", "contract"), resolve=False)
+    out_hi = asm.part("out_hi").solid
+    (piv,) = [ax for ax in asm.axes if "out_hi" in ax.bodies]
+    lo, hi = np.asarray(out_hi.bounding_box()[:3]), np.asarray(out_hi.bounding_box()[3:])
+    ends = (lo @ piv.direction, hi @ piv.direction)
+    assert max(abs(e - piv.origin @ piv.direction) for e in ends) > piv.span / 2 + prof.slab_thickness
+    # nothing of out_hi within the trim radius of the pivot beyond out_hi's own knuckle
+    own = piv.intervals["out_hi"]
+    a1 = max(x for iv in own for x in iv) + prof.knuckle_gap
+    from mlc.mesh.build import cylinder
+    zone = cylinder(piv.origin, piv.direction, a1 + 0.05, max(ends) - piv.origin @ piv.direction + 1.0,
+                    piv.rho - 0.05, 64)
+    assert (out_hi ^ zone).volume() < 1e-6
+    assert thin_walls("out_hi", out_hi, prof.min_wall) == []

@@ -709,15 +709,25 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         my_axes = [ax for ax in axes if bn in ax.bodies]
         my_uj = [(uj, 0 if uj.bodies[0] == bn else 1) for uj in ujoints if bn in uj.bodies]
         # 1. clear the other bodies' knuckles
+        # (a mechanism of its own: a cut that ends at the span's end runs on past what is left of
+        # the body along the axis when that would be thinner than the minimum wall; issue 13:
+        # out_hi's yoke plate, 0.19 mm past the pivot's cut at sla)
+        sheet = {ax.name: (None if reuse else _ext_ivs(shapes[bn], ax), prof.min_wall) for ax in my_axes}
+
         def axis_cuts(ax, grow=0.0):
             return [cylinder(ax.origin, ax.direction, a0, a1, ax.rho + grow, n, cutter=True)
-                    for a0, a1 in _ext(_complement(ax.intervals[bn], -ax.span / 2, ax.span / 2), ax.span, t)]
-        other_cuts, avoid = [], []
+                    for a0, a1 in _ext(_complement(ax.intervals[bn], -ax.span / 2, ax.span / 2), ax.span, t,
+                                       *sheet[ax.name])]
+        other_cuts, avoid, avoid_sweep = [], [], []
         for uj, side in my_uj:
             lay = uj.layouts[side]
+            # the radius the joint's hub and the other body's yoke knuckles sweep about this axis:
+            # the rest of uj.rho is for the other body's slabs in the logic states (_ujoint_trim)
+            sweep = float(np.hypot(uj.layouts[1 - side].extent, uj.R)) + c
             for a0, a1 in _complement(lay.own, *lay.cut):
                 other_cuts.append(cylinder(uj.center, uj.axes[side], a0, a1, uj.rho[side], n, cutter=True))
                 avoid.append((uj.center, uj.axes[side], a0, a1, uj.rho[side]))
+                avoid_sweep.append((uj.center, uj.axes[side], a0, a1, min(sweep, uj.rho[side])))
         for uj in ujoints:      # compound junction: the other bodies of its hinge clear the yoke too
             if uj.host is not None and bn in uj.host.bodies and bn not in uj.bodies:
                 other_cuts.append(cylinder(uj.center, uj.axes[0], *uj.layouts[0].cut, uj.rho[0], n, cutter=True))
@@ -753,7 +763,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
                                  "where only a web thinner than the minimum wall was left")
                 if not ext or thin_at(ax):     # (without plates added, as just measured)
                     need[ax.name] = "thin"
-        bridges, fins = [], []
+        bridges, fins, through = [], [], []
         for ax in my_axes:
             if ax.name not in need:
                 continue
@@ -763,11 +773,22 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
                 if any(o1 <= a0 + 1e-9 for _, o1 in own) and any(o0 >= a1 - 1e-9 for o0, _ in own):
                     # (compiled circuits, reuse: as before, meshes unchanged); a bridge over a
                     # thin web must keep clear of the other bodies in the dense paths too
-                    br = _bridge(ax, bn, a0, a1, samples, state_T, t, prof, () if reuse else avoid,
-                                 (bridge_T, t / 2 + c + 0.5 * (t - scene_t)) if need[ax.name] == "thin" else None)
+                    if need[ax.name] == "thin":
+                        # the web's bridge may run into the universal joint's trim of this body
+                        # (core_cd towards d: its trim radius is set by out_hi's slab in the logic
+                        # states, and the bridge itself is kept clear of every other slab in every
+                        # state and dense pose), not into what the hub and yoke knuckles sweep; the
+                        # gap: the other slab's half thickness, the clearance, and half the diagonal
+                        # of the sample grid (a point between samples is at most that much nearer)
+                        br = _bridge(ax, bn, a0, a1, samples, state_T, t, prof, avoid_sweep,
+                                     (bridge_T, t / 2 + c + h / np.sqrt(2)))
+                    else:
+                        br = _bridge(ax, bn, a0, a1, samples, state_T, t, prof, () if reuse else avoid)
                     if br is None:
                         continue
                     mine.append(br)
+                    if need[ax.name] == "thin":
+                        through.append(br[0])
                     notes.append(f"hinge {ax.name}: {bn} bridges around the other knuckles "
                                  f"({np.degrees(br[1]):.0f} degrees from them)"
                                  + (", where only a web thinner than the minimum wall was left" if need[ax.name] == "thin" else ""))
@@ -776,6 +797,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
                 # than the minimum wall, goes (the trim grown by the minimum wall, less the bridge)
                 fins.append(subtract(union(axis_cuts(ax, prof.min_wall)), [x for x, _ in mine]))
             bridges += mine
+        if through and other_cuts:      # the joint's trims spare a thin web's bridge (checked clear above)
+            cuts = [x for ax in my_axes for x in axis_cuts(ax)] + [subtract(union(other_cuts), through)]
         solid = _clean(subtract(union([solid] + [x for x, _ in bridges]), cuts + fins)) if bridges else cut_solid
         # 2. own knuckles, attachment rings
         keep = []
@@ -1778,7 +1801,10 @@ def _bridge(ax: HingeAxis, bn, a0, a1, samples, state_T, t, prof, avoid=(), clea
     ``clear`` (``(poses, gap)``: ``[{body: 4x4}]`` and mm): the plate's material beyond the trim
     radius must also stay ``gap`` from every other body's mid-plane samples in each of those
     poses (the dense paths: a bridge placed for the logic states alone was then trimmed in
-    motion); the best such direction of the 16 best by angle, else None."""
+    motion); the first such direction of those ``avoid`` leaves, the farthest by angle first, else
+    None (session 36: the 16 best only missed the two clear of a_hi, b_hi and out_hi in the
+    expanding NOR at mjp, 60 degrees from a_hi and b_hi).  A thin web's bridge reaches the full
+    minimum wall past the corners of the trim's polygon."""
     far = 3 * ax.R + 2 * t + 0.5 * prof.sigma_mm
     w = max(prof.min_wall, t)
     foreign = []
@@ -1795,6 +1821,10 @@ def _bridge(ax: HingeAxis, bn, a0, a1, samples, state_T, t, prof, avoid=(), clea
         score = np.full_like(cand, np.pi)
     E = _perp_frame(ax.direction)
     reach = ax.rho + w
+    if clear is not None:
+        # a thin web's bridge is the web: the full wall past the trim cylinder's corners (a
+        # cutter's polygon has its corners at rho / cos(pi / n))
+        reach = ax.rho / np.cos(np.pi / prof.circular_segments) + w
     if avoid:
         # the plate's material beyond the trim radius: along the axis, out to its end, across
         a, r, f = np.meshgrid(np.linspace(a0 - w, a1 + w, 7), np.linspace(ax.rho, reach, 4),
@@ -1826,7 +1856,7 @@ def _bridge(ax: HingeAxis, bn, a0, a1, samples, state_T, t, prof, avoid=(), clea
                 A.append(aa[m]), X.append(px[m]), Y.append(py[m])
         A, X, Y = (np.concatenate(v) if v else np.zeros(0) for v in (A, X, Y))
         da = np.maximum(0.0, np.maximum(lo - A, A - hi))
-        for k in [int(i) for i in np.argsort(-score, kind="stable")[:16] if score[i] >= 0]:
+        for k in [int(i) for i in np.argsort(-score, kind="stable") if score[i] >= 0]:
             c_, s_ = np.cos(cand[k]), np.sin(cand[k])
             x, y = X * c_ + Y * s_, -X * s_ + Y * c_
             dist = np.sqrt(np.maximum(0.0, np.abs(y) - t / 2) ** 2
@@ -1842,14 +1872,23 @@ def _bridge(ax: HingeAxis, bn, a0, a1, samples, state_T, t, prof, avoid=(), clea
     return box(center, Rm, [a1 - a0 + 2 * w, reach, t]), float(score[k])
 
 
-def _ext(intervals, span, t):
-    """Extend cut intervals that end at the span's ends a little further (no coplanar faces)."""
+def _ext(intervals, span, t, beyond=None, min_wall=0.0):
+    """Extend cut intervals that end at the span's ends a little further (``t``, mm: no coplanar
+    faces).  ``beyond`` (:func:`_ext_ivs`: the ranges along the axis, mm, that the body's slabs
+    and plates cover past the span): where the body goes on past the extended end by less than
+    ``min_wall``, the cut runs on past it (``t`` more) instead of leaving a sheet that thin."""
+    lo = min([x for iv in beyond or [] for x in iv] + [-span / 2])
+    hi = max([x for iv in beyond or [] for x in iv] + [span / 2])
     out = []
     for a0, a1 in intervals:
         if abs(a0 + span / 2) < 1e-9:
             a0 -= t
+            if 0.0 < a0 - lo < min_wall:
+                a0 = lo - t
         if abs(a1 - span / 2) < 1e-9:
             a1 += t
+            if 0.0 < hi - a1 < min_wall:
+                a1 = hi + t
         out.append((a0, a1))
     return out
 
