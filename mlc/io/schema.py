@@ -190,7 +190,7 @@ def _compile(s: dict, root: dict, done: dict):
         return cell[0] if cell[0] is not None else (lambda v: cell[0](v))    # recursion: late bound
     cell = [None]
     done[id(s)] = cell
-    fused = _fused(s, root)
+    fused = _fused(s)
     if fused is not None:
         cell[0] = fused
         return fused
@@ -263,7 +263,7 @@ def _number_leaf(s: dict):
     return tuple(s.get(k) for k in _BOUNDS)
 
 
-def _fused(s: dict, root: dict):
+def _fused(s: dict):
     """One predicate without calls per value for the two shapes that make up most of a
     scene: a bounded number, and an array of them with a length range (a vector); None for
     any other schema.  The same verdict as the chained checks of :func:`_compile`."""
