@@ -206,19 +206,10 @@ def _compile(s: dict, root: dict, done: dict):
             checks.append(preds[0])
         else:
             checks.append(lambda v: any(p(v) for p in preds))
-    lo, hi = s.get("minimum"), s.get("maximum")
-    xlo, xhi = s.get("exclusiveMinimum"), s.get("exclusiveMaximum")
-    isfinite = math.isfinite
+    bounded = _bounded(*(s.get(k) for k in _BOUNDS))
 
-    def number(v):
-        if isinstance(v, (int, float)) and not isinstance(v, bool):
-            if not isfinite(v):
-                return False
-            if lo is not None and v < lo or hi is not None and v > hi:
-                return False
-            if xlo is not None and v <= xlo or xhi is not None and v >= xhi:
-                return False
-        return True
+    def number(v):              # a number must be finite and within the bounds; anything else passes
+        return not isinstance(v, (int, float)) or isinstance(v, bool) or bounded(v)
     types = s.get("type")
     types = set(types if isinstance(types, list) else [types]) if types is not None else None
     pure_ref = "$ref" in s and not set(s) - {"$ref"} - _NOTES
@@ -264,9 +255,9 @@ def _number_leaf(s: dict):
 
 
 def _fused(s: dict):
-    """One predicate without calls per value for the two shapes that make up most of a
-    scene: a bounded number, and an array of them with a length range (a vector); None for
-    any other schema.  The same verdict as the chained checks of :func:`_compile`."""
+    """One predicate, one call per value, for the two shapes that make up most of a scene: a
+    bounded number, and an array of them with a length range (a vector); None for any other
+    schema.  The same verdict as the chained checks of :func:`_compile`."""
     if s.get("type") == "array" and isinstance(s.get("items"), dict) and not set(s) - {
             "type", "items", "minItems", "maxItems"} - _NOTES:
         leaf = _number_leaf(s["items"])
@@ -278,30 +269,26 @@ def _fused(s: dict):
         if leaf is None:
             return None
         n_min = n_max = False                # not an array
-    lo, hi, xlo, xhi = leaf
-    isfinite = math.isfinite
-
-    def ok_number(x) -> bool:
-        return (isinstance(x, (int, float)) and not isinstance(x, bool) and isfinite(x)
-                and not (lo is not None and x < lo or hi is not None and x > hi)
-                and not (xlo is not None and x <= xlo or xhi is not None and x >= xhi))
+    ok_number = _bounded(*leaf)
     if n_min is False:
         return ok_number
 
     def ok_vector(v) -> bool:
-        if not isinstance(v, list):
-            return False
-        if n_min is not None and len(v) < n_min or n_max is not None and len(v) > n_max:
-            return False
-        for x in v:
-            if not (isinstance(x, (int, float)) and not isinstance(x, bool) and isfinite(x)):
-                return False
-            if lo is not None and x < lo or hi is not None and x > hi:
-                return False
-            if xlo is not None and x <= xlo or xhi is not None and x >= xhi:
-                return False
-        return True
+        return (isinstance(v, list) and not (n_min is not None and len(v) < n_min or n_max is not None and len(v) > n_max)
+                and all(map(ok_number, v)))
     return ok_vector
+
+
+def _bounded(lo, hi, xlo, xhi):
+    """The predicate "a finite number (not a bool) within these bounds" (None: no bound), for
+    :func:`_compile`'s ``number`` check and the fused predicates alike."""
+    isfinite = math.isfinite
+
+    def ok(x) -> bool:
+        return (isinstance(x, (int, float)) and not isinstance(x, bool) and isfinite(x)
+                and not (lo is not None and x < lo or hi is not None and x > hi)
+                and not (xlo is not None and x <= xlo or xhi is not None and x >= xhi))
+    return ok
 
 
 def _compile_object(s: dict, root: dict, done: dict):
