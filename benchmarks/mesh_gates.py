@@ -11,7 +11,9 @@ parts, the report.
 Writes benchmarks/results/mesh_gates.json: per (gate, signal, profile) whether the report
 passes, the failed checks (blocking, and the goals that do not block yet), part count, the
 number of dense poses, the smallest gap in motion and the pairs under the clearance, the
-measured walls (``thinnest_wall_mm``, ``thin_walls``: the ``wall_thickness`` goal), wall and
+measured walls (``thinnest_wall_mm``, ``thin_walls``, ``wall_detail``: the ``wall_thickness`` goal),
+the notes of the webs thinner than the minimum wall that the mesher carried and bridged
+(``web_notes``: the split test, and since session 37 the measured one), wall and
 CPU seconds, and ``commit`` (benchmarks/gitstate.py: HEAD, ``-dirty`` when mlc/ differs from it).
 
 **Outside check of the web at hinge c** (``section_web``, session 36): the hinge's owner
@@ -185,6 +187,8 @@ def main() -> int:
                        "thinnest_wall_mm": rep.check("wall_thickness").value,
                        "min_wall_mm": profile.min_wall,
                        "thin_walls": rep.check("wall_thickness").failures,
+                       "wall_detail": rep.check("wall_thickness").detail,
+                       "web_notes": [n for n in asm.notes if "thinner than the minimum wall" in n],
                        "section_web": section_webs(asm),
                        "export_s": round(wall, 2), "export_cpu_s": round(cpu, 2), "commit": commit()}
                 rows.append(row)

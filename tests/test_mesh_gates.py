@@ -221,3 +221,79 @@ def test_no_sheet_past_the_pivot_cut():
                     piv.rho - 0.05, 64)
     assert (out_hi ^ zone).volume() < 1e-6
     assert thin_walls("out_hi", out_hi, prof.min_wall) == []
+
+
+def _web_sections(asm, min_wall):
+    """The webs of the hinge owner at hinge c: every piece of a section normal to the axis in the
+    middle of the other bodies' knuckles, near the axis and not the pin, with the diameter of the
+    largest disc in it (Clipper2 offsets, 0.001 mm; as benchmarks/mesh_gates.py's section_webs)."""
+    (c,) = [ax for ax in asm.axes if len(ax.bodies) == 3]
+    E = np.asarray(c.direction, float)
+    from mlc.mesh.build import _perp_frame
+    R = _perp_frame(E).T
+    M = np.hstack([R, (-R @ np.asarray(c.origin, float))[:, None]])
+    local = asm.part(c.owner).solid.transform(M.tolist())
+    out = []
+    for bn, ivs in c.intervals.items():
+        if bn == c.owner:
+            continue
+        for a0, a1 in ivs:
+            for piece in local.slice(0.5 * (a0 + a1)).decompose():
+                x0, y0, x1, y1 = piece.bounds()
+                if x0 <= 0 <= x1 and y0 <= 0 <= y1:
+                    continue
+                if np.hypot(max(x0, 0, -x1), max(y0, 0, -y1)) > c.rho + 2 * min_wall:
+                    continue
+                lo, hi = 0.0, 2.0
+                while hi - lo > 5e-4:
+                    r = 0.5 * (lo + hi)
+                    lo, hi = (lo, r) if piece.offset(-r, mf.JoinType.Round).is_empty() else (r, hi)
+                out.append(2 * lo)
+    return out
+
+
+def test_a_web_that_is_not_the_only_link_is_measured_and_bridged():
+    """core_cd of the contracting AND at mjp (issue 13, session 37): between hinge c's trim (1.3 mm)
+    and the universal joint's (3.87 mm, 5.79 mm away) a web 0.593 mm across was left, against the
+    0.6 mm minimum.  It is not core_cd's only link (the cut grown by the minimum wall does not split
+    the body), so the split test missed it; the web is now measured on sections across the other
+    knuckles (mlc.mesh.build._web_thinner) and bridged like a severed one: every web at hinge c
+    measures the minimum wall.  Without the measured test the web stays 0.593 mm."""
+    import mlc.mesh.build as B
+    prof = load_profile("mjp")
+    scene, poses = gate_scene("AND", "contract"), gate_poses("AND", "contract")
+    asm = build_assembly(scene, prof, poses, resolve=False)
+    assert any("core_cd bridges" in n and "thinner than the minimum wall" in n for n in asm.notes), asm.notes
+    webs = _web_sections(asm, prof.min_wall)
+    assert webs and min(webs) >= prof.min_wall - 1e-3, webs
+    assert len(asm.part("core_cd").solid.decompose()) == 1
+    # the same build with the split test alone: the web is left, thinner than the wall
+    orig = B._web_thinner
+    B._web_thinner = lambda *a: False
+    try:
+        old = build_assembly(scene, prof, poses, resolve=False)
+    finally:
+        B._web_thinner = orig
+    assert not any("core_cd bridges" in n for n in old.notes)
+    assert min(_web_sections(old, prof.min_wall)) < prof.min_wall - 1e-3
+
+
+def test_web_thinner_measures_a_web_beside_another_link():
+    """The measured web test on a body built for it: a plate through an axis, cut around another
+    body's knuckle (radius 1 mm, over the middle of the stack) and by a second cylinder beside it,
+    which leaves a web 0.55 mm across; the plate above and below the cuts still joins the web to the
+    rest (one piece: the split test sees nothing), yet the web is under 0.6 mm.  0.65 mm passes."""
+    from types import SimpleNamespace
+    from mlc.mesh.build import _web_thinner, cylinder
+    d = np.array([0.0, 0.0, 1.0])
+    ax = SimpleNamespace(origin=np.zeros(3), direction=d, rho=1.0, span=3.0,
+                         intervals={"A": [(-1.5, -0.9), (0.9, 1.5)], "B": [(-0.7, 0.7)]})
+    for web, thin in ((0.55, True), (0.65, False)):
+        plate = mf.Manifold.cube([8.0, 0.6, 3.0], True).translate([4.0, 0.0, 0.0])
+        body = plate + mf.Manifold.cube([0.6, 4.0, 3.0], True).translate([7.7, 2.0, 0.0]) \
+            + mf.Manifold.cube([8.0, 0.6, 3.0], True).translate([4.0, 4.0, 0.0])
+        # the knuckle trim, and a second cylinder parallel to it whose near side is `web` further out
+        cut = body - cylinder(ax.origin, d, -0.9, 0.9, 1.0, 64, cutter=True) \
+            - cylinder([1.0 + web + 2.0, 0, 0], d, -0.9, 0.9, 2.0, 64, cutter=True)
+        assert len(cut.decompose()) == 1          # one piece: the web is not the only link
+        assert _web_thinner(cut, ax, "A", 0.6) == thin, web

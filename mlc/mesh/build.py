@@ -741,10 +741,16 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         # mechanism of its own (not reuse), also where that clearance and another trim leave
         # only a web thinner than the minimum wall (the cut grown by the minimum wall severs it:
         # core_cd between hinge c and its universal joint, 0.22 mm at mjp, issue 13)
+        # The split alone misses a web that is not the body's only link (issue 13, session 37:
+        # core_cd of the expanding OR at mjp, a 0.547 mm web between hinge c's trim and the
+        # joint's, the body held on by its other slabs as well): the web is also measured, on
+        # sections of the cut body across the other knuckles (:func:`_web_thinner`)
         def thin_at(ax):
-            return len(_clean(subtract(
-                solid, [x for a in my_axes for x in axis_cuts(a, prof.min_wall if a is ax else 0.0)]
-                + other_cuts)).decompose()) > cut_n
+            if len(_clean(subtract(
+                    solid, [x for a in my_axes for x in axis_cuts(a, prof.min_wall if a is ax else 0.0)]
+                    + other_cuts)).decompose()) > cut_n:
+                return True
+            return _web_thinner(_clean(subtract(solid, cuts)), ax, bn, prof.min_wall)
         need = {}
         for ax in my_axes:
             if cut_n > base_n and len(_clean(subtract(solid, axis_cuts(ax))).decompose()) > base_n:
@@ -1870,6 +1876,47 @@ def _bridge(ax: HingeAxis, bn, a0, a1, samples, state_T, t, prof, avoid=(), clea
     Rm = np.column_stack([ax.direction, e, np.cross(ax.direction, e)])
     center = ax.origin + ax.direction * 0.5 * (a0 + a1) + e * reach / 2
     return box(center, Rm, [a1 - a0 + 2 * w, reach, t]), float(score[k])
+
+
+#: mm: a web is thinner than the minimum wall when the largest disc in its section is more
+#: than this under it (the polygons' own rounding: a slab exactly the minimum wall thick passes)
+WEB_TOL = 1e-3
+
+
+def _web_thinner(cut: mf.Manifold, ax: HingeAxis, bn: str, min_wall: float) -> bool:
+    """Whether the body ``bn``, cut around the other bodies' knuckles on ``ax`` (``cut``: the
+    body's solid after its trims), keeps a web there thinner than ``min_wall``, measured.
+
+    The body is cut by planes normal to the axis in the middle of each stretch of the stack
+    between two of its own knuckles (where the other bodies' knuckles are and a bridge can go);
+    every piece of such a section that comes within the trim radius + the minimum wall of the
+    axis is a web next to the trim, and it is thinner than the wall when no disc of diameter
+    ``min_wall - WEB_TOL`` fits in it (Clipper2's inward offset of the polygon leaves nothing).
+    Unlike the split (the cut grown by the minimum wall severs the body), this finds a web that
+    is not the body's only link: core_cd of the expanding OR at mjp, 0.547 mm between hinge c's
+    trim and the universal joint's, held on by its other slabs too (issue 13, session 37)."""
+    if cut.is_empty():
+        return False
+    own = ax.intervals[bn]
+    E = _perp_frame(ax.direction)
+    Rm = E.T                                    # world -> (e1, e2, axis)
+    M = np.hstack([Rm, (-Rm @ np.asarray(ax.origin, float))[:, None]])
+    local = None
+    near = ax.rho / np.cos(np.pi / 8) + min_wall
+    for a0, a1 in _complement(own, -ax.span / 2, ax.span / 2):
+        if not (any(o1 <= a0 + 1e-9 for _, o1 in own) and any(o0 >= a1 - 1e-9 for o0, _ in own)):
+            continue
+        if local is None:
+            local = cut.transform(M.tolist())
+        for piece in local.slice(0.5 * (a0 + a1)).decompose():
+            x0, y0, x1, y1 = piece.bounds()
+            # the nearest point of the piece's box to the axis
+            dx, dy = max(x0, 0.0, -x1), max(y0, 0.0, -y1)
+            if np.hypot(dx, dy) > near or piece.area() < 1e-9:
+                continue
+            if piece.offset(-(0.5 * min_wall - 0.5 * WEB_TOL), mf.JoinType.Round).is_empty():
+                return True
+    return False
 
 
 def _ext(intervals, span, t, beyond=None, min_wall=0.0):
