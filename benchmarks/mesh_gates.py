@@ -22,6 +22,9 @@ piece of the section near the axis other than the pin measured by the largest di
 in it (manifold3d's slice and Clipper2 polygon offsets, not the voxel grid of
 ``mlc.mesh.walls``): ``web_mm``, the thinnest.
 
+``axis_webs`` (session 37): the same measurement at every hinge axis, for every body with
+knuckles on both sides of another body's (where the mesher's measured web test looks).
+
 **Outside check** (when ``python-fcl`` is installed, ``pip install python-fcl``; not an mlc
 dependency): the Flexible Collision Library's mesh-mesh distance (its own BVH and
 triangle-triangle distance, not manifold3d's ``min_gap``) between every two parts whose posed
@@ -100,6 +103,42 @@ def section_webs(asm) -> dict:
                 w = _inscribed(piece)
                 out["webs"] += 1
                 out["web_mm"] = w if out["web_mm"] is None else min(out["web_mm"], w)
+    if out["web_mm"] is not None:
+        out["web_mm"] = round(out["web_mm"], 4)
+    return out
+
+
+def axis_webs(asm) -> dict:
+    """The same outside measurement as :func:`section_webs` at every hinge axis and for every body
+    with knuckles on both sides of another body's (session 37: where the mesher's web test looks):
+    the body cut by a plane normal to the axis in the middle of each such stretch, every piece
+    near the axis but the pin measured by the largest disc in it.  ``{"web_mm": thinnest or None,
+    "at": "axis/body", "webs": count}``."""
+    out = {"web_mm": None, "at": None, "webs": 0}
+    for ax in asm.axes:
+        d = np.asarray(ax.direction, float)
+        e1 = np.cross(d, [1.0, 0, 0] if abs(d[0]) < 0.9 else [0, 1.0, 0])
+        e1 /= np.linalg.norm(e1)
+        R = np.vstack([e1, np.cross(d, e1), d])
+        M = np.hstack([R, (-R @ np.asarray(ax.origin, float))[:, None]])
+        for bn in ax.bodies:
+            own = sorted(ax.intervals[bn])
+            local = None
+            for (_, a0), (a1, _) in zip(own, own[1:]):
+                if a1 - a0 < 1e-9:
+                    continue
+                if local is None:
+                    local = asm.part(bn).solid.transform(M.tolist())
+                for piece in local.slice(0.5 * (a0 + a1)).decompose():
+                    (x0, y0), (x1, y1) = piece.bounds()[:2], piece.bounds()[2:]
+                    if x0 <= 0 <= x1 and y0 <= 0 <= y1:      # the pin through the axis
+                        continue
+                    if np.hypot(max(x0, 0, -x1), max(y0, 0, -y1)) > ax.rho + 2 * asm.profile.min_wall:
+                        continue
+                    w = _inscribed(piece)
+                    out["webs"] += 1
+                    if out["web_mm"] is None or w < out["web_mm"]:
+                        out["web_mm"], out["at"] = w, f"{ax.name}/{bn}"
     if out["web_mm"] is not None:
         out["web_mm"] = round(out["web_mm"], 4)
     return out
@@ -190,6 +229,7 @@ def main() -> int:
                        "wall_detail": rep.check("wall_thickness").detail,
                        "web_notes": [n for n in asm.notes if "thinner than the minimum wall" in n],
                        "section_web": section_webs(asm),
+                       "axis_webs": axis_webs(asm),
                        "export_s": round(wall, 2), "export_cpu_s": round(cpu, 2), "commit": commit()}
                 rows.append(row)
                 print(json.dumps(row), flush=True)
