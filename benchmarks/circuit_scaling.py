@@ -83,7 +83,7 @@ def save_scene(sc, path: Path) -> str:
 
 
 def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: float | None = None,
-                save_to: Path | None = None, jobs: int = 1) -> dict:
+                save_to: Path | None = None, jobs: int = 1, router: str = "ik") -> dict:
     """One circuit of the series: the ``w``-bit ripple-carry adder, or (``family`` "multiplier")
     the ``w`` x ``w`` array multiplier (2w inputs: 6 bits are 222 gates on 12 inputs), or
     (``family`` "mesh") ``nand_mesh(MESH_WIDTH, w)``, compiled at -O0 (depth 29: 203 gates).  The
@@ -97,7 +97,8 @@ def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: flo
     steps of the minimiser) and recorded as ``verify_stopped_after_s``, ``verify_row_s`` None.
     ``save_to`` (a folder): the scene is written there before the check (:func:`scene_path`;
     ``scene_sha`` in the point), so that a check stopped at its budget can be run again
-    without the build (``--check-saved``)."""
+    without the build (``--check-saved``).  ``router``: the chains' solver
+    (``CircuitOptions.router``; "ik" for the series committed before the fast router)."""
     if family == "mesh":            # structure kept: -O2 would merge what repeats
         spec, level = nand_mesh(MESH_WIDTH, w), 0
     else:
@@ -108,7 +109,8 @@ def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: flo
     load0 = os.getloadavg()[0]
     t0, c0 = time.perf_counter(), time.process_time()
     try:
-        circ = build_circuit(c.netlist, spec, CircuitOptions(max_gates=len(c.netlist.gates), jobs=jobs))
+        circ = build_circuit(c.netlist, spec, CircuitOptions(max_gates=len(c.netlist.gates), jobs=jobs,
+                                                             router=router))
     except MlcError as e:
         if family == "adder":
             raise
@@ -119,6 +121,7 @@ def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: flo
     row = "1" * len(sc.inputs)
     point = {"family": family, "width": w, "gates": len(c.netlist.gates), "bodies": len(sc.bodies), "chains": circ.chains,
             "half_units": circ.half_units, "build_s": t_build, "build_cpu_s": c_build, "load": load0, "jobs": jobs,
+            "router": router,
             "route_solves": route.CACHE_HITS[1] - hits0[1], "route_repeats": route.CACHE_HITS[0] - hits0[0],
             "tight_chains": sc.meta["connector"]["tight_chains"], "build_parts_s": circ.seconds,
             "state_contacts": sc.meta["connector"].get("state_contacts", []),
@@ -297,7 +300,9 @@ def refit(res: dict) -> dict:
 PNG = OUT / "circuit_scaling.png"
 
 
-def plot(res: dict) -> None:
+def plot(res: dict, png: Path = PNG, compare: dict | None = None) -> None:
+    """Bodies against gates, and build and one row's check time against bodies; with
+    ``compare`` (another series' results, the ik router's), its build times in grey."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -318,6 +323,10 @@ def plot(res: dict) -> None:
         for p in pts:
             if p.get("verify_stopped_after_s"):      # a lower bound: stopped, not finished
                 ax[1].plot([p["bodies"]], [p["verify_stopped_after_s"]], "^", color=col, mfc="none")
+        old = [p for p in (compare or {}).get(key, []) if "bodies" in p]
+        if old:
+            ax[1].loglog([p["bodies"] for p in old], [p["build_s"] for p in old], "o-", color="0.6", alpha=0.7,
+                         label=f"{fam}: build, wall, ik router")
     ax[0].set_xlabel("gates")
     ax[0].set_ylabel("bodies in the scene")
     ax[0].legend(fontsize=8)
@@ -332,7 +341,7 @@ def plot(res: dict) -> None:
         a.yaxis.set_minor_formatter(NullFormatter())
     ax[1].legend(fontsize=7)
     fig.tight_layout()
-    fig.savefig(PNG, dpi=110)
+    fig.savefig(png, dpi=110)
 
 
 def main():
@@ -364,9 +373,14 @@ def main():
                     help="only the full adder's per-scheme dynamic cost, into the committed JSON")
     ap.add_argument("--refit", action="store_true",
                     help="recompute fit, goals and extrapolation from the committed JSON's points; run nothing")
+    ap.add_argument("--router", choices=("ik", "fast"), default="ik",
+                    help="the chains' solver (CircuitOptions.router); with fast, write --json "
+                         "circuit_scaling_fast.json (its plot beside it, the ik series' builds in grey)")
     ap.add_argument("--json", type=Path, default=OUT / "circuit_scaling.json",
                     help="results file read and written (another name lets two series run at once)")
     args = ap.parse_args()
+    if args.router == "fast" and args.json == OUT / "circuit_scaling.json":     # never over the ik series
+        args.json = OUT / "circuit_scaling_fast.json"
     if args.save_scenes is not None:              # before the build: an hour's build lost to a missing folder
         args.save_scenes.mkdir(parents=True, exist_ok=True)
     path = args.json
@@ -379,6 +393,9 @@ def main():
             tmp.write_text(json.dumps(res, indent=1))
         if path == OUT / "circuit_scaling.json":
             plot(res)
+        elif args.router == "fast":
+            ik = OUT / "circuit_scaling.json"
+            plot(res, path.with_suffix(".png"), json.loads(ik.read_text()) if ik.exists() else None)
         print(json.dumps({k: res.get(k) for k in ("fit", "fit_multipliers", "goals", "extrapolated_200_gates")},
                          indent=1), flush=True)
 
@@ -401,7 +418,7 @@ def main():
                 p = checked_saved(pts.get(w), args.check_saved, fam, w, args.verify_budget)
             else:                                        # a refusal: its reason
                 p = adder_point(w, fam, on_built=built, verify_budget=args.verify_budget, save_to=args.save_scenes,
-                                jobs=args.jobs)
+                                jobs=args.jobs, router=args.router)
             pts[w] = p
             print(json.dumps({k: (round(v, 3) if isinstance(v, float) else v) for k, v in p.items()
                               if k != "build_parts_s"}), flush=True)
@@ -413,7 +430,7 @@ def main():
     points = []
     t_all = time.perf_counter()
     for w in widths:
-        p = adder_point(w, jobs=args.jobs)
+        p = adder_point(w, jobs=args.jobs, router=args.router)
         points.append(p)
         print(json.dumps({k: (round(v, 3) if isinstance(v, float) else v) for k, v in p.items()
                           if k != "build_parts_s"}), flush=True)

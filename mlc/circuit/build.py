@@ -56,6 +56,21 @@ MAX_BUILD_CPU = 3600.0           # s: about 130 gates
 MAX_GATES = int(BUILD_CPU_REF[0] * (MAX_BUILD_CPU / BUILD_CPU_REF[1]) ** (1 / BUILD_CPU_EXPONENT))
 
 
+FAST_FROM = 17                  # gates: "auto" routes circuits of this many gates or more with the fast
+                                # method (every example has at most 14: their scenes, and the dynamic
+                                # campaigns keyed by them, stay those of the "ik" router)
+ROUTERS = ("auto", "ik", "fast")
+
+
+def router_of(opt, gates: int) -> str:
+    """The routing method (``"ik"`` or ``"fast"``) that ``opt.router`` picks for ``gates`` gates."""
+    if opt.router not in ROUTERS:
+        raise ValueError(f"router {opt.router!r} is not one of {ROUTERS}")
+    if opt.router == "auto":
+        return "fast" if gates >= FAST_FROM else "ik"
+    return opt.router
+
+
 def build_cpu_estimate(gates: int) -> float:
     """CPU seconds to place and route a netlist of ``gates`` gates (an order of magnitude: the fit of
     three adders, ``benchmarks/circuit_scaling.py --refit``)."""
@@ -112,6 +127,8 @@ class CircuitOptions:
     max_gates: int | None = None     # refuse larger netlists before the work (None: MAX_GATES)
     jobs: int = 1                    # processes that route: each chain's first solve is started ahead
                                      # (route.Prefetch); the scene is the same, bit for bit, for any jobs
+    router: str = "auto"             # "ik": every chain solved whole (mlc.circuit.route); "fast": steered and
+                                     # closed at its end; "auto": "fast" above FAST_FROM gates, else "ik"
 
 
 @dataclass
@@ -339,6 +356,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                        netlist.source,
                        f"compile with --no-circuit for the netlist alone, split the design, or lift the limit "
                        f"with --max-gates {n}")
+    method = router_of(opt, len(netlist.gates))
     if len(netlist.inputs) > MAX_INPUTS:
         raise MlcError(f"netlist has {len(netlist.inputs)} inputs; a circuit scene lists every row of its truth "
                        f"table and holds at most {MAX_INPUTS}", netlist.source,
@@ -602,6 +620,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             route_kw = dict(tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
                             start_bend_max=sbm, extras=LANE_EXTRAS, bend_max=LANE_BEND * max_bend(geo),
                             end_bends=(END_JUNCTIONS, END_BEND * max_bend(geo)), wp_weight=WAYPOINT_WEIGHT)
+            if method == "fast":            # only then: an "ik" solve keeps its cache key (and its scene)
+                route_kw["method"] = "fast"
             ch = _Chain(tag, lane, yp, (start.centre, start.axis, target.centre, target.axis, geo, spol), route_kw,
                         dict(tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
                              start_bend_max=sbm),
@@ -665,6 +685,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                         "connector": {"gap": geo.gap, "side": round(geo.side, 6), "joint_k": geo.k, "chains": n_chains,
                                       "half_units": n_half, "planes": 1 + max((k for k, _ in lanes.placed), default=-1),
                                       "tight_chains": [t for t, _ in tight]}})
+    if method == "fast":            # (not written for "ik": the examples' scenes stay as they were)
+        scene.meta["connector"]["router"] = method
     if rip_ups:
         scene.meta["connector"]["rerouted"] = [list(p) for p in rip_ups]
     if contact_rips:

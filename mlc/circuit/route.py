@@ -116,6 +116,62 @@ def _steer(c0, u0, t0, guide, pitch, bmax, free_start, max_half):
     return bends
 
 
+@njit(cache=True)
+def _steer_kernel(c0, u0, t0, guide, seg, pitch, bmax, lim0, m, eb, max_half, out):
+    """:func:`_steer` for the fast method, compiled: the bound of junction i is ``lim0``
+    for i = 0, ``eb`` for 1 <= i <= m, ``bmax`` after.  Writes the bends into ``out``
+    and returns their count."""
+    c = c0.copy()
+    u = u0.copy()
+    t = t0.copy()
+    G = guide.shape[0]
+    end = guide[G - 1]
+    total = seg[G - 1]
+    count = 0
+    for i in range(max_half):
+        j = 0
+        best = np.inf
+        for q in range(G):
+            dd = (guide[q, 0] - c[0]) ** 2 + (guide[q, 1] - c[1]) ** 2 + (guide[q, 2] - c[2]) ** 2
+            if dd < best:
+                best, j = dd, q
+        k = np.searchsorted(seg, seg[j] + 2.0 * pitch)
+        if k > G - 1:
+            k = G - 1
+        d = guide[k] - c
+        du = d[0] * u[0] + d[1] * u[1] + d[2] * u[2]
+        dp = d - du * u
+        ndp = math.sqrt(dp[0] ** 2 + dp[1] ** 2 + dp[2] ** 2)
+        lim = lim0 if i == 0 else (eb if i <= m else bmax)
+        b = 0.0
+        if ndp > 1e-9 and lim > 0:
+            dp = dp / ndp
+            cx = t[1] * dp[2] - t[2] * dp[1]
+            cy = t[2] * dp[0] - t[0] * dp[2]
+            cz = t[0] * dp[1] - t[1] * dp[0]
+            ang = math.atan2(cx * u[0] + cy * u[1] + cz * u[2], t[0] * dp[0] + t[1] * dp[1] + t[2] * dp[2])
+            b = max(-lim, min(lim, ang))
+        cb, sb = math.cos(b), math.sin(b)
+        kx = u[1] * t[2] - u[2] * t[1]
+        ky = u[2] * t[0] - u[0] * t[2]
+        kz = u[0] * t[1] - u[1] * t[0]
+        kd = u[0] * t[0] + u[1] * t[1] + u[2] * t[2]
+        t = np.array([t[0] * cb + kx * sb + u[0] * kd * (1.0 - cb), t[1] * cb + ky * sb + u[1] * kd * (1.0 - cb),
+                      t[2] * cb + kz * sb + u[2] * kd * (1.0 - cb)])
+        out[count] = b
+        count += 1
+        c = c + pitch * t
+        u = np.array([t[1] * u[2] - t[2] * u[1], t[2] * u[0] - t[0] * u[2], t[0] * u[1] - t[1] * u[0]])
+        de = math.sqrt((end[0] - c[0]) ** 2 + (end[1] - c[1]) ** 2 + (end[2] - c[2]) ** 2)
+        if de < 0.75 * pitch and seg[j] > total - 3.0 * pitch:
+            break
+        if seg[j] >= total - 1e-9 and de < 3.0 * pitch:
+            break
+        if i * pitch > 2.0 * total + 20.0 * pitch:
+            break
+    return count
+
+
 _BLAS = None                # [(set, get)] of the OpenBLAS libraries loaded (see blas_single_thread)
 
 
@@ -324,7 +380,8 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
                 min_half: int = 2, max_half: int = MAX_HALF, bend_max: float | None = None,
                 last_pitch: float | None = None, start_bend_max: float = math.radians(50.0),
                 extras=(0, 2, 4, 8, 12, 16, 24), end_bends: tuple[int, float] | None = None,
-                 wp_weight: float = 0.3, avoid=(), avoid_from: int = 0, polish: bool = True) -> Route | None:
+                 wp_weight: float = 0.3, avoid=(), avoid_from: int = 0, polish: bool = True,
+                 method: str = "ik") -> Route | None:
     """A chain from pair (c0, u0) to pair (target_c, +-target_a) with ``n % 2 == parity``
     half units; None when no chain closes.
 
@@ -345,7 +402,10 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
     scaled like the waypoints: the closing passes keep the shape but do not enforce it).
     ``polish``: when no length closes, the lengths whose passes ended within ``POLISH_FROM``
     of closing (approach kept) are closed by :func:`_polish`, shortest first; a route that
-    closes without it is the same with or without it."""
+    closes without it is the same with or without it.
+    ``method``: "ik", the whole chain solved by scipy's trust region as above; or "fast"
+    (:func:`_solve_fast`): the steered chain closed by moving mostly its last bends, with
+    the trust region as the fallback where that does not close and for ``avoid``."""
     c0, u0 = np.asarray(c0, float), np.asarray(u0, float) / np.linalg.norm(u0)
     P, a = np.asarray(target_c, float), np.asarray(target_a, float) / np.linalg.norm(target_a)
     e1, e2 = _perp_basis(a)
@@ -357,6 +417,12 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
     t0 = _project_perp(tangent, u0)
     app = None if approach is None else np.asarray(approach, float) / np.linalg.norm(approach)
     guide = _guide(c0, t0, waypoints, P, app)
+    if method == "fast" and not len(avoid):
+        r = _solve_fast(c0, u0, t0, P, e1, e2, app, guide, waypoints, geo, parity, bmax,
+                        free_start and start_bend_max, min_half, max_half, last_pitch, extras, end_bends,
+                        wp_weight)
+        if r is not None:
+            return r
     guess = _steer(c0, u0, t0, guide, geo.pitch, bmax, free_start and start_bend_max, max_half)
     near = []                   # (n, pitches, route) of the lengths that nearly closed
     for extra in extras:
@@ -393,6 +459,128 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
         if err < EXACT and aerr < 0.5:
             return Route(c0, u0, t0, [float(v) for v in x], err, aerr)
     return None
+
+
+def _solve_fast(c0, u0, t0, P, e1, e2, app, guide, waypoints, geo, parity, bmax, start_lim, min_half,
+                max_half, last_pitch, extras, end_bends, wp_weight) -> Route | None:
+    """The ``fast`` method: the chain steered along ``guide`` (every bend within its bound),
+    then closed by :func:`_lm_close`, whose bend changes fall off as exp(-d / FAST_TAIL)
+    with the distance d (half units) from the chain's end, in two passes: the last pair
+    towards the target with the approach and the waypoints of the last ``FAST_HOLD`` half
+    units holding the shape, then the closure alone, exactly.  Each pass solves a system
+    of the equations' size (5 to ~70), not of the chain's, so a solve costs about as much
+    for 400 half units as for 40.  The lengths tried: the steered one less 2 half units
+    (the steering stops within a pitch past the target), then ``extras`` beyond it.  None
+    when no length closes."""
+    m, eb = end_bends if end_bends is not None else (0, bmax)
+    lim0 = float(start_lim) if start_lim else 0.0
+
+    guide = np.ascontiguousarray(guide, dtype=np.float64)
+    seg = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(guide, axis=0), axis=1))])
+    buf = np.empty(max_half)
+    k = _steer_kernel(np.asarray(c0, float), np.asarray(u0, float), np.asarray(t0, float), guide, seg,
+                      float(geo.pitch), float(bmax), lim0, int(m), float(eb), int(max_half), buf)
+    guess = [float(v) for v in buf[:k]]
+    tried = set()
+    for extra in (-2,) + tuple(extras):
+        n = max(min_half, len(guess) + extra)
+        if n % 2 != parity:
+            n += 1
+        if n in tried:
+            continue
+        tried.add(n)
+        x0 = np.nan_to_num(np.array((guess + [0.0] * n)[:n]))
+        pitches = np.full(n, geo.pitch)
+        if last_pitch is not None:
+            pitches[-1] = last_pitch
+        lo, hi = _bounds(n, bmax, start_lim, end_bends)
+        x0 = np.clip(x0, lo, hi)
+        scale = np.exp(-(n - 1 - np.arange(n)) / FAST_TAIL)
+        cs, _, _ = _fk(c0, u0, t0, x0, pitches)
+        wps = []
+        for w in waypoints:
+            w = np.asarray(w, float)
+            k = max(1, min(n - 1, int(np.argmin(np.linalg.norm(cs - w, axis=1)))))
+            if k >= n - FAST_HOLD:
+                wps.append((k, w))
+        x = _lm_close(x0, lo, hi, c0, u0, t0, pitches, P, e1, e2, app, scale, wps, 1.0, wp_weight)
+        cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
+        for widen in (1.0, 3.0):        # a closure stalled on bends at their bounds: let more bends move
+            x = _lm_close(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, None, scale ** (1.0 / widen), (), 0.0)
+            _fk_kernel(c0, u0, t0, x, pitches, cs, us, ts, True)
+            err = float(max(np.linalg.norm(cs[-1] - P), abs(us[-1] @ e1), abs(us[-1] @ e2)))
+            if err < EXACT:
+                break
+        aerr = 0.0 if app is None else float(np.linalg.norm(ts[-1] - app))
+        if DEBUG:
+            print("fast", n, "error", err, "approach", aerr)
+        if err < EXACT and aerr < 0.5:
+            return Route(c0, u0, t0, [float(v) for v in x], err, aerr)
+    return None
+
+
+FAST_TAIL = 20.0            # half units: the fast method's bend changes fall off as exp(-d / FAST_TAIL) from the end
+FAST_HOLD = 40              # half units: the waypoints this near the end hold the shape while it closes
+CLOSE_STEPS = 40            # iterations of a pass of _lm_close at most
+
+
+def _lm_close(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, app, scale=None, wps=(), w_soft=1.0,
+                  wp_weight=1.0) -> np.ndarray:
+    """Levenberg-Marquardt on a few equations, in their row space: the closure (the last
+    pair's position and axis, weight 10), with ``w_soft`` > 0 the approach (the last
+    tangent, weight 2 w_soft) and the waypoints ``wps`` ((index, point), weight
+    w_soft wp_weight), inside the bounds: each step is the smallest in the metric
+    ``scale`` x the room towards the bound the descent heads for (Coleman and Li), then
+    projected onto the bounds.  Returns the bends (rad)."""
+    n = x.shape[0]
+    cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
+    has_app = app is not None and w_soft > 0
+    app_v = np.zeros(3) if app is None else np.asarray(app, float)
+    wps = [(k, p) for k, p in wps if 0 < k <= n] if w_soft > 0 else []
+    wp_k = np.array([k for k, _ in wps], dtype=np.int64)
+    wp_p = np.array([p for _, p in wps], dtype=float).reshape(-1, 3)
+    rows = 5 + (3 if has_app else 0) + 3 * len(wp_k)
+    J = np.empty((rows + (n - 1), n))
+    out = np.empty(rows + (n - 1))
+    sc = np.ones(n) if scale is None else np.asarray(scale, float)
+    half = np.maximum(0.5 * (hi - lo), 1e-12)
+
+    def resid(b):
+        _fk_kernel(c0, u0, t0, b, pitches, cs, us, ts, True)
+        _resid_kernel(cs, us, ts, b, P, e1, e2, has_app, app_v, wp_k, wp_p, w_soft, wp_weight, out)
+        return out[:rows].copy()
+
+    x = np.clip(np.ascontiguousarray(x, dtype=np.float64), lo, hi)
+    r = resid(x)
+    f = float(r @ r)
+    mu = 1e-6
+    for _ in range(CLOSE_STEPS):
+        if rows == 5 and max(abs(r)) < 10.0 * EXACT * CLOSE_MARGIN:
+            break
+        _jac_kernel(cs, us, ts, e1, e2, has_app, wp_k, w_soft, wp_weight, J)
+        g = J[:rows].T @ r                  # Coleman-Li: room towards the bound the descent heads for
+        room = np.sqrt(np.clip(np.where(g < 0, hi - x, x - lo), 0.0, None) / half)
+        D = sc * room
+        A = J[:rows] * D
+        M = A @ A.T
+        tr = float(np.trace(M)) / rows
+        while True:
+            z = np.linalg.solve(M + mu * tr * np.eye(rows), -r)
+            step = D * (A.T @ z)
+            x_new = np.clip(x + step, lo, hi)          # projected onto the bounds
+            r_new = resid(x_new)
+            f_new = float(r_new @ r_new)
+            if f_new < f:
+                mu = max(mu / 4.0, 1e-9)
+                break
+            mu *= 8.0
+            if mu > 1e6:
+                return x
+        if rows > 5 and f - f_new < 1e-6 * f:
+            x = x_new
+            break
+        x, r, f = x_new, r_new, f_new
+    return x
 
 
 def _bounds(n: int, bmax: float, free_start, end_bends) -> tuple[np.ndarray, np.ndarray]:
@@ -543,8 +731,8 @@ def _fk(c0, u0, t0, b, pitch):
 
 
 def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=(), end_bends=None,
-             wp_weight=0.3, avoid=(), avoid_from=0) -> Route:
-    lo, hi = _bounds(n, bmax, free_start, end_bends)
+             wp_weight=0.3, avoid=(), avoid_from=0, bounds=None) -> Route:
+    lo, hi = _bounds(n, bmax, free_start, end_bends) if bounds is None else bounds
 
     wp_k = np.array([k for k, _ in wps], dtype=np.int64)
     wp_p = np.array([p for _, p in wps], dtype=float).reshape(-1, 3)

@@ -80,6 +80,10 @@ def register(sub):
     p.add_argument("--max-gates", dest="max_gates", type=int, default=None, metavar="N",
                    help="build circuits of up to N gates (default: about an hour of place-and-route CPU by the "
                         "adders' fit; docs/circuits.md)")
+    p.add_argument("--router", choices=("auto", "ik", "fast"), default="auto",
+                   help="how connector chains are solved: ik (each chain whole, by inverse kinematics), fast "
+                        "(steered along its lane, closed at its end; docs/circuits.md, 'The fast router'), auto "
+                        "(default: fast from 17 gates on)")
     p.add_argument("--direct", action="store_true",
                    help="join a gate whose output feeds exactly one gate input by one full connector unit, "
                         "the sink placed on it (docs/circuits.md section 3, 'Direct connection')")
@@ -290,7 +294,7 @@ def run(args) -> int:
         from mlc.scene.io import dump_scene
         extra = {} if joint_k is None else {"joint_k": joint_k}
         opts = CircuitOptions(direct=bool(getattr(args, "direct", False)), max_gates=max_gates, jobs=args.jobs,
-                              **extra)
+                              router=getattr(args, "router", "auto"), **extra)
         with Progress("placing and routing", total=1) as bar:
             build(c, progress=lambda done, total: (setattr(bar, "total", total), bar.update(done)), options=opts)
         scene = c.circuit.scene
