@@ -67,3 +67,21 @@ def test_space_nearest_matches_brute_force():
     assert all(o != who for cell in sp.grid.values() for _, o in cell)
     assert sp.nearest(q, 2) > got and len(sp.points(2)) == 30 * 3
     assert np.allclose(layer_centres([[0, 0, 0], [0, 0, 1], [0, 0, 3]]), [[0, 0, 0.5], [0, 0, 2]])
+
+
+def test_the_bounding_box_shortcut_gives_the_measured_answer():
+    """``_near`` skips the measurement where the bounding boxes are ``sep`` apart: on
+    random polylines (many near the threshold) it answers as ``_poly_dist(a, b) < sep``."""
+    from mlc.circuit.lanes import _near, _poly_dist
+    rng = np.random.default_rng(7)
+    skipped = 0
+    for _ in range(3000):
+        a = rng.uniform(0, 10, (int(rng.integers(2, 5)), 2))
+        b = rng.uniform(0, 10, (int(rng.integers(2, 5)), 2)) + rng.uniform(-12, 12, 2)
+        sep = float(rng.uniform(0.5, 4.0))
+        d = _poly_dist(a, b)
+        if rng.random() < 0.2:
+            sep = d            # exactly at the threshold: not near
+        assert _near(a, b, sep) == (d < sep)
+        skipped += d >= sep
+    assert skipped > 500

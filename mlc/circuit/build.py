@@ -783,21 +783,25 @@ def _chain_parts(ch: _Chain, geo, flip: int = 0):
     return parts, pairs, lout
 
 
-def _state_contacts(routed: dict, geo, tags=None) -> list:
+def _state_contacts(routed: dict, geo, tags=None, cache: dict | None = None) -> list:
     """:func:`mlc.circuit.contact.state_contacts` of the routed chains (of those involving a
     chain of ``tags`` when given): every pair of layers of two chains within two bounding
-    radii plus ``CONTACT_MARGIN``, tested as rigid layers in every state of their wires."""
+    radii plus ``CONTACT_MARGIN``, tested as rigid layers in every state of their wires.
+    ``cache``: the layers' boxes of each chain and state, kept across calls while the chain
+    keeps the same route (the caller's: one build)."""
     from mlc.circuit.contact import candidate_pairs, layer_boxes, state_contacts
     centres = {t: ch.layers() for t, ch in routed.items() if ch.route is not None}
     pairs = candidate_pairs(centres, 2.0 * LAYER_RADIUS + CONTACT_MARGIN)
     if tags is not None:
         pairs = [p for p in pairs if p[0] in tags or p[2] in tags]
-    cache: dict = {}
+    cache = {} if cache is None else cache
 
     def boxes(tag, flip):
-        if (tag, flip) not in cache:
-            cache[(tag, flip)] = layer_boxes(_chain_parts(routed[tag], geo, flip)[0].bodies, tag)
-        return cache[(tag, flip)]
+        route = routed[tag].route
+        hit = cache.get((tag, flip))
+        if hit is None or hit[0] is not route:
+            hit = cache[(tag, flip)] = (route, layer_boxes(_chain_parts(routed[tag], geo, flip)[0].bodies, tag))
+        return hit[1]
     return state_contacts(pairs, boxes, {t: routed[t].ctx[0] for t in centres})
 
 
@@ -964,7 +968,8 @@ def _rip_up_contacts(routed: dict, lanes, space, space_clear: float, geo) -> tup
     chain in place, then the other one; the new routes are kept if the pair's smallest
     clearance (each chain against every chain, in every state) grew, else the old ones are
     put back.  Returns (the pairs re-routed, the contacts left, smallest first)."""
-    contacts = _state_contacts(routed, geo)
+    boxes: dict = {}
+    contacts = _state_contacts(routed, geo, cache=boxes)
     order = {t: k for k, t in enumerate(routed)}
     done, seen = [], set()
     for k in list(contacts):
@@ -974,7 +979,7 @@ def _rip_up_contacts(routed: dict, lanes, space, space_clear: float, geo) -> tup
             continue
         seen.add((k.a, k.b))
         tags = {k.a, k.b}
-        old_score = min(c.clearance for c in _state_contacts(routed, geo, tags))
+        old_score = min(c.clearance for c in _state_contacts(routed, geo, tags, boxes))
         if old_score >= CONTACT_MARGIN:          # an earlier re-route settled it
             continue
         pair = sorted((routed[k.a], routed[k.b]), key=lambda c: order[c.tag])
@@ -985,7 +990,7 @@ def _rip_up_contacts(routed: dict, lanes, space, space_clear: float, geo) -> tup
             if c.route is None:
                 break
         if all(c.route is not None for c in pair):
-            new_score = min((c.clearance for c in _state_contacts(routed, geo, tags)), default=math.inf)
+            new_score = min((c.clearance for c in _state_contacts(routed, geo, tags, boxes)), default=math.inf)
             if new_score > old_score:
                 for c in pair:
                     c.gap = c.gap_of(c.route)
@@ -997,7 +1002,7 @@ def _rip_up_contacts(routed: dict, lanes, space, space_clear: float, geo) -> tup
             lanes.take(c.lane, plane)
             space.add(c.layers(route), c.tag)
     if done:
-        contacts = _state_contacts(routed, geo)
+        contacts = _state_contacts(routed, geo, cache=boxes)
     return done, contacts
 
 

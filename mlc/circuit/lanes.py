@@ -84,6 +84,15 @@ def _poly_dist(a: np.ndarray, b: np.ndarray) -> float:
     return min(_seg_dist(a[i], a[i + 1], b[j], b[j + 1]) for i in range(len(a) - 1) for j in range(len(b) - 1))
 
 
+def _near(a: np.ndarray, b: np.ndarray, sep: float) -> bool:
+    """``_poly_dist(a, b) < sep``, without measuring where the polylines' bounding boxes
+    are ``sep`` or more apart along x or z (then so are the polylines)."""
+    if (a[:, 0].min() - b[:, 0].max() >= sep or b[:, 0].min() - a[:, 0].max() >= sep
+            or a[:, 1].min() - b[:, 1].max() >= sep or b[:, 1].min() - a[:, 1].max() >= sep):
+        return False
+    return _poly_dist(a, b) < sep
+
+
 class Lanes:
     """Planes taken so far and the lanes in them."""
 
@@ -97,10 +106,11 @@ class Lanes:
         n = 0
         for k2, other in self.placed:
             opoly, ocross = other.polyline(), other.crossings()
-            if ((k2 == k and _poly_dist(poly, opoly) < self.sep)
-                    or (k2 < k and min(_poly_dist(c, opoly) for c in cross) < self.sep)     # mine pass its plane
-                    or (k2 > k and min(_poly_dist(c, poly) for c in ocross) < self.sep)    # its pass mine
-                    or min(_poly_dist(c, oc) for c in cross for oc in ocross) < self.sep):
+            sep = self.sep
+            if ((k2 == k and _near(poly, opoly, sep))
+                    or (k2 < k and any(_near(c, opoly, sep) for c in cross))      # mine pass its plane
+                    or (k2 > k and any(_near(c, poly, sep) for c in ocross))     # its pass mine
+                    or any(_near(c, oc, sep) for c in cross for oc in ocross)):
                 n += 1
         return n
 
