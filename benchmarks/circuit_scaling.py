@@ -188,7 +188,10 @@ def fit_and_goals(points: list[dict]):
     static check against bodies, and of bodies against gates; the goals (None when no point
     has 200 gates); and, when no point reaches 200 gates, the power laws carried to 200
     gates (bodies, build CPU s, one row's check s, and each time over its goal).  A straight
-    line in log-log through a few small adders: an order of magnitude, not a prediction."""
+    line in log-log through a few small adders: an order of magnitude, not a prediction.
+    No points (a series that starts with another family): no fit, no goals."""
+    if not points:
+        return {}, {"build_200_gates_under_2s": None, "verify_row_200_gates_under_10s": None}, None
     g = np.array([p["gates"] for p in points], float)
     b = np.array([p["bodies"] for p in points], float)
     tb = np.array([p["build_s"] for p in points])
