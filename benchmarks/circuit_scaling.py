@@ -435,6 +435,9 @@ def main():
     for w in widths:
         p = adder_point(w, jobs=args.jobs, router=args.router)
         points.append(p)
+        if args.router == "fast":           # a long series keeps what it measured (the meshes kept)
+            save(dict(old, adders=list(points) if not args.widths else
+                      [q for q in old.get("adders", []) if q["width"] not in {x["width"] for x in points}] + points))
         print(json.dumps({k: (round(v, 3) if isinstance(v, float) else v) for k, v in p.items()
                           if k != "build_parts_s"}), flush=True)
         if time.perf_counter() - t_all > args.budget:

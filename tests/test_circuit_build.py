@@ -344,6 +344,30 @@ def test_build_time_estimate_follows_the_measured_circuits():
     assert cb.build_cpu_estimate(cb.MAX_GATES) <= cb.MAX_BUILD_CPU < cb.build_cpu_estimate(cb.MAX_GATES + 1)
 
 
+def test_the_fast_routers_estimate_follows_its_measured_circuits():
+    """The fast router's estimate against the committed build CPU of its series
+    (``circuit_scaling.py --router fast``: the points of circuit_scaling_fast.json and the
+    adders its log printed) from 10 gates on: within a factor 3 of each, and
+    MAX_FAST_GATES is where it reaches an hour."""
+    import json
+    from pathlib import Path
+
+    from mlc.circuit import build as cb
+    res = Path(__file__).resolve().parents[1] / "benchmarks" / "results"
+    d = json.loads((res / "circuit_scaling_fast.json").read_text())
+    pts = d.get("adders", []) + d.get("meshes", [])
+    pts += [json.loads(ln) for ln in (res / "circuit_scaling_fast_2026-12-02.log").read_text().splitlines()
+            if ln.startswith('{"family"')]
+    pts = [a for a in pts if a["gates"] >= 10 and "build_cpu_s" in a]
+    assert len(pts) >= 5 and max(a["gates"] for a in pts) >= 200
+    assert all(a["router"] == "fast" for a in pts)
+    for a in pts:
+        ratio = cb.build_cpu_estimate(a["gates"], "fast") / a["build_cpu_s"]
+        assert 1 / 3 < ratio < 3, (a["gates"], a["build_cpu_s"], ratio)
+    est = lambda g: cb.build_cpu_estimate(g, "fast")
+    assert est(cb.MAX_FAST_GATES) <= cb.MAX_BUILD_CPU < est(cb.MAX_FAST_GATES + 1)
+
+
 def test_a_netlist_too_large_to_build_is_refused_with_the_estimate(monkeypatch, tmp_path, capsys):
     """An 84-AND circuit (EPFL ctrl) routed for 45 min without a word; now refused before the work,
     naming the estimate, --no-circuit and the --max-gates that would build it, exit 2, nothing

@@ -785,6 +785,8 @@ def test_kernel_compile_notice_once(monkeypatch):
     (["compile", "-e", "y = a & b", "-o", "{d}/o", "--no-circuit", "--jobs", "2"],
      ["--jobs only applies to the circuit", "drop --no-circuit"]),
     (["compile", "-e", "y = a & b", "-o", "{d}/o", "--jobs", "0"], ["--jobs", "between 1 and 256"]),
+    (["compile", "-e", "y = a & b", "-o", "{d}/o", "--no-circuit", "--router", "fast"],
+     ["--router only applies to the circuit", "drop --no-circuit"]),
     (["gate", "NAND", "-o", "/dev/full"], ["-o", "/dev/full"]),
     # a step over 1e9 averaging windows made no step: the rest pose was reported as a wrong bit (exit 1)
     (["verify", "{scene}", "--dynamic", "--seeds", "1", "--dt", "1e308"], ["--dt", "longer than any run needs"]),

@@ -54,6 +54,12 @@ BUILD_CPU_REF = (45, 347.0)      # (gates, CPU s) of the fit at the 7-bit adder
 BUILD_CPU_EXPONENT = 2.18        # in gates
 MAX_BUILD_CPU = 3600.0           # s: about 130 gates
 MAX_GATES = int(BUILD_CPU_REF[0] * (MAX_BUILD_CPU / BUILD_CPU_REF[1]) ** (1 / BUILD_CPU_EXPONENT))
+# The fast router (session 37): build CPU ~ gates^1.07, the fit of the 2- to 6-bit adders
+# (benchmarks/results/circuit_scaling_fast_2026-12-02.log, 22 to 99 s for 10 to 38 gates) and
+# the 203-gate NAND mesh (circuit_scaling_fast.json, 411 s): every point within 0.7 to 1.5 of it.
+FAST_BUILD_CPU_REF = (203, 424.0)     # (gates, CPU s) of the fit at 203 gates
+FAST_BUILD_CPU_EXPONENT = 1.07        # in gates
+MAX_FAST_GATES = int(FAST_BUILD_CPU_REF[0] * (MAX_BUILD_CPU / FAST_BUILD_CPU_REF[1]) ** (1 / FAST_BUILD_CPU_EXPONENT))
 
 
 FAST_FROM = 17                  # gates: "auto" routes circuits of this many gates or more with the fast
@@ -71,10 +77,12 @@ def router_of(opt, gates: int) -> str:
     return opt.router
 
 
-def build_cpu_estimate(gates: int) -> float:
-    """CPU seconds to place and route a netlist of ``gates`` gates (an order of magnitude: the fit of
-    three adders, ``benchmarks/circuit_scaling.py --refit``)."""
-    return BUILD_CPU_REF[1] * (max(gates, 1) / BUILD_CPU_REF[0]) ** BUILD_CPU_EXPONENT
+def build_cpu_estimate(gates: int, method: str = "ik") -> float:
+    """CPU seconds to place and route a netlist of ``gates`` gates with the router ``method``
+    (an order of magnitude: "ik", the fit of three adders, ``benchmarks/circuit_scaling.py
+    --refit``; "fast", the fit of ``circuit_scaling_fast.json``)."""
+    ref, ex = (BUILD_CPU_REF, BUILD_CPU_EXPONENT) if method == "ik" else (FAST_BUILD_CPU_REF, FAST_BUILD_CPU_EXPONENT)
+    return ref[1] * (max(gates, 1) / ref[0]) ** ex
 MAX_INPUTS = 14             # the scene's truth table lists every row
 LEVEL_PITCH = 23.0          # sigma between logic levels (z), plus LAYER_PITCH per route arriving
 GATE_PITCH = 12.0           # sigma between gates of one level (x)
@@ -124,7 +132,8 @@ class CircuitOptions:
                                      # "Thermal spread": 100 k0 joints give 12 spreads of margin, not 1.8)
     direct: bool = False             # join a gate's single-sink net by one full unit (mlc.circuit.direct)
     direct_skip: tuple = ()          # ... except into these sinks (build_circuit fills it: see there)
-    max_gates: int | None = None     # refuse larger netlists before the work (None: MAX_GATES)
+    max_gates: int | None = None     # refuse larger netlists before the work (None: MAX_GATES, or
+                                     # MAX_FAST_GATES with the fast router)
     jobs: int = 1                    # processes that route: each chain's first solve is started ahead
                                      # (route.Prefetch); the scene is the same, bit for bit, for any jobs
     router: str = "auto"             # "ik": every chain solved whole (mlc.circuit.route); "fast": steered and
@@ -346,17 +355,19 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
 
     opt = options or CircuitOptions()
     t_start = time.perf_counter()
-    limit = MAX_GATES if opt.max_gates is None else opt.max_gates
+    method = router_of(opt, len(netlist.gates))
+    limit = (MAX_GATES if method == "ik" else MAX_FAST_GATES) if opt.max_gates is None else opt.max_gates
     if len(netlist.gates) > limit:
         n = len(netlist.gates)
-        est = build_cpu_estimate(n)
+        est = build_cpu_estimate(n, method)
+        fit = (f"the ripple-carry adders' fit, gates^{BUILD_CPU_EXPONENT:g}" if method == "ik" else
+               f"the fast router's fit, gates^{FAST_BUILD_CPU_EXPONENT:g}")
         raise MlcError(f"netlist has {n} gates; placing and routing it as one mechanism would take "
-                       f"about {est / 3600:.2g} h of CPU (the ripple-carry adders' fit, gates^{BUILD_CPU_EXPONENT:g}; "
+                       f"about {est / 3600:.2g} h of CPU ({fit}; "
                        f"short wires build faster); the circuit back end builds at most {limit} gates unless told",
                        netlist.source,
                        f"compile with --no-circuit for the netlist alone, split the design, or lift the limit "
                        f"with --max-gates {n}")
-    method = router_of(opt, len(netlist.gates))
     if len(netlist.inputs) > MAX_INPUTS:
         raise MlcError(f"netlist has {len(netlist.inputs)} inputs; a circuit scene lists every row of its truth "
                        f"table and holds at most {MAX_INPUTS}", netlist.source,
@@ -979,7 +990,8 @@ def _rip_up_contacts(routed: dict, lanes, space, space_clear: float, geo) -> tup
             continue
         seen.add((k.a, k.b))
         tags = {k.a, k.b}
-        old_score = min(c.clearance for c in _state_contacts(routed, geo, tags, boxes))
+        # (none left within reach: an earlier re-route moved them apart)
+        old_score = min((c.clearance for c in _state_contacts(routed, geo, tags, boxes)), default=math.inf)
         if old_score >= CONTACT_MARGIN:          # an earlier re-route settled it
             continue
         pair = sorted((routed[k.a], routed[k.b]), key=lambda c: order[c.tag])

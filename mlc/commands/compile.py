@@ -264,6 +264,8 @@ def run(args) -> int:
         if max_gates < 1:
             raise MlcError(f"--max-gates must be at least 1, got {max_gates}", "--max-gates",
                            "give the largest gate count to build, e.g. --max-gates 250")
+    if getattr(args, "router", "auto") != "auto" and not want_circuit:
+        raise MlcError("--router only applies to the circuit", "--no-circuit", "drop --no-circuit")
     if getattr(args, "direct", False) and not want_circuit:
         raise MlcError("--direct only applies to the circuit", "--no-circuit", "drop --no-circuit")
     if getattr(args, "robot", None):
