@@ -137,7 +137,7 @@ class CircuitOptions:
     jobs: int = 1                    # processes that route: each chain's first solve is started ahead
                                      # (route.Prefetch); the scene is the same, bit for bit, for any jobs
     router: str = "auto"             # "ik": every chain solved whole (mlc.circuit.route); "fast": steered and
-                                     # closed at its end; "auto": "fast" above FAST_FROM gates, else "ik"
+                                     # closed at its end; "auto": "fast" from FAST_FROM gates on, else "ik"
 
 
 @dataclass
