@@ -40,8 +40,8 @@ from mlc.pipeline import compile_spec
 OUT = Path(__file__).resolve().parent / "results"
 
 
-def record_solves(depth: int) -> list:
-    """The (args, kw) of every solve of the ik build of ``nand_mesh(7, depth)``."""
+def record_solves(depth: int, router: str = "ik") -> list:
+    """The (args, kw) of every solve of the ``router`` build of ``nand_mesh(7, depth)``."""
     spec = nand_mesh(7, depth)
     c = compile_spec(spec, 0)
     calls = []
@@ -52,7 +52,7 @@ def record_solves(depth: int) -> list:
         return real(args, kw)
     R._solve_plain, size, R.CACHE_SIZE = rec, R.CACHE_SIZE, 0
     try:
-        _build_circuit(c.netlist, spec, CircuitOptions(router="ik", max_gates=10_000))
+        _build_circuit(c.netlist, spec, CircuitOptions(router=router, max_gates=10_000))
     finally:
         R._solve_plain, R.CACHE_SIZE = real, size
     return calls

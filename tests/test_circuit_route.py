@@ -209,3 +209,43 @@ def test_the_fast_method_keeps_to_the_lane_as_the_whole_solve_does():
         cs, _, _ = R._fk(route.centre, route.axis, route.tangent, route.bends, geo.pitch)
         return float(np.sqrt(((cs[:, None, :] - dense[None]) ** 2).sum(-1)).min(axis=1).mean())
     assert far(fast) <= 1.5 * far(ik), (far(fast), far(ik))
+
+
+def test_the_fast_method_pushes_a_chain_away_from_what_it_avoids_and_still_closes():
+    """``method="fast"`` with ``avoid``: the route is pushed off a row of points laid 0.6
+    sigma beside the middle of the plain fast route (keep-away distance 1.5 sigma), so its
+    layers keep farther from them than the plain route's (which passes 0.6 away), and it
+    still closes on the target (by the exact rotations), within every bound, with no call
+    of the trust region."""
+    from mlc.gates.connector import chain_frames
+    args, kw = _long_args(0)
+    c0, u0, P, a, geo, _ = args
+    plain = R._solve_plain(args, dict(kw, method="fast"))
+    cs, _, _ = R._fk(plain.centre, plain.axis, plain.tangent, plain.bends, geo.pitch)
+    mid = 0.5 * (cs[1:] + cs[:-1])
+    k = len(mid) // 2
+    side = np.cross(cs[k + 1] - cs[k], [0.0, 1.0, 0.0])
+    side /= np.linalg.norm(side)
+    pts = mid[k - 6:k + 6] + 0.6 * side
+    avoid = ((pts, 1.5),)
+
+    def keep(route):
+        cs, _, _ = R._fk(route.centre, route.axis, route.tangent, route.bends, geo.pitch)
+        m = 0.5 * (cs[1:] + cs[:-1])[10:]
+        return float(np.sqrt(((m[:, None] - pts[None]) ** 2).sum(-1)).min()) - 1.5
+    called = []
+    real = R._solve_n
+    R._solve_n = lambda *x, **k: called.append(1) or real(*x, **k)
+    try:
+        r = R._solve_plain(args, dict(kw, method="fast", avoid=avoid, avoid_from=10))
+    finally:
+        R._solve_n = real
+    assert r is not None and not called
+    assert keep(plain) < -0.8 and keep(r) > keep(plain) + 0.5, (keep(plain), keep(r))
+    cs, us, ts = chain_frames(r.centre, r.axis, r.tangent, r.bends, geo.pitch)
+    assert np.linalg.norm(cs[-1] - P) < 10 * R.EXACT
+    assert abs(abs(float(us[-1] @ a)) - 1.0) < 1e-10
+    b = np.abs(np.array(r.bends))
+    m, eb = kw["end_bends"]
+    assert b.max() <= kw["bend_max"] + 1e-12 and b[0] <= kw["start_bend_max"] + 1e-12
+    assert b[1:1 + m].max() <= eb + 1e-12 and b[-m:].max() <= eb + 1e-12

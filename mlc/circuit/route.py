@@ -405,7 +405,8 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
     closes without it is the same with or without it.
     ``method``: "ik", the whole chain solved by scipy's trust region as above; or "fast"
     (:func:`_solve_fast`): the steered chain closed by moving mostly its last bends, with
-    the trust region as the fallback where that does not close and for ``avoid``."""
+    the trust region as the fallback where that does not close; with ``avoid``, the fast
+    route pushed away by :func:`_fast_avoid` (the trust region where that does not close)."""
     c0, u0 = np.asarray(c0, float), np.asarray(u0, float) / np.linalg.norm(u0)
     P, a = np.asarray(target_c, float), np.asarray(target_a, float) / np.linalg.norm(target_a)
     e1, e2 = _perp_basis(a)
@@ -417,10 +418,13 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
     t0 = _project_perp(tangent, u0)
     app = None if approach is None else np.asarray(approach, float) / np.linalg.norm(approach)
     guide = _guide(c0, t0, waypoints, P, app)
-    if method == "fast" and not len(avoid):
+    if method == "fast":
         r = _solve_fast(c0, u0, t0, P, e1, e2, app, guide, waypoints, geo, parity, bmax,
                         free_start and start_bend_max, min_half, max_half, last_pitch, extras, end_bends,
                         wp_weight)
+        if r is not None and len(avoid):
+            r = _fast_avoid(r, P, e1, e2, app, geo, last_pitch, bmax, free_start and start_bend_max,
+                            end_bends, avoid, avoid_from)
         if r is not None:
             return r
     guess = _steer(c0, u0, t0, guide, geo.pitch, bmax, free_start and start_bend_max, max_half)
@@ -519,6 +523,101 @@ def _solve_fast(c0, u0, t0, P, e1, e2, app, guide, waypoints, geo, parity, bmax,
     return None
 
 
+def _fast_avoid(route: Route, P, e1, e2, app, geo, last_pitch, bmax, start_lim, end_bends, avoid,
+                avoid_from: int) -> Route | None:
+    """The ``fast`` method's ``avoid``: the closed ``route`` pushed away from the ``avoid``
+    sets, every bend free within its bounds (the push can be needed anywhere along the
+    chain), by Levenberg-Marquardt in the row space of the closure and approach (weight
+    ``AVOID_CLOSE`` over the trust region's) and of the keep-away rows of the layer
+    centres from the ``avoid_from``-th on that are inside their set's distance (the
+    trust region's one-sided term, ``AVOID_WEIGHT`` (D - d)), for ``AVOID_STEPS``
+    iterations at most; then closed exactly as :func:`_solve_fast` closes (the last bends
+    mostly).  None when that closure fails; the caller keeps the pushed route only if it
+    is farther from what it avoids."""
+    x = np.array(route.bends, float)
+    n = x.shape[0]
+    c0, u0, t0 = route.centre, route.axis, route.tangent
+    pitches = np.full(n, geo.pitch)
+    if last_pitch is not None:
+        pitches[-1] = last_pitch
+    lo, hi = _bounds(n, bmax, start_lim, end_bends)
+    sets = [(cKDTree(np.asarray(p, float).reshape(-1, 3)), float(d)) for p, d in avoid if len(p)]
+    j0 = min(max(int(avoid_from), 0), n)
+    n_av = n - j0
+    cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
+    has_app = app is not None
+    app_v = np.zeros(3) if app is None else np.asarray(app, float)
+    no_k, no_p = np.zeros(0, np.int64), np.zeros((0, 3))
+    head = 5 + (3 if has_app else 0)
+    buf = np.empty(head + n - 1)
+    Jb = np.empty((head + n - 1, n))
+    near_q = np.zeros((len(sets) * n_av, 3))
+    near_d = np.full(len(sets) * n_av, np.inf)
+    Ja = np.empty((near_d.size, n))
+
+    def resid(b):
+        _fk_kernel(c0, u0, t0, b, pitches, cs, us, ts, True)
+        _resid_kernel(cs, us, ts, b, P, e1, e2, has_app, app_v, no_k, no_p, 1.0, 1.0, buf)
+        m = 0.5 * (cs[1:] + cs[:-1])[j0:]
+        gap = np.zeros(near_d.size)
+        for k, (tree, d) in enumerate(sets):
+            dist, idx = tree.query(m, distance_upper_bound=d)
+            sl = slice(k * n_av, (k + 1) * n_av)
+            ok = np.isfinite(dist)
+            near_d[sl] = dist
+            near_q[sl][ok] = tree.data[idx[ok]]
+            gap[sl] = np.where(ok, d - dist, 0.0)
+        return np.concatenate([AVOID_CLOSE * buf[:head], AVOID_WEIGHT * gap])
+
+    x = np.clip(x, lo, hi)
+    r = resid(x)
+    f = float(r @ r)
+    mu = 1e-4
+    half = np.maximum(0.5 * (hi - lo), 1e-12)
+    for _ in range(AVOID_STEPS):
+        act = np.concatenate([np.arange(head), head + np.nonzero(r[head:])[0]])
+        if act.size == head:
+            break
+        _jac_kernel(cs, us, ts, e1, e2, has_app, no_k, 1.0, 1.0, Jb)
+        _avoid_jac_kernel(cs, us, j0, near_q, near_d, AVOID_WEIGHT, Ja)
+        J = np.concatenate([AVOID_CLOSE * Jb[:head], Ja])[act]
+        ra = r[act]
+        g = J.T @ ra
+        D = np.sqrt(np.clip(np.where(g < 0, hi - x, x - lo), 0.0, None) / half)
+        A = J * D
+        M = A @ A.T
+        tr = float(np.trace(M)) / act.size
+        while True:
+            z = np.linalg.solve(M + mu * tr * np.eye(act.size), -ra)
+            x_new = np.clip(x + D * (A.T @ z), lo, hi)
+            r_new = resid(x_new)
+            f_new = float(r_new @ r_new)
+            if f_new < f:
+                mu = max(mu / 4.0, 1e-9)
+                break
+            mu *= 8.0
+            if mu > 1e6:
+                break
+        if mu > 1e6 or f - f_new < 1e-4 * f:
+            if f_new < f:
+                x = x_new
+            break
+        x, r, f = x_new, r_new, f_new
+    scale = np.exp(-(n - 1 - np.arange(n)) / FAST_TAIL)
+    for widen in (1.0, 3.0):
+        x = _lm_close(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, None, scale ** (1.0 / widen), (), 0.0)
+        _fk_kernel(c0, u0, t0, x, pitches, cs, us, ts, True)
+        err = float(max(np.linalg.norm(cs[-1] - P), abs(us[-1] @ e1), abs(us[-1] @ e2)))
+        if err < EXACT:
+            break
+    aerr = 0.0 if app is None else float(np.linalg.norm(ts[-1] - app))
+    if err < EXACT and aerr < 0.5:
+        return Route(c0, u0, t0, [float(v) for v in x], err, aerr)
+    return None
+
+
+AVOID_STEPS = 100           # iterations of the fast method's push away from ``avoid`` at most
+AVOID_CLOSE = 1.0           # weight of the closure and approach in that push, over the trust region's
 FAST_TAIL = 20.0            # half units: the fast method's bend changes fall off as exp(-d / FAST_TAIL) from the end
 FAST_HOLD = 40              # half units: the waypoints this near the end hold the shape while it closes
 CLOSE_STEPS = 40            # iterations of a pass of _lm_close at most
