@@ -2,7 +2,8 @@
 or failed a wall between 0.72 and 0.92 x min_wall with its position on the grid; the ball centres
 near the threshold are now placed from the surface itself (session 37), so a web just under the
 minimum fails at any angle and offset, one at the minimum passes, and the report names the
-thinnest spot of a thin region."""
+thinnest spot of a thin region.  Since session 38 the distances to the surface are exact (the
+nearest triangle), so the pass mark is sharp to 0.001 mm."""
 import manifold3d as mf
 import numpy as np
 import pytest
@@ -43,6 +44,18 @@ def test_the_pass_mark_is_within_the_tolerance_of_the_minimum():
     assert thin_walls("web", _web(edge + 0.003, rot, off), 0.6) == []
 
 
+@pytest.mark.parametrize("k", range(3))
+def test_the_pass_mark_is_sharp(k):
+    """With exact distances to the surface (session 38; the surface samples of session 37 measured
+    a wall up to 0.0024 mm thicker than it is), a web 0.001 mm under the pass mark fails and one
+    0.001 mm over it passes, at oblique angles, and the thin one is measured within 0.0005 mm."""
+    edge = 0.6 * (1 - WALL_TOL)
+    rot, off = (11 + 23 * k, 7 + 31 * k, 5 * k), (0.007 * k, 0.019 * k, 0.023 * k)
+    (w,) = thin_walls("web", _web(edge - 0.001, rot, off), 0.6)
+    assert abs(w.thickness_mm - (edge - 0.001)) < 5e-4, w
+    assert thin_walls("web", _web(edge + 0.001, rot, off), 0.6) == []
+
+
 def test_the_report_names_the_thinnest_spot():
     """A web 0.4 mm thick over most of its length with a 0.25 mm stretch at one end (x from 3.0
     to 3.6 mm): one thin region, measured 0.4 mm (its largest ball), whose thinnest spot is the
@@ -67,3 +80,35 @@ def _unrotate(p, rot):
     Ry = np.array([[np.cos(ay), 0, np.sin(ay)], [0, 1, 0], [-np.sin(ay), 0, np.cos(ay)]])
     Rz = np.array([[np.cos(az), -np.sin(az), 0], [np.sin(az), np.cos(az), 0], [0, 0, 1]])
     return (Rz @ Ry @ Rx).T @ p
+
+
+def test_the_surface_distance_is_exact():
+    """The distances the measure places its balls with (session 38: the nearest triangle through a
+    bounding volume hierarchy, no longer the nearest of surface samples) against the box's own
+    distance, worked out from its size alone: points inside, outside, near faces, edges and
+    corners of a turned and moved box (its faces cut into many triangles), and which side."""
+    from mlc.mesh.walls import _Surface, voxelize
+    from mlc.mesh.printability import _mesh_arrays
+    size = np.array([2.0, 1.2, 0.7])
+    rot, off = (17, 41, 8), np.array([0.3, -0.2, 0.11])
+    solid = mf.Manifold.cube(list(size), True).refine(5).rotate(list(rot)).translate(list(off))
+    V, F = _mesh_arrays(solid)
+    assert len(F) > 12 * 20
+    grid, lo = voxelize(solid, 0.05)
+    surf = _Surface(V, F, grid, lo, 0.05)
+    rng = np.random.default_rng(38)
+    L = rng.uniform(-0.8, 0.8, (4000, 3)) * size          # in the box's frame, inside and out
+    ax, ay, az = np.radians(rot)
+    Rx = np.array([[1, 0, 0], [0, np.cos(ax), -np.sin(ax)], [0, np.sin(ax), np.cos(ax)]])
+    Ry = np.array([[np.cos(ay), 0, np.sin(ay)], [0, 1, 0], [-np.sin(ay), 0, np.cos(ay)]])
+    Rz = np.array([[np.cos(az), -np.sin(az), 0], [np.sin(az), np.cos(az), 0], [0, 0, 1]])
+    P = L @ (Rz @ Ry @ Rx).T + off
+    q = np.abs(L) - size / 2
+    want = np.where((q < 0).all(1), -q.max(1), np.linalg.norm(np.maximum(q, 0), axis=1))
+    d, Q = surf.query(P)
+    assert np.abs(d - want).max() < 1e-6       # (the mesh is in float32)
+    assert np.abs(np.linalg.norm(P - Q, axis=1) - d).max() < 1e-9
+    D, _, ins = surf.inside(P)
+    deep = (q < -0.06).all(1)          # inside by more than a cell: the grid agrees
+    assert ins[deep].all() and np.abs(D[deep] - want[deep]).max() < 1e-6
+    assert not ins[(q > 0).any(1)].any() and (D[(q > 0).any(1)] == 0).all()

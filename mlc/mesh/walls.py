@@ -10,8 +10,9 @@ with a ball of diameter ``min_wall`` (the union of every such ball that fits ins
    ball centred there that stays inside (to the nearest outside cell centre: at least the
    distance to the surface, at most about two cells more);
 3. the ball centres: a cell two cells deeper than ``r = min_wall / 2`` is one; a cell near that
-   depth is measured from the surface (session 37, :class:`_Surface`: the distance to samples of
-   the triangles at most half a cell apart, a k-d tree), and is one when a ball of radius
+   depth is measured from the surface (session 37; :class:`_Surface`: since session 38 the exact
+   distance to the nearest triangle, through a bounding volume hierarchy compiled by Numba), and
+   is one when a ball of radius
    ``r (1 - WALL_TOL)`` fits within a few cells of it (:func:`_ball`: from the cell, along the
    line away from the nearest surface point to where the distances to the two sides meet,
    three times: a plate's mid-plane, a square bar's axis).  Only the cells that can decide a
@@ -36,19 +37,24 @@ about 5 times faster.
 Resolution: ``h = min_wall / 8`` by default.  Until session 37 the ball centres were the cells
 within half a cell of ``r`` on the grid alone: a plate of ``min_wall`` or ``0.92 min_wall``
 always passed, one of ``0.72 min_wall`` or less always failed, and in between it depended on the
-grid (the 0.547 mm web of the expanding OR at mjp passed).  Now (tests/test_mesh_walls.py,
-tests/test_mesh_print.py, plates and webs at random offsets and angles) a wall of
-``(1 - WALL_TOL) min_wall`` plus the sampling error (under 0.003 mm at mjp) passes and one under
-``(1 - WALL_TOL) min_wall`` minus 0.004 mm fails (mjp: 0.594 mm passes, 0.587 mm fails), its
-thickness measured within 0.005 mm.  ``WALL_TOL`` (1.5 %) is for the facets of round features:
-a knuckle's ring drawn as a 32-gon is up to 1.3 % under its nominal 0.6 mm wall at mjp.  About 10
-times the grid-only time (a library gate's nine parts: 4.5 s at mjp, 11 s at sla, 16 s at fdm).
+grid (the 0.547 mm web of the expanding OR at mjp passed).  Session 37 measured them from samples
+of the surface (a wall measured up to 0.0024 mm thicker than it is at mjp).  Now
+(tests/test_mesh_walls.py, tests/test_mesh_print.py, plates and webs at random offsets and
+angles) a wall 0.001 mm over ``(1 - WALL_TOL) min_wall`` passes and one 0.001 mm under it fails
+(mjp: the pass mark is 0.591 mm), its thickness measured within 0.0005 mm.  ``WALL_TOL`` (1.5 %)
+is for the facets of round features: a knuckle's ring drawn as a 32-gon is up to 1.3 % under its
+nominal 0.6 mm wall at mjp.
+
+Time: the surface samples and their k-d tree (session 37) made the measure about 10 times the
+grid-only one; the exact distances (a query of about 2 microseconds, most of the time left) make
+it faster again (``benchmarks/mesh_walls_speed.py``; the figures in docs/printing.md).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 
 #: cells of the largest grid measured at once (memory: about 40 bytes a cell during the transforms)
@@ -143,98 +149,232 @@ def _edt_upto(mask: np.ndarray, R: int) -> np.ndarray:
 #: n-gon (its radius at the corners, a cutter's at the flats) take up to ``(R + r)(1 - cos pi/n)``
 #: of a ring's wall (mjp's knuckles, 32 segments: 0.0077 mm, 1.3 % of its 0.6 mm)
 WALL_TOL = 0.015
-#: spacing of the surface samples, in cells: the distance to the nearest sample exceeds the
-#: distance to the surface by at most ``rho**2 / (2 d)``, ``rho = spacing / sqrt(2)`` (0.0012 mm
-#: at d = 0.3 mm and mjp's cell of 0.075 mm: a wall measures up to 0.0024 mm thicker than it is)
-SAMPLE_CELLS = 0.5
 #: a thin region's thinnest spot is looked for among at most this many of its cells
 MAX_CHORDS = 1000
+#: triangles in a leaf of the bounding volume hierarchy of :func:`_bvh_build`
+LEAF = 4
 
 
-def _surface_samples(V, F, s: float):
-    """Points on every triangle of the mesh (V, F) at most ``s`` apart: a square grid of step
-    ``s`` in each triangle's plane (along its longest edge and across it), and its three edges
-    at step ``s``; and the outward unit normal of each point's triangle."""
-    A, B, C = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
-    P = np.stack([A, B, C], 1)
-    e = np.stack([np.linalg.norm(B - A, axis=1), np.linalg.norm(C - B, axis=1), np.linalg.norm(A - C, axis=1)], 1)
-    k = e.argmax(1)
-    idx = (np.arange(3)[None, :] + k[:, None]) % 3
-    P = np.take_along_axis(P, idx[:, :, None], 1)
-    P0, P1, P2 = P[:, 0], P[:, 1], P[:, 2]
-    L = np.linalg.norm(P1 - P0, axis=1)
-    N = np.cross(B - A, C - A)
-    N /= np.maximum(np.linalg.norm(N, axis=1), 1e-300)[:, None]
-    ok = L > 1e-12
-    P0, P1, P2, L, N = P0[ok], P1[ok], P2[ok], L[ok], N[ok]
-    ex = (P1 - P0) / L[:, None]
-    w = P2 - P0
-    px = np.einsum("ij,ij->i", w, ex)
-    hv = w - px[:, None] * ex
-    H = np.linalg.norm(hv, axis=1)
-    ey = hv / np.maximum(H, 1e-12)[:, None]
-    nx = np.ceil(L / s).astype(np.int64) + 1
-    ny = np.ceil(H / s).astype(np.int64) + 1
-    cnt = nx * ny
-    tri = np.repeat(np.arange(len(L)), cnt)
-    first = np.concatenate([[0], np.cumsum(cnt)[:-1]])
-    loc = np.arange(int(cnt.sum())) - first[tri]
-    i, j = loc % nx[tri], loc // nx[tri]
-    x = i * (L / (nx - 1))[tri]
-    y = j * (H / np.maximum(ny - 1, 1))[tri]
-    # inside the triangle (0, 0), (L, 0), (px, H) of the plane's frame
-    inside = ((y * px[tri] <= H[tri] * x + 1e-12) & (y * (L - px)[tri] <= H[tri] * (L[tri] - x) + 1e-12))
-    tri, x, y = tri[inside], x[inside], y[inside]
-    pts = [P0[tri] + x[:, None] * ex[tri] + y[:, None] * ey[tri]]
-    nrm = [N[tri]]
-    for Q0, Q1 in ((P1, P2), (P2, P0)):      # the two slanted edges (the base is in the grid)
-        n = np.ceil(np.linalg.norm(Q1 - Q0, axis=1) / s).astype(np.int64) + 1
-        t_ = np.repeat(np.arange(len(n)), n)
-        f = (np.arange(int(n.sum())) - np.concatenate([[0], np.cumsum(n)[:-1]])[t_]) / np.maximum(n - 1, 1)[t_]
-        pts.append(Q0[t_] + f[:, None] * (Q1 - Q0)[t_])
-        nrm.append(N[t_])
-    return np.concatenate(pts), np.concatenate(nrm)
+@njit(cache=True)
+def _bvh_build(V, F):
+    """A bounding volume hierarchy of the triangles ``F`` of ``V``: a node's box holds its
+    triangles; a node splits them at the median of their centroids along the longest side of
+    the centroids' box, down to ``LEAF`` triangles.  (node boxes lo, hi, left and right child
+    (-1: a leaf), first triangle and count of a leaf in ``perm``, perm)."""
+    m = F.shape[0]
+    tlo = np.empty((m, 3))
+    thi = np.empty((m, 3))
+    cen = np.empty((m, 3))
+    for t in range(m):
+        for a in range(3):
+            x0 = V[F[t, 0], a]
+            x1 = V[F[t, 1], a]
+            x2 = V[F[t, 2], a]
+            tlo[t, a] = min(x0, x1, x2)
+            thi[t, a] = max(x0, x1, x2)
+            cen[t, a] = (x0 + x1 + x2) / 3.0
+    perm = np.arange(m)
+    cap = 2 * m + 1
+    nlo = np.empty((cap, 3))
+    nhi = np.empty((cap, 3))
+    left = np.full(cap, -1, np.int64)
+    right = np.full(cap, -1, np.int64)
+    start = np.zeros(cap, np.int64)
+    count = np.zeros(cap, np.int64)
+    stack = np.empty((cap, 3), np.int64)
+    sp = 0
+    stack[0, 0], stack[0, 1], stack[0, 2] = 0, 0, m
+    sp = 1
+    nn = 1
+    while sp > 0:
+        sp -= 1
+        node, s, e = stack[sp, 0], stack[sp, 1], stack[sp, 2]
+        clo = np.full(3, np.inf)
+        chi = np.full(3, -np.inf)
+        for a in range(3):
+            nlo[node, a] = np.inf
+            nhi[node, a] = -np.inf
+        for k in range(s, e):
+            t = perm[k]
+            for a in range(3):
+                nlo[node, a] = min(nlo[node, a], tlo[t, a])
+                nhi[node, a] = max(nhi[node, a], thi[t, a])
+                clo[a] = min(clo[a], cen[t, a])
+                chi[a] = max(chi[a], cen[t, a])
+        if e - s <= LEAF:
+            start[node], count[node] = s, e - s
+            continue
+        ax = 0
+        for a in range(1, 3):
+            if chi[a] - clo[a] > chi[ax] - clo[ax]:
+                ax = a
+        sub = perm[s:e].copy()
+        order = np.argsort(cen[sub, ax])
+        perm[s:e] = sub[order]
+        mid = (s + e) // 2
+        l, r = nn, nn + 1
+        nn += 2
+        left[node], right[node] = l, r
+        stack[sp, 0], stack[sp, 1], stack[sp, 2] = l, s, mid
+        sp += 1
+        stack[sp, 0], stack[sp, 1], stack[sp, 2] = r, mid, e
+        sp += 1
+    return nlo[:nn].copy(), nhi[:nn].copy(), left[:nn].copy(), right[:nn].copy(), start[:nn].copy(), count[:nn].copy(), perm
+
+
+@njit(cache=True, inline='always')
+def _closest(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz):
+    """Closest point of triangle abc to p (Ericson, Real-Time Collision Detection 5.1.5)."""
+    abx, aby, abz = bx - ax, by - ay, bz - az
+    acx, acy, acz = cx - ax, cy - ay, cz - az
+    apx, apy, apz = px - ax, py - ay, pz - az
+    d1 = abx * apx + aby * apy + abz * apz
+    d2 = acx * apx + acy * apy + acz * apz
+    if d1 <= 0.0 and d2 <= 0.0:
+        return ax, ay, az
+    bpx, bpy, bpz = px - bx, py - by, pz - bz
+    d3 = abx * bpx + aby * bpy + abz * bpz
+    d4 = acx * bpx + acy * bpy + acz * bpz
+    if d3 >= 0.0 and d4 <= d3:
+        return bx, by, bz
+    vc = d1 * d4 - d3 * d2
+    if vc <= 0.0 and d1 >= 0.0 and d3 <= 0.0:
+        v = d1 / (d1 - d3) if d1 - d3 > 0.0 else 0.0
+        return ax + v * abx, ay + v * aby, az + v * abz
+    cpx, cpy, cpz = px - cx, py - cy, pz - cz
+    d5 = abx * cpx + aby * cpy + abz * cpz
+    d6 = acx * cpx + acy * cpy + acz * cpz
+    if d6 >= 0.0 and d5 <= d6:
+        return cx, cy, cz
+    vb = d5 * d2 - d1 * d6
+    if vb <= 0.0 and d2 >= 0.0 and d6 <= 0.0:
+        w = d2 / (d2 - d6) if d2 - d6 > 0.0 else 0.0
+        return ax + w * acx, ay + w * acy, az + w * acz
+    va = d3 * d6 - d5 * d4
+    if va <= 0.0 and (d4 - d3) >= 0.0 and (d5 - d6) >= 0.0:
+        s_ = (d4 - d3) + (d5 - d6)
+        w = (d4 - d3) / s_ if s_ > 0.0 else 0.0
+        return bx + w * (cx - bx), by + w * (cy - by), bz + w * (cz - bz)
+    if not va + vb + vc > 0.0:       # a degenerate (zero-area) triangle: its vertex a
+        return ax, ay, az
+    den = 1.0 / (va + vb + vc)
+    v = vb * den
+    w = vc * den
+    return ax + abx * v + acx * w, ay + aby * v + acy * w, az + abz * v + acz * w
+
+
+@njit(cache=True)
+def _nearest(P, V, F, N, nlo, nhi, left, right, start, count, perm):
+    """For each row of P: distance to the mesh, nearest point, and the triangle whose plane
+    is farthest among those at that distance (the one whose normal tells the side)."""
+    n = P.shape[0]
+    D = np.empty(n)
+    Q = np.empty((n, 3))
+    T = np.empty(n, np.int64)
+    stack = np.empty(256, np.int64)
+    for i in range(n):
+        px, py, pz = P[i, 0], P[i, 1], P[i, 2]
+        best = np.inf
+        bq0 = bq1 = bq2 = np.nan
+        bt = -1
+        bplane = -1.0
+        if i > 0:       # the previous point's nearest triangle first (the points come in runs of
+            t = T[i - 1]    # neighbours): a tight bound from the start, the same result
+            a, b, c = F[t, 0], F[t, 1], F[t, 2]
+            qx, qy, qz = _closest(px, py, pz, V[a, 0], V[a, 1], V[a, 2], V[b, 0], V[b, 1], V[b, 2],
+                                  V[c, 0], V[c, 1], V[c, 2])
+            ex, ey, ez = px - qx, py - qy, pz - qz
+            best = ex * ex + ey * ey + ez * ez
+            bq0, bq1, bq2, bt = qx, qy, qz, t
+            bplane = abs(ex * N[t, 0] + ey * N[t, 1] + ez * N[t, 2])
+        sp = 0
+        stack[0] = 0
+        sp = 1
+        while sp > 0:
+            sp -= 1
+            node = stack[sp]
+            dx = max(nlo[node, 0] - px, 0.0, px - nhi[node, 0])
+            dy = max(nlo[node, 1] - py, 0.0, py - nhi[node, 1])
+            dz = max(nlo[node, 2] - pz, 0.0, pz - nhi[node, 2])
+            if dx * dx + dy * dy + dz * dz > best * (1.0 + 1e-9) + 1e-24:
+                continue
+            if left[node] < 0:
+                for k in range(start[node], start[node] + count[node]):
+                    t = perm[k]
+                    a, b, c = F[t, 0], F[t, 1], F[t, 2]
+                    qx, qy, qz = _closest(px, py, pz, V[a, 0], V[a, 1], V[a, 2], V[b, 0], V[b, 1], V[b, 2],
+                                          V[c, 0], V[c, 1], V[c, 2])
+                    ex, ey, ez = px - qx, py - qy, pz - qz
+                    d2 = ex * ex + ey * ey + ez * ez
+                    pl = abs(ex * N[t, 0] + ey * N[t, 1] + ez * N[t, 2])
+                    if d2 < best * (1.0 - 1e-9) - 1e-24 or (d2 <= best * (1.0 + 1e-9) + 1e-24 and pl > bplane):
+                        if d2 < best:
+                            best = d2
+                        bq0, bq1, bq2, bt, bplane = qx, qy, qz, t, pl
+            else:
+                l, r = left[node], right[node]
+                # the nearer child on top of the stack
+                dl = 0.0
+                dr = 0.0
+                for a in range(3):
+                    u = max(nlo[l, a] - P[i, a], 0.0, P[i, a] - nhi[l, a])
+                    dl += u * u
+                    u = max(nlo[r, a] - P[i, a], 0.0, P[i, a] - nhi[r, a])
+                    dr += u * u
+                if dl < dr:
+                    stack[sp] = r
+                    stack[sp + 1] = l
+                else:
+                    stack[sp] = l
+                    stack[sp + 1] = r
+                sp += 2
+        D[i] = np.sqrt(best)
+        Q[i, 0], Q[i, 1], Q[i, 2] = bq0, bq1, bq2
+        T[i] = bt
+    return D, Q, T
 
 
 class _Surface:
-    """Distance to the surface of a solid (mm), from points near the cells of ``mask`` (within
-    ``reach`` mm): the nearest of the samples of :func:`_surface_samples` near them (a k-d tree)."""
+    """Distance to the surface of a solid (mm): the exact distance to its nearest triangle
+    (:func:`_nearest`, a bounding volume hierarchy of the triangles, compiled by Numba).
+    Session 37 took the nearest of samples of the triangles at most half a cell apart (a k-d
+    tree; up to 0.0012 mm more than the distance at mjp), 2 to 7 microseconds a query."""
 
-    def __init__(self, V, F, grid, lo, h, mask, reach):
-        from scipy.spatial import cKDTree
-        s = SAMPLE_CELLS * h
-        pts, nrm = _surface_samples(V, F, s)
-        n = int(np.ceil(reach / h)) + 1
-        near = _edt_upto(~mask, n) <= n if (~mask).any() else np.ones(grid.shape, bool)
-        ijk = np.clip(np.rint((pts - lo) / h).astype(np.int64), 0, np.asarray(grid.shape) - 1)
-        sel = near[ijk[:, 0], ijk[:, 1], ijk[:, 2]]
-        pts, nrm = pts[sel], nrm[sel]
+    def __init__(self, V, F, grid, lo, h):
+        V = np.ascontiguousarray(V, float)
+        F = np.ascontiguousarray(F, np.int64)
+        N = np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]])
+        N /= np.maximum(np.linalg.norm(N, axis=1), 1e-300)[:, None]
+        self.V, self.F, self.N = V, F, N
+        self.bvh = _bvh_build(V, F) if len(F) else None
         self.grid, self.lo, self.h = grid, lo, h
-        self.rho = s / np.sqrt(2)
-        self.tree = cKDTree(pts) if len(pts) else None
-        self.pts, self.nrm = pts, nrm
+        #: a point closer to the surface than this is not moved off it (its direction is unsure)
+        self.rho = 1e-6 * h
+
+    def _near(self, P):
+        return _nearest(np.ascontiguousarray(P, float), self.V, self.F, self.N, *self.bvh)
 
     def query(self, P):
         """(distance, nearest surface point) for each row of ``P``."""
-        if self.tree is None:
+        if self.bvh is None:
             return np.full(len(P), np.inf), np.full_like(P, np.nan)
-        d, i = self.tree.query(P)
-        return d, self.pts[i]
+        d, Q, _ = self._near(P)
+        return d, Q
 
     def inside(self, P):
         """(distance, nearest surface point, whether the point is inside: behind the nearest
-        sample's face; a point on the surface, or past it, has distance 0)."""
-        if self.tree is None:
+        triangle's face, of those at that distance the one whose plane is farthest; a point on
+        the surface, or past it, has distance 0)."""
+        if self.bvh is None:
             return np.full(len(P), np.inf), np.full_like(P, np.nan), np.ones(len(P), bool)
-        d, i = self.tree.query(P)
-        F = self.pts[i]
-        ins = np.einsum("ij,ij->i", P - F, self.nrm[i]) < 0
-        # (and in an inside cell: an edge's samples carry one of its two faces' normals)
+        d, Q, T = self._near(P)
+        ins = np.einsum("ij,ij->i", P - Q, self.N[T]) < 0
+        # (and in an inside cell, as before)
         ijk = np.rint((P - self.lo) / self.h).astype(np.int64)
         ok = np.all((ijk >= 0) & (ijk < np.asarray(self.grid.shape)), axis=1)
         ins &= ok
         ins[ok] &= self.grid[ijk[ok, 0], ijk[ok, 1], ijk[ok, 2]]
-        return np.where(ins, d, 0.0), F, ins
+        return np.where(ins, d, 0.0), Q, ins
 
 
 def _ball(surf: _Surface, P, h, need=None, rounds=3):
@@ -246,27 +386,27 @@ def _ball(surf: _Surface, P, h, need=None, rounds=3):
     no face) does not count.  ``need`` (mm): only whether a ball of that radius is found
     matters: a point is measured no further once it has one, or once it is more than a cell
     short of it."""
-    D, _, _ = surf.inside(P)
+    D, Fc, _ = surf.inside(P)       # (and the nearest surface point of each centre so far)
     C = P.copy()
     for _ in range(rounds):
-        # (from a point within twice the samples' spacing of the surface, the direction away
-        # from the nearest sample is not the normal: not moved)
+        # (from a point within a hair of the surface, the direction away from it is unsure:
+        # not moved)
         go = D > 2 * surf.rho if need is None else (D > 2 * surf.rho) & (D < need) & (D + h >= need)
         if not go.any():
             break
         idx = np.flatnonzero(go)
         X = C[idx]
-        D0, F0 = surf.query(X)
+        D0, F0 = D[idx], Fc[idx]        # (inside: its distance is the distance to F0)
         u = (X - F0) / np.maximum(D0, 1e-12)[:, None]
         P1 = X + h * u
-        D1, _, _ = surf.inside(P1)
+        D1, F1, _ = surf.inside(P1)
         sm = np.clip(0.5 * (D1 - D0 + h), 0.0, h)
         Ps = X + sm[:, None] * u
-        Ds, _, _ = surf.inside(Ps)
+        Ds, Fs, _ = surf.inside(Ps)
         moved = False
-        for Dn, Pn in ((D1, P1), (Ds, Ps)):
+        for Dn, Pn, Fn in ((D1, P1, F1), (Ds, Ps, Fs)):
             better = Dn > D[idx] + 1e-9
-            D[idx[better]], C[idx[better]] = Dn[better], Pn[better]
+            D[idx[better]], C[idx[better]], Fc[idx[better]] = Dn[better], Pn[better], Fn[better]
             moved |= bool(better.any())
         if not moved:
             break
@@ -276,7 +416,8 @@ def _ball(surf: _Surface, P, h, need=None, rounds=3):
 def _chords(surf: _Surface, P, limit, eps):
     """The chord through each point of ``P`` along the line from its nearest surface point:
     (length, middle) (mm); the far end found by steps of the distance to the surface (never past
-    it), stopped within ``eps``; ``inf`` where it is not reached within ``limit``."""
+    it), stopped within ``eps`` of it and the last step added (the exact distance: a face square
+    to the chord is reached to float rounding); ``inf`` where it is not reached within ``limit``."""
     D0, F0 = surf.query(P)
     u = (P - F0) / np.maximum(D0, 1e-12)[:, None]
     s = np.zeros(len(P))
@@ -286,10 +427,12 @@ def _chords(surf: _Surface, P, limit, eps):
             break
         X = P[alive] + s[alive, None] * u[alive]
         d, Fx = surf.query(X)
-        # arrived: within eps of the surface, and the nearest surface ahead (not the near face)
+        # arrived: within eps of the surface, and the nearest surface ahead (not the near face),
+        # or on it
         ahead = np.einsum("ij,ij->i", Fx - X, u[alive]) > 0
-        s[alive] += np.maximum(d, eps)
-        alive[alive] = ~((d <= eps) & ahead) & (s[alive] < limit)
+        there = (d <= eps) & (ahead | (d <= 1e-9))
+        s[alive] += np.where(there, d, np.maximum(d, eps))
+        alive[alive] = ~there & (s[alive] < limit)
     w = np.where(s < limit, D0 + s, np.inf)
     mid = P + (0.5 * (s - D0))[:, None] * u
     return w, mid
@@ -318,6 +461,7 @@ def thin_walls(name: str, solid, min_wall: float, h: float | None = None) -> lis
     # every distance below is compared with r or edge only (and a thin cell's depth is under r):
     # exact up to a bound past both is all it takes
     R = int(np.ceil(max(r, edge) / h)) + 3
+    surf = None       # the surface (exact distances), built when first needed
     # distance from each inside cell centre to the nearest outside cell centre: at least the
     # distance to the surface (the segment crosses it), at most about two cells more
     depth = _edt_upto(grid, R) * h
@@ -333,9 +477,9 @@ def thin_walls(name: str, solid, min_wall: float, h: float | None = None) -> lis
         cov = (_edt_upto(~centres, R) * h <= r + 1e-9) & grid if centres.any() else np.zeros_like(grid)
         far = grid & ~cov & ((_edt_upto(~cov, R) * h > edge) if cov.any() else True)
         # (a cell near one of those is covered by a ball up to r + the corner rounding away)
-        band &= (ndimage.distance_transform_edt(~far) * h <= r + edge + h) if far.any() else False
+        band &= (_edt_upto(~far, int(np.ceil((r + edge + h) / h)) + 1) * h <= r + edge + h) if far.any() else False
     if band.any():
-        surf = _Surface(V, F, grid, lo, h, band, r + 3 * h)
+        surf = surf or _Surface(V, F, grid, lo, h)
         ib = np.argwhere(band)
         D, _ = _ball(surf, lo + h * ib, h, r * (1 - WALL_TOL))
         ok = D >= r * (1 - WALL_TOL)
@@ -368,12 +512,8 @@ def thin_walls(name: str, solid, min_wall: float, h: float | None = None) -> lis
     found = [(k, v, t) for k, d, v, t in zip(idx, deep[1:], size[1:], thick[1:]) if d > edge and v > r ** 3]
     if not found:
         return out
-    # the thickness and the thinnest spot of each thin region, from the surface itself: the
-    # surface near the regions (a chord is at most 2 min_wall long)
-    reg = np.zeros(grid.shape, bool)
-    keep = np.isin(labels, [k for k, _, _ in found])
-    reg[box] = keep
-    surf = _Surface(V, F, grid, lo, h, reg, 2 * min_wall + 3 * h)
+    # the thickness and the thinnest spot of each thin region, from the surface itself
+    surf = surf or _Surface(V, F, grid, lo, h)
     rng = np.random.default_rng(0)
     for k, v, t in found:
         cells = np.argwhere(labels == k) + corner
