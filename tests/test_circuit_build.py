@@ -282,9 +282,9 @@ def test_rip_up_reroutes_a_chain_and_the_one_it_presses_into(monkeypatch):
     # this rip-up alone: the contact rip-up (_rip_up_contacts) takes this pair apart too
     monkeypatch.setattr(B, "_rip_up_contacts", _no_contact_rip_up)
     monkeypatch.setattr(B, "RIP_GAP", 0.0)              # no rip-up
-    plain = B._build_circuit(c.netlist, spec, opt, first_wires=("g4", "g5"))
+    plain = B._build_circuit(c.netlist, spec, opt, first_wires=("g4", "g5")).assemble()
     monkeypatch.setattr(B, "RIP_GAP", 1.4)
-    ripped = B._build_circuit(c.netlist, spec, opt, first_wires=("g4", "g5"))
+    ripped = B._build_circuit(c.netlist, spec, opt, first_wires=("g4", "g5")).assemble()
     assert plain.closest < B.RIP_GAP and "rerouted" not in plain.scene.meta["connector"]
     assert ripped.scene.meta["connector"]["rerouted"], "no chain was routed again"
     assert ripped.closest > plain.closest, (plain.closest, ripped.closest)
@@ -308,9 +308,9 @@ def test_contact_rip_up_reroutes_chains_whose_layers_would_touch_when_a_wire_swi
     monkeypatch.setattr(B, "CONTACT_MARGIN", 0.6)
     real = B._rip_up_contacts
     monkeypatch.setattr(B, "_rip_up_contacts", _no_contact_rip_up)
-    plain = B._build_circuit(c.netlist, spec, opt, first_wires=("g4", "g5"))
+    plain = B._build_circuit(c.netlist, spec, opt, first_wires=("g4", "g5")).assemble()
     monkeypatch.setattr(B, "_rip_up_contacts", real)
-    ripped = B._build_circuit(c.netlist, spec, opt, first_wires=("g4", "g5"))
+    ripped = B._build_circuit(c.netlist, spec, opt, first_wires=("g4", "g5")).assemble()
     pairs = ripped.scene.meta["connector"].get("rerouted_contacts")
     assert pairs, "no chain was routed again"
     assert "rerouted_contacts" not in plain.scene.meta["connector"]

@@ -324,19 +324,34 @@ def _build_routed(netlist, spec, options: CircuitOptions, progress) -> Circuit:
     distance (:func:`_merit`; the first on a tie): one chain pressed into another is
     worse than several just inside the keep-apart distance."""
     first = _build_circuit(netlist, spec, options, progress)
-    tight = first.scene.meta["connector"]["tight_chains"]
-    if not tight:
-        return first
-    wires = tuple(dict.fromkeys(t[2:].rsplit("_", 1)[0] for t in tight))
+    if not first.tight:
+        return first.assemble()
+    wires = tuple(dict.fromkeys(t[2:].rsplit("_", 1)[0] for t, _ in first.tight))
     second = _build_circuit(netlist, spec, options, progress, first_wires=wires)
     if _merit(second) > _merit(first):
-        second.seconds["first_build"] = sum(first.seconds.values())
-        return second
-    first.seconds["second_build"] = sum(second.seconds.values())
-    return first
+        kept, other, key = second, first, "first_build"
+    else:
+        kept, other, key = first, second, "second_build"
+    c = kept.assemble()             # only the build kept is assembled
+    c.seconds[key] = sum(other.seconds.values())
+    return c
 
 
-def _merit(c: Circuit) -> tuple:
+@dataclass
+class _Routed:
+    """One build routed, not yet assembled: its chains left tight (``(tag, gap)``, in
+    assembly order), their smallest gap (``closest``, sigma), the contacts of its chains'
+    layers (:func:`_state_contacts`, smallest first), the seconds so far, and ``assemble()``,
+    which makes the :class:`Circuit` (once)."""
+
+    tight: list
+    closest: float
+    contacts: list
+    seconds: dict
+    assemble: object
+
+
+def _merit(c) -> tuple:
     """How well a build keeps its chains apart, larger is better: the smallest clearance of
     two chains' layers over the wires' states (up to ``CONTACT_MARGIN``: beyond it they
     are clear), then the smallest layer-centre distance of a tight chain (sigma)."""
@@ -345,8 +360,9 @@ def _merit(c: Circuit) -> tuple:
 
 
 def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, progress=None,
-                   first_wires: tuple = ()) -> Circuit:
-    """One build; ``first_wires`` (wire names: a gate id or a circuit input) are routed first."""
+                   first_wires: tuple = ()) -> _Routed:
+    """One build, routed (its assembly deferred: :class:`_Routed`); ``first_wires`` (wire
+    names: a gate id or a circuit input) are routed first."""
     import time
 
     from scipy.spatial import cKDTree
@@ -646,14 +662,24 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     rip_ups = _rip_up(routed, lanes, space, space_clear)
     contact_rips, contacts = _rip_up_contacts(routed, lanes, space, space_clear, geo)
     t_done = time.perf_counter()
-    # ---- assembly, in routing order (pages and stubs where they were made) --------------
-    for item in deferred:
+    tight += [(t, round(float(routed[t].gap), 3)) for t in deferred
+              if not isinstance(t, Parts) and routed[t].gap < space_clear]
+    seconds = {"place": t_route - t_start, "route": t_rip - t_route, "rip_up": t_done - t_rip}
+
+    def _assemble() -> Circuit:
+        """The scene of this build, in routing order (pages and stubs where they were made),
+        then the constant outputs, the probes and the meta."""
+        t_asm = time.perf_counter()
+        for item in deferred:
+            _assemble_item(item)
+        return _finish(t_asm)
+
+    def _assemble_item(item) -> None:
+        nonlocal n_chains, n_half
         if isinstance(item, Parts):
             add(item)
-            continue
+            return
         tag, ch = item, routed[item]
-        if ch.gap < space_clear:
-            tight.append((tag, round(float(ch.gap), 3)))
         wire, start, tap, spol, sstate, stop_at_tap, t_up, target, ext = ch.ctx
         route = ch.route
         parts, pairs, lout = _chain_parts(ch, geo)
@@ -673,46 +699,47 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         bonds.append(Bond(f"{tag}_end_lo", ends[0], target.lo, geo.k, 0.0, 0.0, "universal", f"{tag}_end_lo"))
         bonds.append(Bond(f"{tag}_end_hi", ends[1], target.hi, geo.k, 0.0, 0.0, "universal", f"{tag}_end_hi"))
 
-    # ---- constant outputs ------------------------------------------------------------
-    for i, o in enumerate(netlist.outputs):
-        if o.kind == "const":
-            L = geo.length(o.value)
-            c = np.array([(i + 1) * opt.gate_pitch, -opt.gate_pitch, 0.0])
-            p, q = c - [0.5 * L, 0, 0], c + [0.5 * L, 0, 0]
-            body = slab_body(f"const_{o.name}", [(p, q)], {"lo": p, "hi": q}, np.array([0, 0, 1.0]),
-                             geo.width, geo.thickness)
-            add(Parts([body], [], []))
-            probes.append(Probe(o.name, o.name, f"const_{o.name}.lo", f"const_{o.name}.hi", geo.L0, geo.L1))
+    def _finish(t_asm) -> Circuit:
+        # ---- constant outputs ------------------------------------------------------------
+        for i, o in enumerate(netlist.outputs):
+            if o.kind == "const":
+                L = geo.length(o.value)
+                c = np.array([(i + 1) * opt.gate_pitch, -opt.gate_pitch, 0.0])
+                p, q = c - [0.5 * L, 0, 0], c + [0.5 * L, 0, 0]
+                body = slab_body(f"const_{o.name}", [(p, q)], {"lo": p, "hi": q}, np.array([0, 0, 1.0]),
+                                 geo.width, geo.thickness)
+                add(Parts([body], [], []))
+                probes.append(Probe(o.name, o.name, f"const_{o.name}.lo", f"const_{o.name}.hi", geo.L0, geo.L1))
 
-    # order probes as the outputs
-    order = {o.name: i for i, o in enumerate(netlist.outputs)}
-    probes.sort(key=lambda p: order[p.output])
-    table = _truth_table(spec, netlist)
-    scene = Scene(name=f"circuit_{_stem(netlist.source)}", bodies=bodies, bonds=bonds, muscles=muscles,
-                  probes=probes, inputs=names, outputs=[o.name for o in netlist.outputs], truth_table=table,
-                  meta={"element": "circuit", "signal": signal, "source": netlist.source,
-                        "gates": {g.id: {"type": g.type, "origin": [float(v) for v in origin[g.id]],
-                                         "depth": g.depth} for g in netlist.gates},
-                        "connector": {"gap": geo.gap, "side": round(geo.side, 6), "joint_k": geo.k, "chains": n_chains,
-                                      "half_units": n_half, "planes": 1 + max((k for k, _ in lanes.placed), default=-1),
-                                      "tight_chains": [t for t, _ in tight]}})
-    if method == "fast":            # (not written for "ik": the examples' scenes stay as they were)
-        scene.meta["connector"]["router"] = method
-    if rip_ups:
-        scene.meta["connector"]["rerouted"] = [list(p) for p in rip_ups]
-    if contact_rips:
-        scene.meta["connector"]["rerouted_contacts"] = [list(p) for p in contact_rips]
-    touching = [k for k in contacts if k.clearance < CONTACT_MARGIN]
-    if touching:        # layers that may touch in some row: named, with their clearance (sigma)
-        scene.meta["connector"]["state_contacts"] = [[k.a, k.i, k.b, k.j, round(k.clearance, 4)] for k in touching]
-    if opt.direct:
-        scene.meta["connector"]["direct"] = [[d, s, p] for s, (d, p) in direct.items()]
-    scene.check()
-    t_end = time.perf_counter()
-    return Circuit(scene, origin, n_chains, n_half,
-                   {"place": t_route - t_start, "route": t_rip - t_route, "rip_up": t_done - t_rip,
-                    "assemble": t_end - t_done},
-                   min((g for _, g in tight), default=float("inf")), contacts)
+        # order probes as the outputs
+        order = {o.name: i for i, o in enumerate(netlist.outputs)}
+        probes.sort(key=lambda p: order[p.output])
+        table = _truth_table(spec, netlist)
+        scene = Scene(name=f"circuit_{_stem(netlist.source)}", bodies=bodies, bonds=bonds, muscles=muscles,
+                      probes=probes, inputs=names, outputs=[o.name for o in netlist.outputs], truth_table=table,
+                      meta={"element": "circuit", "signal": signal, "source": netlist.source,
+                            "gates": {g.id: {"type": g.type, "origin": [float(v) for v in origin[g.id]],
+                                             "depth": g.depth} for g in netlist.gates},
+                            "connector": {"gap": geo.gap, "side": round(geo.side, 6), "joint_k": geo.k, "chains": n_chains,
+                                          "half_units": n_half, "planes": 1 + max((k for k, _ in lanes.placed), default=-1),
+                                          "tight_chains": [t for t, _ in tight]}})
+        if method == "fast":            # (not written for "ik": the examples' scenes stay as they were)
+            scene.meta["connector"]["router"] = method
+        if rip_ups:
+            scene.meta["connector"]["rerouted"] = [list(p) for p in rip_ups]
+        if contact_rips:
+            scene.meta["connector"]["rerouted_contacts"] = [list(p) for p in contact_rips]
+        touching = [k for k in contacts if k.clearance < CONTACT_MARGIN]
+        if touching:        # layers that may touch in some row: named, with their clearance (sigma)
+            scene.meta["connector"]["state_contacts"] = [[k.a, k.i, k.b, k.j, round(k.clearance, 4)] for k in touching]
+        if opt.direct:
+            scene.meta["connector"]["direct"] = [[d, s, p] for s, (d, p) in direct.items()]
+        scene.check()
+        t_end = time.perf_counter()
+        return Circuit(scene, origin, n_chains, n_half, dict(seconds, assemble=t_end - t_asm),
+                       min((g for _, g in tight), default=float("inf")), contacts)
+
+    return _Routed(tight, min((g for _, g in tight), default=float("inf")), contacts, seconds, _assemble)
 
 
 def _check_reach(netlist, taps, consumers, by_name, level, geo) -> None:
