@@ -13,7 +13,9 @@ passes, the failed checks (blocking, and the goals that do not block yet), part 
 number of dense poses, the smallest gap in motion and the pairs under the clearance, the
 measured walls (``thinnest_wall_mm``, ``thin_walls``, ``wall_detail``: the ``wall_thickness`` goal),
 the notes of the webs thinner than the minimum wall that the mesher carried and bridged
-(``web_notes``: the split test, and since session 37 the measured one), wall and
+(``web_notes``: the split test, and since session 37 the measured one), the print-only feet
+(``feet_mm3``: volume added a part) and the first layer's share of the footprint
+(``bed_contact``, ``bed_detail``; since session 38), wall and
 CPU seconds, and ``commit`` (benchmarks/gitstate.py: HEAD, ``-dirty`` when mlc/ differs from it).
 
 **Outside check of the web at hinge c** (``section_web``, session 36): the hinge's owner
@@ -228,6 +230,9 @@ def main() -> int:
                        "thin_walls": rep.check("wall_thickness").failures,
                        "wall_detail": rep.check("wall_thickness").detail,
                        "web_notes": [n for n in asm.notes if "thinner than the minimum wall" in n],
+                       "feet_mm3": dict(getattr(asm, "feet", {})),
+                       "bed_contact": rep.check("bed_contact").value,
+                       "bed_detail": rep.check("bed_contact").detail,
                        "section_web": section_webs(asm),
                        "axis_webs": axis_webs(asm),
                        "export_s": round(wall, 2), "export_cpu_s": round(cpu, 2), "commit": commit()}

@@ -5,7 +5,7 @@ commit's, on the same finished parts in one run: the time a part and the thin re
 
 The parts: a library gate (NAND, expanding, mjp: ``export_assembly``, what ``mlc stl`` runs) and
 the compiled Tetris circuit (examples/tetris.tt, compiled as ``mlc compile`` does, its one
-mechanism posed and built as ``export_assembly`` does, mjp; its checks are not run).  The old
+distinct mechanisms posed and built as ``export_assembly`` does, mjp; their checks are not run).  The old
 measure is ``mlc/mesh/walls.py`` of ``--old`` (``git show``), loaded beside this checkout's
 (both use this checkout's ``mlc.mesh.printability`` for the voxel raster, unchanged between
 them).  Each part is measured by the old code, then by the new: every part of the gate, every
@@ -62,16 +62,31 @@ def gate_parts():
 
 
 def circuit_parts():
+    """The distinct mechanisms of the circuit's scene, each posed and built as export_assembly
+    builds it (copies of a mechanism are translated there, their walls the same): one list of
+    parts (a namespace with ``parts``), the congruence frames of each mechanism's parts."""
+    import types
     from mlc import pipeline
     from mlc.mesh.build import build_assembly
-    from mlc.mesh.pipeline import _dense_poses, split_mechanisms, state_poses
+    from mlc.mesh.congruence import shape_key
+    from mlc.mesh.pipeline import _dense_poses, _signature, split_mechanisms, state_poses
     from mlc.mesh.profiles import load_profile
     scene = pipeline.build(pipeline.compile_spec(pipeline.load(str(ROOT / "examples/tetris.tt"), None))).circuit.scene
-    assert len(split_mechanisms(scene)) == 1
     prof = load_profile("mjp")
-    poses, _ = state_poses(scene)
-    dense = _dense_poses(scene, prof, [])
-    return build_assembly(scene, prof, poses, motion_poses=dense), prof
+    parts, keys, seen = [], set(), set()
+    mechs = split_mechanisms(scene)
+    for m in mechs:
+        sig = _signature(m.scene)
+        if sig in seen:
+            continue
+        seen.add(sig)
+        poses, _ = state_poses(m.scene)
+        dense = _dense_poses(m.scene, prof, [])
+        a = build_assembly(m.scene, prof, poses or None, motion_poses=dense)
+        parts += a.parts
+        cong = getattr(a, "congruence", None)
+        keys |= {shape_key(p.solid, cong.frames[i]) if cong else (len(seen), i) for i, p in enumerate(a.parts)}
+    return types.SimpleNamespace(parts=parts, mechanisms=len(mechs), built=len(seen), shapes=len(keys)), prof
 
 
 def summary(ws):
@@ -103,7 +118,6 @@ def main() -> int:
     ap.add_argument("--out", default=str(RESULTS / "mesh_walls_speed_s38.json"))
     args = ap.parse_args()
     from mlc.mesh import walls as new
-    from mlc.mesh.congruence import shape_key
     old = old_walls(args.old)
     import manifold3d as mf
     new.thin_walls("warm", mf.Manifold.cube([1, 1, 1]), 0.6)     # Numba's compiled kernels loaded
@@ -116,10 +130,9 @@ def main() -> int:
     print("gate", {k: v for k, v in out["gate"].items() if k != "rows"}, flush=True)
     t0 = time.perf_counter()
     asm, prof = circuit_parts()
-    cong = getattr(asm, "congruence", None)
-    keys = {shape_key(p.solid, cong.frames[i]) for i, p in enumerate(asm.parts)} if cong else set()
     out["circuit"] = {"case": "tetris mjp", "build_s": round(time.perf_counter() - t0, 1),
-                      "distinct_shapes": len(keys), **compare(asm, prof, old, new, args.every)}
+                      "mechanisms": asm.mechanisms, "mechanisms_built": asm.built,
+                      "distinct_shapes": asm.shapes, **compare(asm, prof, old, new, args.every)}
     print("circuit", {k: v for k, v in out["circuit"].items() if k != "rows"}, flush=True)
     t0 = time.perf_counter()
     n = sum(len(new.thin_walls(p.name, p.solid, prof.min_wall)) for p in asm.parts if not p.solid.is_empty())

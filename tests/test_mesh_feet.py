@@ -88,6 +88,39 @@ def test_feet_reach_the_bed_and_keep_the_clearance_in_every_pose():
     assert 0.5 * 30 * 1.2 < sec < 30 * 1.2
 
 
+def test_feet_are_at_least_the_minimum_wall_where_a_shadow_narrows_them():
+    """A plate exactly the minimum wall thick (fdm: 1.2 mm) with a block C on the bed beside it,
+    C's shadow (grown by the clearance and the economies' slack) taking off all but 0.96 of the
+    wall over 10 mm of the plate's length.  Opened at FOOT_OPEN (0.9 x the wall) alone and then
+    simplified, as until session 38, that stretch of the foot stayed 1.15 mm wide, under the
+    measured check's pass mark (0.985 x the wall), and the rest of the foot a little under the
+    wall too.  Now every foot passes the measured wall check, A's still reaches the bed along most
+    of the plate, and the feet keep the clearance from C and from each other in every pose."""
+    from mlc.mesh.walls import thin_walls
+    prof = load_profile("fdm")
+    mw, c = prof.min_wall, prof.clearance
+    edge = 0.96 * mw + c * (1 + FT.FOOT_MARGIN) + FT.FOOT_MERGE_MM + 2 * FT.FOOT_SIMPLIFY_MM
+    parts = [Part("A", "body", _box([0, 0, 5], [30, mw, 15])),
+             Part("B", "body", _box([0, 6, 5], [30, 6 + mw, 15])),
+             Part("C", "body", _box([10, edge, 0], [20, 4, 3]))]
+    asm = types.SimpleNamespace(parts=parts, profile=prof, notes=[],
+                                axes=[types.SimpleNamespace(direction=np.array([0, 0, 1.0]))])
+    asm.part = lambda n: next(p for p in parts if p.name == n)
+    Ts = [{"A": _T(), "B": _T(_rot_z(0.5 * k), (0.0, 0.0, 0.0)), "C": _T()} for k in range(5)]
+    FT.add_feet(asm, Ts)
+    assert set(asm.feet) == {"A", "B"}
+    A = asm.part("A").solid
+    assert np.asarray(A.bounding_box())[2] == pytest.approx(0.0, abs=1e-9)
+    assert 0.6 * 30 * mw < A.slice(0.1).area() < 30 * mw * 1.3
+    for n in "AB":
+        assert thin_walls(n, asm.part(n).solid, mw) == [], n
+    for T in [{n: np.eye(4) for n in "ABC"}] + Ts:
+        for X, Y in (("A", "C"), ("B", "C"), ("A", "B")):
+            M = np.linalg.solve(T[X], T[Y])
+            g = asm.part(X).solid.min_gap(transform_solid(asm.part(Y).solid, M), 2 * c)
+            assert g >= c - 1e-6, (X, Y, g)
+
+
 def test_without_feet_nothing_changes():
     asm, Ts = _toy()
     vol = [p.solid.volume() for p in asm.parts]

@@ -24,9 +24,14 @@ two economies (poses that move the other part by at most :data:`FOOT_MERGE_MM` f
 taken share its shadow; the shadows' union and the foot's outline are simplified to
 :data:`FOOT_SIMPLIFY_MM`: 12 s for NAND fdm's 814 poses, not minutes).  So each foot
 keeps the clearance from every other part in every one of those poses (the ``min_gap``,
-``states`` and ``motion_clearance`` checks measure it again on the finished parts).  Slivers
-narrower than :data:`FOOT_OPEN` x the minimum wall (a morphological opening) and pieces under
-:data:`FOOT_MIN_AREA` x min_feature^2 are dropped.
+``states`` and ``motion_clearance`` checks measure it again on the finished parts).  The
+section is simplified, slivers narrower than :data:`FOOT_OPEN` x the minimum wall (a
+morphological opening) and pieces under :data:`FOOT_MIN_AREA` x min_feature^2 are dropped, and
+what is left grows by :data:`FOOT_GROW` x the minimum wall (the shadows were grown by twice that
+more): every foot is at least (FOOT_OPEN + 2 FOOT_GROW) x the minimum wall across, wider by
+FOOT_GROW on each side than a slab of the minimum wall it carries, and passes the measured wall
+check (session 38; until then the opened section was simplified after, which left feet under the
+minimum: 0.515-0.591 mm at mjp, 0.903-1.183 mm at fdm, ``mesh_gates_walls_s37*.json``).
 
 The feet are real solid material of the part (the slicer prints them; they are vertical prisms,
 so they need no support of their own), unioned with it before the orientation is chosen.  The
@@ -59,6 +64,11 @@ FOOT_MERGE_MM = 0.1
 FOOT_SIMPLIFY_MM = 0.02
 #: slivers narrower than this many minimum walls are dropped from a foot's section
 FOOT_OPEN = 0.9
+#: ... and what is left is grown by this many minimum walls (the other parts' shadows by twice as
+#: much more): every point of a foot's section lies in a disc of (FOOT_OPEN + 2 FOOT_GROW) minimum
+#: walls inside it, so the foot's walls are at least that (session 38: opened at FOOT_OPEN alone
+#: and then simplified, a foot under a slab of the minimum wall measured 0.515-0.591 mm at mjp)
+FOOT_GROW = 0.1
 #: pieces of a foot's section smaller than this many min_feature^2 are dropped
 FOOT_MIN_AREA = 1.0
 #: a part is planar when its rotation turns d by less than this (rad) in every pose ...
@@ -218,7 +228,8 @@ def add_feet(asm, Ts: list, names: list | None = None) -> list:
         keep_out = []
         TX = np.array([T[X] for T in Ts])
         sb = np.asarray(sec.bounds(), float).ravel()          # only shadows near the section matter
-        reach = grow + slack + 1e-3
+        g = FOOT_GROW * prof.min_wall
+        reach = grow + slack + 2 * g + 1e-3
 
         def near(b):
             return bool(b[0] <= sb[2] + reach and sb[0] <= b[2] + reach and b[1] <= sb[3] + reach
@@ -252,16 +263,21 @@ def add_feet(asm, Ts: list, names: list | None = None) -> list:
                     if sh is not None:
                         keep_out.append(sh)
         if keep_out:
+            # (grown by 2 g more: this foot grows by g below, and so may the other's)
             away = mf.CrossSection.batch_boolean(keep_out, mf.OpType.Add).simplify(FOOT_SIMPLIFY_MM).offset(
-                grow + slack, mf.JoinType.Round, 2.0, seg)
+                grow + slack + 2 * g, mf.JoinType.Round, 2.0, seg)
             sec = sec - away
+        # simplified first, then opened and grown: nothing thins the section after
+        sec = sec.simplify(FOOT_SIMPLIFY_MM)
         w = FOOT_OPEN * prof.min_wall / 2
         if w > 0 and not sec.is_empty():
             sec = sec.offset(-w, mf.JoinType.Round, 2.0, seg).offset(w, mf.JoinType.Round, 2.0, seg) ^ sec
         pieces = [x for x in sec.decompose() if x.area() >= FOOT_MIN_AREA * prof.min_feature ** 2]
         if not pieces:
             continue
-        sec = mf.CrossSection.batch_boolean(pieces, mf.OpType.Add).simplify(FOOT_SIMPLIFY_MM)
+        sec = mf.CrossSection.batch_boolean(pieces, mf.OpType.Add)
+        if g > 0:
+            sec = sec.offset(g, mf.JoinType.Round, 2.0, seg)
         # from the bed up into the part (FOOT_EPS of overlap: one solid after the union)
         foot = mf.Manifold.extrude(sec, top - bed).translate([0.0, 0.0, bed])
         foot = transform_solid(foot, Fi)
