@@ -605,3 +605,32 @@ def test_the_fast_router_builds_a_full_adder_that_computes_every_row():
     rep = verify_static(fast.scene)
     assert rep.ok and len(rep.rows) == 8, format_report(rep)
     assert min(r["clearance"] for r in rep.rows) > 0, format_report(rep)
+
+
+def test_the_contact_test_builds_only_the_layers_it_measures_and_finds_the_same_contacts(monkeypatch):
+    """``_state_contacts`` builds the boxes of the candidate layers alone
+    (``_chain_parts(..., only=...)``, the last half unit with its longer post as the whole
+    chain makes it): its contacts are the same, clearance for clearance, as those measured on
+    the whole chains' boxes (the full adder, wires g4 and g5 routed first, contact margin
+    raised to 0.6 sigma so that there are contacts, the last half units among them)."""
+    from mlc.circuit import build as B
+    spec = load("examples/full_adder.tt", None)
+    c = compile_spec(spec)
+    monkeypatch.setattr(B, "CONTACT_MARGIN", 0.6)
+    monkeypatch.setattr(B, "_rip_up_contacts", _no_contact_rip_up)
+    routed = {}
+    real_rip = B._rip_up
+
+    def keep(r, *a, **k):
+        routed.update(r)
+        return real_rip(r, *a, **k)
+    monkeypatch.setattr(B, "_rip_up", keep)
+    B._build_circuit(c.netlist, spec, B.CircuitOptions(), first_wires=("g4", "g5"))
+    geo = next(iter(routed.values())).geo_ext[0]
+    fast = B._state_contacts(routed, geo)
+    real = B._chain_parts
+    monkeypatch.setattr(B, "_chain_parts", lambda ch, geo, flip=0, only=None: real(ch, geo, flip))
+    whole = B._state_contacts(routed, geo)
+    assert len(fast) > 20 and fast == whole
+    last = {t: len(ch.route.bends) - 1 for t, ch in routed.items()}
+    assert any(k.i == last[k.a] or k.j == last[k.b] for k in fast)

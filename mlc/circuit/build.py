@@ -41,8 +41,9 @@ from functools import lru_cache
 import numpy as np
 
 from mlc.errors import MlcError
-from mlc.gates.connector import (POST_WIDTH, Pair, Parts, branch_angles, chain_parts, connector_geometry,
-                                 half_unit_parts, half_unit_prefix, join, junction_stops, max_bend, rotate)
+from mlc.gates.connector import (POST_WIDTH, Pair, Parts, branch_angles, chain_frames, chain_parts,
+                                 connector_geometry, half_unit_parts, half_unit_prefix, join, junction_stops,
+                                 max_bend, rotate)
 from mlc.gates.parts import slab_body
 from mlc.scene.model import Body, Bond, Muscle, Probe, Scene
 
@@ -795,19 +796,36 @@ class _Chain:
         return _layers(self.route if route is None else route, *self.geo_ext)
 
 
-def _chain_parts(ch: _Chain, geo, flip: int = 0):
+def _chain_parts(ch: _Chain, geo, flip: int = 0, only=None):
     """The half units of routed chain ``ch`` as assembled (bodies posed as built, the
     junction bonds and stops), each layer in its state of the all-zero row, or with
     ``flip`` in the other one (every layer of a chain flips when its wire does).  The last
     half unit's output post is longer, so that its layer clears the lever plane.
-    Returns (parts, pairs, the last half unit's output pair)."""
+    Returns (parts, pairs, the last half unit's output pair).  ``only`` (a set of
+    indices): the bodies of those half units alone, as in the whole chain (parts only)."""
     tag = ch.tag
     _, start, tap, _, sstate, stop_at_tap, _, _, ext = ch.ctx
     route = ch.route
     state = sstate ^ flip
-    parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, state, geo,
-                               in_stop=stop_at_tap if start is tap else POST_WIDTH, stops=True)
     last = len(route.bends) - 1
+    in0 = stop_at_tap if start is tap else POST_WIDTH
+    if only is not None:
+        parts, _ = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, state, geo,
+                               in_stop=in0, only=set(only) - {last})
+        if last in only:            # the last half unit from the same pairs as below
+            cs, us, ts = chain_frames(route.centre, route.axis, route.tangent, route.bends, geo.pitch)
+
+            def unit(i):
+                return half_unit_parts(f"{tag}_{i}", cs[i], us[i], ts[i], (state + i) % 2, geo,
+                                       in_stop=in0 if i == 0 else POST_WIDTH)
+            cs_in = unit(last - 1)[2] if last > 0 else unit(0)[1]
+            out = unit(last)[2]
+            t_last = (out.centre - cs_in.centre) / np.linalg.norm(out.centre - cs_in.centre)
+            parts.add(half_unit_parts(f"{tag}_{last}", cs_in.centre, cs_in.axis, t_last, state ^ (last % 2), geo,
+                                      out_post=0.5 * geo.gap + ext, out_stop=LEVER_STOP)[0])
+        return parts, None, None
+    parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, state, geo,
+                               in_stop=in0, stops=True)
     for b in list(parts.bodies):
         if b.name.startswith(f"{tag}_{last}_"):
             parts.bodies.remove(b)
@@ -833,12 +851,20 @@ def _state_contacts(routed: dict, geo, tags=None, cache: dict | None = None) -> 
     if tags is not None:
         pairs = [p for p in pairs if p[0] in tags or p[2] in tags]
     cache = {} if cache is None else cache
+    need: dict = {}
+    for a, i, b, j in pairs:
+        need.setdefault(a, set()).add(i)
+        need.setdefault(b, set()).add(j)
 
-    def boxes(tag, flip):
+    def boxes(tag, flip):           # the layers the pairs need, made once per route
         route = routed[tag].route
         hit = cache.get((tag, flip))
         if hit is None or hit[0] is not route:
-            hit = cache[(tag, flip)] = (route, layer_boxes(_chain_parts(routed[tag], geo, flip)[0].bodies, tag))
+            hit = cache[(tag, flip)] = (route, {}, set())
+        missing = need[tag] - hit[2]
+        if missing:
+            hit[1].update(layer_boxes(_chain_parts(routed[tag], geo, flip, only=missing)[0].bodies, tag))
+            hit[2].update(missing)
         return hit[1]
     return state_contacts(pairs, boxes, {t: routed[t].ctx[0] for t in centres})
 

@@ -49,7 +49,7 @@ import numpy as np
 
 from mlc.gates.library import SIGNALS, Design, _check_signal, load_design
 from mlc.gates.parts import axis_sites, hinge, muscle, segment_box, slab_body, universal_joint
-from mlc.geometry.rotation import expmap
+from mlc.geometry.rotation import cross3, expmap
 from mlc.scene.model import Body, Bond, Muscle, Probe, Scene
 
 _EX = np.array([1.0, 0.0, 0.0])
@@ -191,7 +191,7 @@ def half_unit_parts(prefix: str, centre, axis, tangent, state: int, geo: Connect
     c, u, t = np.asarray(centre, float), _unit(axis), _unit(tangent)
     if abs(float(u @ t)) > 1e-9:
         raise ValueError("a half unit's tangent must be perpendicular to its input axis")
-    v = np.cross(t, u)
+    v = cross3(t, u)
     Lin, Lout = geo.length(state), geo.length(1 - state)
     w = geo.width
     mid = c + (in_post + 0.5 * w) * t              # layer mid-plane centre
@@ -273,7 +273,7 @@ def chain_frames(centre, axis, tangent, bends, pitch: float):
     for i in range(len(bends)):
         ts.append(t)
         cs.append(cs[-1] + pitch * t)
-        us.append(np.cross(t, us[-1]))
+        us.append(cross3(t, us[-1]))
         if i + 1 < len(bends):
             t = rotate(t, us[-1], bends[i + 1])
     return cs, us, ts
@@ -281,16 +281,23 @@ def chain_frames(centre, axis, tangent, bends, pitch: float):
 
 def chain_parts(prefix: str, centre, axis, tangent, bends, state: int, geo: ConnectorGeometry,
                 k: float | None = None, tolerance: float = 0.0,
-                in_stop: float = POST_WIDTH, stops: bool = False) -> tuple[Parts, list[Pair]]:
+                in_stop: float = POST_WIDTH, stops: bool = False, only=None) -> tuple[Parts, list[Pair]]:
     """A chain of ``len(bends)`` half units (see :func:`chain_frames`), the first input pair
     carrying ``state``.  Consecutive half units are joined by two universal joints, and
     with ``stops`` by the :func:`junction_stops` bond that keeps their layers apart.
     ``in_stop``: how far the first half unit's input posts stop short of their joints (see
     :func:`half_unit_parts`).  Returns (parts, pairs) with pairs[0] the chain's input and
-    pairs[-1] its output."""
+    pairs[-1] its output.  ``only`` (a set of indices): only those half units' bodies (the
+    same bodies as in the whole chain; no bonds, no pairs): what a test of a few layers needs."""
     cs, us, ts = chain_frames(centre, axis, tangent, bends, geo.pitch)
     parts, pairs = Parts(), []
     k = geo.k if k is None else k
+    if only is not None:
+        for i in sorted(only):
+            if 0 <= i < len(ts):
+                parts.add(half_unit_parts(f"{prefix}_{i}", cs[i], us[i], ts[i], (state + i) % 2, geo,
+                                          in_stop=in_stop if i == 0 else POST_WIDTH)[0])
+        return parts, pairs
     for i, t in enumerate(ts):
         p, pin, pout = half_unit_parts(f"{prefix}_{i}", cs[i], us[i], t, (state + i) % 2, geo,
                                        in_stop=in_stop if i == 0 else POST_WIDTH)

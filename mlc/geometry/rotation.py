@@ -77,6 +77,14 @@ def rotation_between(u, v) -> np.ndarray:
     return expmap(ax / s * np.arctan2(s, c))
 
 
+def cross3(a, b) -> np.ndarray:
+    """``np.cross`` of two 3-vectors, bit for bit (the same products and differences, each
+    rounded once), without its general-shape overhead: the builders call it for every slab."""
+    a0, a1, a2 = np.asarray(a, float).tolist()
+    b0, b1, b2 = np.asarray(b, float).tolist()
+    return np.array([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0])
+
+
 def frame_matrix(x_axis, y_axis) -> np.ndarray:
     """Rotation whose columns are the orthonormalised ``x_axis``, ``y_axis`` and their cross."""
     x = np.asarray(x_axis, float)
@@ -84,4 +92,4 @@ def frame_matrix(x_axis, y_axis) -> np.ndarray:
     y = np.asarray(y_axis, float)
     y = y - np.dot(y, x) * x
     y /= np.linalg.norm(y)
-    return np.column_stack([x, y, np.cross(x, y)])
+    return np.array((x, y, cross3(x, y))).T
