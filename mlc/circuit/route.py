@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 from numba import njit
@@ -78,8 +79,16 @@ def _bezier(p0, d0, p3, d3, k=64):
     """Points of the cubic Bezier from p0 (leaving along d0) to p3 (arriving along d3)."""
     L = float(np.linalg.norm(p3 - p0))
     p1, p2 = p0 + 0.4 * L * d0, p3 - 0.4 * L * d3
+    b0, b1, b2, b3 = _bernstein(k)
+    return b0 * p0 + b1 * p1 + b2 * p2 + b3 * p3
+
+
+@lru_cache(maxsize=4)
+def _bernstein(k: int):
+    """The cubic Bernstein weights at ``k`` points from 0 to 1, each a (k, 1) column, computed
+    as the Bezier's expression computes them (the same numbers, made once)."""
     s = np.linspace(0.0, 1.0, k)[:, None]
-    return (1 - s) ** 3 * p0 + 3 * (1 - s) ** 2 * s * p1 + 3 * (1 - s) * s ** 2 * p2 + s ** 3 * p3
+    return (1 - s) ** 3, 3 * (1 - s) ** 2 * s, 3 * (1 - s) * s ** 2, s ** 3
 
 
 def _steer(c0, u0, t0, guide, pitch, bmax, free_start, max_half):
@@ -550,7 +559,7 @@ def _fast_avoid(route: Route, P, e1, e2, app, geo, last_pitch, bmax, start_lim, 
     no_k, no_p = np.zeros(0, np.int64), np.zeros((0, 3))
     head = 5 + (3 if has_app else 0)
     buf = np.empty(head + n - 1)
-    Jb = np.empty((head + n - 1, n))
+    Jb = np.empty((head, n))
     near_q = np.zeros((len(sets) * n_av, 3))
     near_d = np.full(len(sets) * n_av, np.inf)
     Ja = np.empty((near_d.size, n))
@@ -630,45 +639,84 @@ def _lm_close(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, app, scale=None, wps=()
     tangent, weight 2 w_soft) and the waypoints ``wps`` ((index, point), weight
     w_soft wp_weight), inside the bounds: each step is the smallest in the metric
     ``scale`` x the room towards the bound the descent heads for (Coleman and Li), then
-    projected onto the bounds.  Returns the bends (rad)."""
+    projected onto the bounds (:func:`_lm_close_kernel`, compiled).  Returns the bends (rad)."""
     n = x.shape[0]
-    cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
     has_app = app is not None and w_soft > 0
     app_v = np.zeros(3) if app is None else np.asarray(app, float)
     wps = [(k, p) for k, p in wps if 0 < k <= n] if w_soft > 0 else []
     wp_k = np.array([k for k, _ in wps], dtype=np.int64)
     wp_p = np.array([p for _, p in wps], dtype=float).reshape(-1, 3)
-    rows = 5 + (3 if has_app else 0) + 3 * len(wp_k)
-    J = np.empty((rows + (n - 1), n))
+    sc = np.ones(n) if scale is None else np.ascontiguousarray(scale, dtype=np.float64)
+    return _lm_close_kernel(np.array(x, dtype=np.float64), np.asarray(lo, float), np.asarray(hi, float),
+                            np.asarray(c0, float), np.asarray(u0, float), np.asarray(t0, float),
+                            np.asarray(pitches, float), np.asarray(P, float), np.asarray(e1, float),
+                            np.asarray(e2, float), has_app, app_v, wp_k, wp_p, float(w_soft), float(wp_weight), sc,
+                            CLOSE_STEPS, 10.0 * EXACT * CLOSE_MARGIN)
+
+
+@njit(cache=True)
+def _lm_close_kernel(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, has_app, app, wp_k, wp_p, w_soft, wp_weight, sc,
+                     steps, close_tol):
+    """:func:`_lm_close`'s iterations: at most ``steps``; the closure alone stops within
+    ``close_tol`` (its rows' largest residual); with soft rows, at a relative decrease
+    under 1e-6; a step refused until the damping passes 1e6 ends it."""
+    n = x.shape[0]
+    cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
+    rows = 5 + (3 if has_app else 0) + 3 * wp_k.shape[0]
+    J = np.empty((rows, n))                 # the rows used: not the small-bend rows
     out = np.empty(rows + (n - 1))
-    sc = np.ones(n) if scale is None else np.asarray(scale, float)
-    half = np.maximum(0.5 * (hi - lo), 1e-12)
-
-    def resid(b):
-        _fk_kernel(c0, u0, t0, b, pitches, cs, us, ts, True)
-        _resid_kernel(cs, us, ts, b, P, e1, e2, has_app, app_v, wp_k, wp_p, w_soft, wp_weight, out)
-        return out[:rows].copy()
-
-    x = np.clip(np.ascontiguousarray(x, dtype=np.float64), lo, hi)
-    r = resid(x)
-    f = float(r @ r)
+    half = np.empty(n)
+    for i in range(n):
+        half[i] = max(0.5 * (hi[i] - lo[i]), 1e-12)
+        x[i] = min(max(x[i], lo[i]), hi[i])
+    _fk_kernel(c0, u0, t0, x, pitches, cs, us, ts, True)
+    _resid_kernel(cs, us, ts, x, P, e1, e2, has_app, app, wp_k, wp_p, w_soft, wp_weight, out)
+    r = out[:rows].copy()
+    f = 0.0
+    for k in range(rows):
+        f += r[k] * r[k]
     mu = 1e-6
-    for _ in range(CLOSE_STEPS):
-        if rows == 5 and max(abs(r)) < 10.0 * EXACT * CLOSE_MARGIN:
-            break
+    D = np.empty(n)
+    A = np.empty((rows, n))
+    M = np.empty((rows, rows))
+    x_new = np.empty(n)
+    for _ in range(steps):
+        if rows == 5:
+            big = 0.0
+            for k in range(5):
+                big = max(big, abs(r[k]))
+            if big < close_tol:
+                break
         _jac_kernel(cs, us, ts, e1, e2, has_app, wp_k, w_soft, wp_weight, J)
-        g = J[:rows].T @ r                  # Coleman-Li: room towards the bound the descent heads for
-        room = np.sqrt(np.clip(np.where(g < 0, hi - x, x - lo), 0.0, None) / half)
-        D = sc * room
-        A = J[:rows] * D
-        M = A @ A.T
-        tr = float(np.trace(M)) / rows
+        for i in range(n):
+            g = 0.0
+            for k in range(rows):
+                g += J[k, i] * r[k]
+            room = hi[i] - x[i] if g < 0 else x[i] - lo[i]
+            D[i] = sc[i] * math.sqrt(max(room, 0.0) / half[i])
+            for k in range(rows):
+                A[k, i] = J[k, i] * D[i]
+        M[:, :] = np.dot(A, A.T)
+        tr = 0.0
+        for a in range(rows):
+            tr += M[a, a]
+        tr /= rows
+        f_new = f
         while True:
-            z = np.linalg.solve(M + mu * tr * np.eye(rows), -r)
-            step = D * (A.T @ z)
-            x_new = np.clip(x + step, lo, hi)          # projected onto the bounds
-            r_new = resid(x_new)
-            f_new = float(r_new @ r_new)
+            Md = M.copy()
+            for a in range(rows):
+                Md[a, a] += mu * tr
+            z = np.linalg.solve(Md, -r)
+            for i in range(n):
+                st = 0.0
+                for k in range(rows):
+                    st += A[k, i] * z[k]
+                x_new[i] = min(max(x[i] + D[i] * st, lo[i]), hi[i])
+            _fk_kernel(c0, u0, t0, x_new, pitches, cs, us, ts, True)
+            _resid_kernel(cs, us, ts, x_new, P, e1, e2, has_app, app, wp_k, wp_p, w_soft, wp_weight, out)
+            f_new = 0.0
+            for k in range(rows):
+                f_new += out[k] * out[k]
             if f_new < f:
                 mu = max(mu / 4.0, 1e-9)
                 break
@@ -676,9 +724,10 @@ def _lm_close(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, app, scale=None, wps=()
             if mu > 1e6:
                 return x
         if rows > 5 and f - f_new < 1e-6 * f:
-            x = x_new
-            break
-        x, r, f = x_new, r_new, f_new
+            return x_new.copy()
+        x[:] = x_new
+        r[:] = out[:rows]
+        f = f_new
     return x
 
 
@@ -1000,7 +1049,7 @@ def _jac_kernel(cs, us, ts, e1, e2, has_app, wp_k, w_soft, wp_weight, J):
                 J[r + 1, i] = w_soft * wp_weight * (uz * dx - ux * dz)
                 J[r + 2, i] = w_soft * wp_weight * (ux * dy - uy * dx)
             r += 3
-        if i >= 1:
+        if i >= 1 and r + i - 1 < J.shape[0]:       # (a J of the first rows only: without them)
             J[r + i - 1, i] = w_soft * 0.05
 
 
