@@ -465,7 +465,7 @@ def _solve_route(c0, u0, target_c, target_a, geo: ConnectorGeometry, parity: int
         x = _polish(np.array(r.bends), lo, hi, c0, u0, t0, pitches, P, e1, e2)
         cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
         _fk_kernel(c0, u0, t0, x, pitches, cs, us, ts, True)
-        err = float(max(np.linalg.norm(cs[-1] - P), abs(us[-1] @ e1), abs(us[-1] @ e2)))
+        err = _closure_error(cs, us, P, e1, e2)
         aerr = 0.0 if app is None else float(np.linalg.norm(ts[-1] - app))
         if DEBUG:
             print("polished", n, "error", r.error, "->", err, "approach", aerr)
@@ -517,19 +517,37 @@ def _solve_fast(c0, u0, t0, P, e1, e2, app, guide, waypoints, geo, parity, bmax,
             if k >= n - FAST_HOLD:
                 wps.append((k, w))
         x = _lm_close(x0, lo, hi, c0, u0, t0, pitches, P, e1, e2, app, scale, wps, 1.0, wp_weight)
-        cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
-        for widen in (1.0, 3.0):        # a closure stalled on bends at their bounds: let more bends move
-            x = _lm_close(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, None, scale ** (1.0 / widen), (), 0.0)
-            _fk_kernel(c0, u0, t0, x, pitches, cs, us, ts, True)
-            err = float(max(np.linalg.norm(cs[-1] - P), abs(us[-1] @ e1), abs(us[-1] @ e2)))
-            if err < EXACT:
-                break
-        aerr = 0.0 if app is None else float(np.linalg.norm(ts[-1] - app))
-        if DEBUG:
-            print("fast", n, "error", err, "approach", aerr)
-        if err < EXACT and aerr < 0.5:
-            return Route(c0, u0, t0, [float(v) for v in x], err, aerr)
+        r = _close_exactly(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, app, scale)
+        if r is not None:
+            return r
     return None
+
+
+def _close_exactly(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, app, scale) -> Route | None:
+    """The fast method's last pass: :func:`_lm_close` on the closure alone from bends ``x``
+    in the metric ``scale``, again with it three times wider where it stalled (bends at
+    their bounds: let more bends move); the route if it closes within ``EXACT`` with the
+    last tangent within 0.5 of ``app``, else None."""
+    n = x.shape[0]
+    cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
+    for widen in (1.0, 3.0):
+        x = _lm_close(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, None, scale ** (1.0 / widen), (), 0.0)
+        _fk_kernel(c0, u0, t0, x, pitches, cs, us, ts, True)
+        err = _closure_error(cs, us, P, e1, e2)
+        if err < EXACT:
+            break
+    aerr = 0.0 if app is None else float(np.linalg.norm(ts[-1] - app))
+    if DEBUG:
+        print("fast", n, "error", err, "approach", aerr)
+    if err < EXACT and aerr < 0.5:
+        return Route(c0, u0, t0, [float(v) for v in x], err, aerr)
+    return None
+
+
+def _closure_error(cs, us, P, e1, e2) -> float:
+    """How far a chain's last pair is from closing: its centre's distance from ``P`` and
+    its axis's components across the target axis (``e1``, ``e2``), the largest (sigma)."""
+    return float(max(np.linalg.norm(cs[-1] - P), abs(us[-1] @ e1), abs(us[-1] @ e2)))
 
 
 def _fast_avoid(route: Route, P, e1, e2, app, geo, last_pitch, bmax, start_lim, end_bends, avoid,
@@ -612,17 +630,8 @@ def _fast_avoid(route: Route, P, e1, e2, app, geo, last_pitch, bmax, start_lim, 
                 x = x_new
             break
         x, r, f = x_new, r_new, f_new
-    scale = np.exp(-(n - 1 - np.arange(n)) / FAST_TAIL)
-    for widen in (1.0, 3.0):
-        x = _lm_close(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, None, scale ** (1.0 / widen), (), 0.0)
-        _fk_kernel(c0, u0, t0, x, pitches, cs, us, ts, True)
-        err = float(max(np.linalg.norm(cs[-1] - P), abs(us[-1] @ e1), abs(us[-1] @ e2)))
-        if err < EXACT:
-            break
-    aerr = 0.0 if app is None else float(np.linalg.norm(ts[-1] - app))
-    if err < EXACT and aerr < 0.5:
-        return Route(c0, u0, t0, [float(v) for v in x], err, aerr)
-    return None
+    return _close_exactly(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, app,
+                          np.exp(-(n - 1 - np.arange(n)) / FAST_TAIL))
 
 
 AVOID_STEPS = 100           # iterations of the fast method's push away from ``avoid`` at most
@@ -763,7 +772,7 @@ def _polish(x, lo, hi, c0, u0, t0, pitches, P, e1, e2, margin: float = 1e-9) -> 
 
     def error(b) -> float:
         _fk_kernel(c0, u0, t0, b, pitches, cs, us, ts, True)
-        return float(max(np.linalg.norm(cs[-1] - P), abs(us[-1] @ e1), abs(us[-1] @ e2)))
+        return _closure_error(cs, us, P, e1, e2)
 
     x = np.clip(np.ascontiguousarray(x, dtype=np.float64), lo, hi)
     err = error(x)
@@ -940,7 +949,7 @@ def _solve_n(n, c0, u0, t0, P, e1, e2, app, x0, pitches, bmax, free_start, wps=(
 
     def errors(x):
         cs, us, ts = _fk(c0, u0, t0, x, pitches)
-        err = float(max(np.linalg.norm(cs[-1] - P), abs(us[-1] @ e1), abs(us[-1] @ e2)))
+        err = _closure_error(cs, us, P, e1, e2)
         return err, (0.0 if app is None else float(np.linalg.norm(ts[-1] - app)))
 
     # passes: soft terms on (shape the chain), then nearly off (close exactly); a last,
