@@ -51,6 +51,7 @@ from pathlib import Path
 import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
 import numpy as np
 
+from gitstate import commit
 from mlc.circuit.build import CircuitOptions, build_circuit
 from mlc.errors import MlcError
 from mlc.io.atomic import atomic_path
@@ -121,7 +122,7 @@ def adder_point(w: int, family: str = "adder", on_built=None, verify_budget: flo
     row = "1" * len(sc.inputs)
     point = {"family": family, "width": w, "gates": len(c.netlist.gates), "bodies": len(sc.bodies), "chains": circ.chains,
             "half_units": circ.half_units, "build_s": t_build, "build_cpu_s": c_build, "load": load0, "jobs": jobs,
-            "router": router,
+            "router": router, "commit": commit(),
             "route_solves": route.CACHE_HITS[1] - hits0[1], "route_repeats": route.CACHE_HITS[0] - hits0[0],
             "tight_chains": sc.meta["connector"]["tight_chains"], "build_parts_s": circ.seconds,
             "state_contacts": sc.meta["connector"].get("state_contacts", []),
