@@ -83,7 +83,9 @@ def feet_widths(asm) -> dict:
             bed, top = float(pb[5]), float(fb[5])
         z = 0.5 * (bed + top)
         cs = part.slice(z)
-        pieces = cs.decompose()
+        # (a part that reaches the bed without its foot is not cut in its foot: nothing measured;
+        # the results file of session 38 records such a part's empty section as width Infinity)
+        pieces = [p for p in cs.decompose() if p.area() > 0] if abs(top - bed) > 1e-6 else []
         out[name] = {"z_mm": round(z, 3), "foot_mm": round(abs(top - bed), 3), "pieces": len(pieces),
                      "area_mm2": round(cs.area(), 3),
                      "width_mm": round(min(width(p) for p in pieces), 4) if pieces else None}
