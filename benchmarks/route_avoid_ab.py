@@ -24,8 +24,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import os
-import platform
 import time
 from pathlib import Path
 
@@ -33,10 +31,8 @@ import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.
 import numpy as np
 from scipy.spatial import cKDTree
 
-from gitstate import commit
 from mlc.circuit import route as R
-from mlc.io.atomic import atomic_path
-from route_fast_ab import closure, record_solves
+from route_fast_ab import closure, record_solves, write
 
 OUT = Path(__file__).resolve().parent / "results"
 
@@ -98,16 +94,8 @@ def main():
         "closure_max_ik": max(r["ik"]["closure"] for r in both),
         "closure_max_fast": max(r["fast"]["closure"] for r in both),
     }
-    res = {"what": f"every avoid re-solve of the fast build of nand_mesh(7, {args_.depth}), solved again by "
-                   "each method", "commit": commit(),
-           "machine": {"platform": platform.platform(), "cpus": os.cpu_count(), "load": os.getloadavg()[0]},
-           "units": "sigma, s (CPU of this process)", "summary": summary, "rows": rows}
-    OUT.mkdir(exist_ok=True)
-    path = OUT / "route_avoid_ab.json"
-    with atomic_path(path) as tmp:
-        Path(tmp).write_text(json.dumps(res, indent=1))
-    print(json.dumps(summary, indent=1))
-    plot(res, path.with_suffix(".png"))
+    write(f"every avoid re-solve of the fast build of nand_mesh(7, {args_.depth}), solved again by each method",
+          summary, rows, OUT / "route_avoid_ab.json", plot)
 
 
 def plot(res: dict, png: Path) -> None:

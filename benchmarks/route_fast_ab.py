@@ -138,16 +138,21 @@ def main():
         "half_units_mean_ik": float(np.mean([r["ik"]["n"] for r in both])),
         "half_units_mean_fast": float(np.mean([r["fast"]["n"] for r in both])),
     }
-    res = {"what": f"every lane solve of the ik build of nand_mesh(7, {args_.depth}), solved again by each method",
-           "commit": commit(), "machine": {"platform": platform.platform(), "cpus": os.cpu_count(),
-                                           "load": os.getloadavg()[0]},
+    write(f"every lane solve of the ik build of nand_mesh(7, {args_.depth}), solved again by each method",
+          summary, rows, OUT / "route_fast_ab.json", plot)
+
+
+def write(what: str, summary: dict, rows: list, path: Path, plot_fn) -> None:
+    """Write an A/B result (``what``, the commit, the machine, ``summary``, ``rows``) to
+    ``path`` and its picture (``plot_fn(res, png)``) beside it."""
+    res = {"what": what, "commit": commit(),
+           "machine": {"platform": platform.platform(), "cpus": os.cpu_count(), "load": os.getloadavg()[0]},
            "units": "sigma, s (CPU of this process)", "summary": summary, "rows": rows}
-    OUT.mkdir(exist_ok=True)
-    path = OUT / "route_fast_ab.json"
+    path.parent.mkdir(exist_ok=True)
     with atomic_path(path) as tmp:
         Path(tmp).write_text(json.dumps(res, indent=1))
     print(json.dumps(summary, indent=1))
-    plot(res, path.with_suffix(".png"))
+    plot_fn(res, path.with_suffix(".png"))
 
 
 def plot(res: dict, png: Path) -> None:
