@@ -62,6 +62,9 @@ FOOT_MERGE_MM = 0.1
 #: the shadows' union and a foot's outline are simplified to this (mm; the shadows are grown by
 #: twice as much more)
 FOOT_SIMPLIFY_MM = 0.02
+#: a grown foot's outline is simplified to this (mm): its near-duplicate vertices merged, the foot
+#: thinner by at most twice this, far inside FOOT_GROW's margin over the minimum wall
+FOOT_DEDUP_MM = 0.001
 #: slivers narrower than this many minimum walls are dropped from a foot's section
 FOOT_OPEN = 0.9
 #: ... and what is left is grown by this many minimum walls (the other parts' shadows by twice as
@@ -277,7 +280,9 @@ def add_feet(asm, Ts: list, names: list | None = None) -> list:
             continue
         sec = mf.CrossSection.batch_boolean(pieces, mf.OpType.Add)
         if g > 0:
-            sec = sec.offset(g, mf.JoinType.Round, 2.0, seg)
+            # (then the grown outline's near-duplicate vertices merged, FOOT_DEDUP_MM: left in,
+            # they extrude into walls of zero width that float32 STL splits off the part)
+            sec = sec.offset(g, mf.JoinType.Round, 2.0, seg).simplify(FOOT_DEDUP_MM)
         # from the bed up into the part (FOOT_EPS of overlap: one solid after the union)
         foot = mf.Manifold.extrude(sec, top - bed).translate([0.0, 0.0, bed])
         foot = transform_solid(foot, Fi)
