@@ -631,3 +631,93 @@ def test_the_contact_test_builds_only_the_layers_it_measures_and_finds_the_same_
     assert len(fast) > 20 and fast == whole
     last = {t: len(ch.route.bends) - 1 for t, ch in routed.items()}
     assert any(k.i == last[k.a] or k.j == last[k.b] for k in fast)
+
+
+def test_a_branch_chains_first_layers_are_held_apart_before_it_is_routed(monkeypatch):
+    """A chain of a branch is kept apart from its siblings' first layers even when it is
+    routed before them: each branch chain's head layers (``_head_layers``, straight on from
+    its page) are in the keep-apart space from the start, each chain sees every other
+    chain's (routed or held) when it is routed, and the held ones are where the routed
+    first layers come to lie, within a fraction of a layer's bound."""
+    from mlc.circuit import build as B
+    spec = load("examples/full_adder.tt", None)
+    c = compile_spec(spec)
+    seen, done = {}, {}
+    route_chain = B._route_chain
+
+    def spy(ch, lanes, space, space_clear, pf=None):
+        seen[ch.tag] = {tuple(np.round(p, 9)) for p in space.points(ch.tag)}
+        route_chain(ch, lanes, space, space_clear, pf)
+        done[ch.tag] = ch
+
+    monkeypatch.setattr(B, "_route_chain", spy)
+    B._build_circuit(c.netlist, spec, B.CircuitOptions(router="fast"))
+    branch = [ch for ch in done.values() if ch.skip]
+    assert len(branch) >= 4, "the full adder has fan-out: some chains start on branch pages"
+    for ch in branch:
+        heads = B._head_layers(ch)
+        assert heads.shape == (B.BRANCH_LAYERS, 3)
+        # every other branch chain's first layers were in the space this chain was routed in
+        for other in branch:
+            if other is not ch:
+                want = B._head_layers(other) if list(done).index(other.tag) > list(done).index(ch.tag) \
+                    else other.layers()[:other.skip]
+                got = seen[ch.tag]
+                assert all(tuple(np.round(p, 9)) in got for p in want), (ch.tag, other.tag)
+        # held where the routed chain starts: well within a layer's bounding radius
+        assert np.linalg.norm(ch.layers()[:ch.skip] - heads, axis=1).max() < 0.5 * B.LAYER_RADIUS
+
+
+def test_the_fast_routers_two_way_branch_pages_are_held_clear_of_each_other():
+    """In a fast build a 2-way branch's pages leave up and towards the routing planes
+    (``FAST_PAIR_PAGES``), with a stop between them (``_page_stop``): free while the pages
+    are at least ``PAGE_MIN_ANGLE`` apart about the pair they hang on, stiff when they close
+    further; their posts are long enough that at that angle the two pages' slabs are still
+    clear (exact box clearance), and closer than their posts allow they would touch."""
+    import math
+
+    from mlc.circuit import build as B
+    from mlc.geometry.rotation import expmap, matrix_to_quat, quat_to_matrix
+    spec = load("examples/full_adder.tt", None)
+    c = compile_spec(spec)
+    sc = build_circuit(c.netlist, spec, B.CircuitOptions(router="fast")).scene
+    stops = [b for b in sc.bonds if b.name.endswith("_pp")]
+    assert stops, "the full adder's 2-way branches get a page stop"
+    by = {b.name: b for b in sc.bodies}
+    for bond in stops:
+        p0, p1 = bond.a.split("_AB.")[0], bond.b.split("_AB.")[0]
+        names = [f"{p}_{s}" for p in (p0, p1) for s in ("AB", "BC", "CD", "DA")]
+        # the axis both pages turn about: through the joints of the second page's A and C posts
+        a, cpt = by[f"{p1}_AB"].world("A"), by[f"{p1}_CD"].world("C")
+        assert np.allclose(a, by[f"{p0}_AB"].world("A")) and np.allclose(cpt, by[f"{p0}_CD"].world("C"))
+        u = (cpt - a) / np.linalg.norm(cpt - a)
+        t0 = by[f"{p0}_AB"].world("stop_in") - a
+        t1 = by[f"{p1}_AB"].world("stop_in") - a
+        built = math.acos(float(t0 @ t1 / np.linalg.norm(t0) / np.linalg.norm(t1)))
+        assert abs(built - (B.FAST_PAIR_PAGES[1] - B.FAST_PAIR_PAGES[0])) < 1e-9
+        sign = 1.0 if float(np.cross(t1, t0) @ u) > 0 else -1.0    # turning p1 by +sign closes them
+
+        def posed(close):
+            """The two pages' bodies and their own bonds, p1 turned by ``close`` towards p0."""
+            R = expmap(sign * close * u)
+            sub = copy.copy(sc)
+            sub.bodies = [copy.deepcopy(by[n]) for n in names]
+            for b in sub.bodies:
+                if b.name.startswith(p1 + "_"):
+                    b.position = a + R @ (b.position - a)
+                    b.orientation = matrix_to_quat(R @ quat_to_matrix(b.orientation))
+            keep = set(names)
+            sub.bonds = [bd for bd in sc.bonds if {bd.a.split(".")[0], bd.b.split(".")[0]} <= keep]
+            return sub
+
+        def energy(sub):
+            bb = {b.name: b for b in sub.bodies}
+            d = np.linalg.norm(bb[bond.a.split(".")[0]].world("stop_in") - bb[bond.b.split(".")[0]].world("stop_in"))
+            return 0.5 * bond.k * max(0.0, abs(d - bond.rest) - bond.tolerance) ** 2
+
+        at_stop = built - B.PAGE_MIN_ANGLE
+        assert energy(posed(0.0)) == 0.0 and energy(posed(at_stop - 1e-3)) == 0.0
+        assert energy(posed(at_stop + 0.05)) > 0.0           # closer than the stop: held
+        assert clearance(posed(at_stop)).min_clearance > 0    # clear at the stop's angle
+        # and the stop is needed: the pages, free to close to 20 degrees apart, would touch
+        assert clearance(posed(built - math.radians(20.0))).min_clearance < 0

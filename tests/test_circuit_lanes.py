@@ -64,7 +64,7 @@ def test_space_nearest_matches_brute_force():
     brute_who = min(((np.linalg.norm(p - x), o) for x in q for p, o in placed if o != 2), key=lambda t: t[0])[1]
     assert d == got and who == brute_who
     sp.remove(who)
-    assert all(o != who for cell in sp.grid.values() for _, o in cell)
+    assert all(o != who for cell in sp.grid.values() for _, o, _ in cell)
     assert sp.nearest(q, 2) > got and len(sp.points(2)) == 30 * 3
     assert np.allclose(layer_centres([[0, 0, 0], [0, 0, 1], [0, 0, 3]]), [[0, 0, 0.5], [0, 0, 2]])
 
@@ -85,3 +85,27 @@ def test_the_bounding_box_shortcut_gives_the_measured_answer():
         assert _near(a, b, sep) == (d < sep)
         skipped += d >= sep
     assert skipped > 500
+
+
+def test_a_branchs_first_layers_are_exempt_only_from_each_other():
+    """Sibling chains' first layers (``head`` layers of one ``group``) pass each other by
+    in a test that names the group; every other pair of their layers is measured, and
+    ``remove`` forgets exactly one owner's layers (its cells' index kept with them)."""
+    sp = Space(0.9)
+    # chain "a" of wire W: two head layers at the branch, then a layer far along
+    sp.add(np.array([[0.0, 0, 0], [1, 0, 0], [5, 0, 0]]), "a", head=2, group="W")
+    sib_head = np.array([[0.0, 0.5, 0]])            # sibling's first layer, beside a's head
+    assert sp.nearest(sib_head, "b", exempt="W") == np.inf
+    assert sp.nearest(sib_head, "b") == 0.5          # not exempt: measured
+    # a sibling's later layer beside a's head: measured, whatever the group
+    assert abs(sp.nearest(np.array([[1.0, 0.7, 0]]), "b") - 0.7) < 1e-12
+    # a sibling's head beside a's layer far along (not a head): measured, exempt or not
+    assert abs(sp.nearest(np.array([[5.0, 0.6, 0]]), "b", exempt="W") - 0.6) < 1e-12
+    # another wire's head layers are not exempt from W's test
+    sp.add(np.array([[0.0, -0.4, 0]]), "c", head=1, group="V")
+    assert abs(sp.nearest(sib_head, "b", exempt="W") - 0.9) < 1e-12
+    sp.remove("c")
+    assert sp.nearest(sib_head, "b", exempt="W") == np.inf and "c" not in sp.cells_of
+    assert sorted(sp.cells_of) == ["a"] and sum(len(c) for c in sp.grid.values()) == 3
+    sp.remove("nobody")                              # nothing placed: nothing to do
+    assert sum(len(c) for c in sp.grid.values()) == 3

@@ -112,6 +112,8 @@ PIN_STAGGER = 2.5           # sigma: the far input's chain crosses under the gat
 PIN_END = 1.5               # sigma: and rises to its lever this far to its side of the gate (x)
 TAP_LEAN = math.radians(45.0)   # a single chain leaves a gate's output pair this far from up, towards -y
 TAP_TURN = math.radians(50.0)   # ... turned by at most this much about the pair's axis by the router
+FAST_PAIR_PAGES = (0.0, math.radians(90.0))   # "fast": a 2-way branch's pages, up and towards the planes
+PAGE_MIN_ANGLE = math.radians(60.0)            # ... held by a stop (_page_stop) from closing below this
 TAP_CONTACT = math.radians(85.0)   # its first layer meets the output lever's slabs about 90 deg from up
 TAP_FREE = (math.radians(10.0), math.radians(70.0))   # the tap stop's free swing about the built direction
 SOURCE_LEAN, SOURCE_TURN = 0.5, 0.3   # a chain or stub on a source leans 0.5 max_bend, turned by at most 0.3
@@ -186,6 +188,26 @@ def _tap_stop(name: str, lever: Body, site: str, t_up, t_first, first: str, k: f
     lever.sites["stop_tap"] = lever.rotation().T @ (p - lever.position)
     d_stop, d_free = 2.0 * m * math.cos(0.5 * free), 2.0 * m + 0.5
     return [Bond(name, f"{lever.name}.stop_tap", f"{first}_AB.stop_in", k, 0.5 * (d_stop + d_free),
+                 0.5 * (d_free - d_stop), "bond", None)]
+
+
+def _page_stop(name: str, parts0: Parts, parts1: Parts, page0: str, page1: str, spread: float, k: float) -> list[Bond]:
+    """A flat-bottom bond that keeps two branch pages hung on one pair, built ``spread``
+    apart, from closing on each other: their ``stop_in`` sites lie on the pages' centre
+    lines, ``STOP_ARM`` (R) from the joint both pages' A vertices hang on, so
+    2 R sin(theta/2) apart at an angle theta between the pages; the bond is free from
+    ``PAGE_MIN_ANGLE`` up (the posts are long enough for that angle) and stiff below it.
+    Units: sigma, k0."""
+    from mlc.errors import InternalError
+    from mlc.gates.connector import STOP_ARM
+    b0 = next(b for b in parts0.bodies if b.name == f"{page0}_AB")
+    b1 = next(b for b in parts1.bodies if b.name == f"{page1}_AB")
+    R = STOP_ARM
+    d_built = float(np.linalg.norm(b0.world("stop_in") - b1.world("stop_in")))
+    if abs(d_built - 2.0 * R * math.sin(0.5 * spread)) > 1e-9:
+        raise InternalError(f"pages {page0}, {page1}: stop sites {d_built} apart, not on one joint's lines")
+    d_stop, d_free = 2.0 * R * math.sin(0.5 * PAGE_MIN_ANGLE), 2.0 * R + 0.5
+    return [Bond(name, f"{page0}_AB.stop_in", f"{page1}_AB.stop_in", k, 0.5 * (d_stop + d_free),
                  0.5 * (d_free - d_stop), "bond", None)]
 
 
@@ -579,8 +601,12 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         else:
             starts = []
             angs = branch_angles(len(cons))
+            held = method == "fast" and len(cons) == 2
+            if held:
+                angs = list(FAST_PAIR_PAGES)
             spread = abs(angs[1] - angs[0])
-            post = max(geo.branch_post, geo.reach / math.tan(0.5 * spread) + 0.25) + PAGE_CLEAR
+            # (held pages: posts long enough for the smallest angle their stop lets them close to)
+            post = max(geo.branch_post, geo.reach / math.tan(0.5 * (PAGE_MIN_ANGLE if held else spread)) + 0.25) + PAGE_CLEAR
             # the pages' input posts meet at the tap's joint: their ends, d from it, are
             # 2 d sin(s/2) apart, a post's width w at d = w for 4 pages (s = 60 deg; measured
             # clear, +0.0107 sigma); 5 pages at d = w overlapped by 0.0117 sigma, so from 5
@@ -592,6 +618,9 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                 parts, pin, pout = half_unit_parts(f"w_{wname}_p{k}", tap.centre, tap.axis, t, state_at_tap, geo,
                                                    in_post=post, in_stop=page_stop)
                 parts.bonds += join(f"w_{wname}_p{k}_j", tap, pin, geo.k)
+                if held and k == 1:
+                    parts.bonds += _page_stop(f"w_{wname}_pp", deferred[-1], parts, f"w_{wname}_p0", f"w_{wname}_p1",
+                                              spread, geo.k)
                 deferred.append(parts)
                 n_half += 1
                 starts.append((pout, pol ^ 1, True, t, None))
@@ -653,7 +682,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             ch = _Chain(tag, lane, yp, (start.centre, start.axis, target.centre, target.axis, geo, spol), route_kw,
                         dict(tangent=t0, free_start=free, approach=app, last_pitch=geo.pitch + ext,
                              start_bend_max=sbm),
-                        skip, others, _gap_fn(space, tag, skip, others_tree, geo, ext, space_clear), (geo, ext),
+                        skip, others, _gap_fn(space, tag, skip, wire, others_tree, geo, ext, space_clear), (geo, ext),
                         (wire, start, tap, spol, sstate, stop_at_tap, t_up, target, ext))
             ch.sink = f"{gid}.{pin_name}"
             chains.append(ch)
@@ -878,13 +907,18 @@ def _layers(route, geo, ext: float) -> np.ndarray:
     return layer_centres(cs)
 
 
-def _gap_fn(space, tag: str, skip: int, others_tree, geo, ext: float, space_clear: float):
+def _gap_fn(space, tag: str, skip: int, group, others_tree, geo, ext: float, space_clear: float):
     """The keep-apart distance of a route of chain ``tag``: the smallest distance of its
-    layers (from the ``skip``-th on) to the layers of the other chains in ``space``; a
-    gate's points count as a layer nearer by the difference of the two clearances (sigma)."""
+    layers to the layers of the other chains in ``space``, its first ``skip`` layers (at
+    its branch page) not to its sibling chains' first layers (``space`` group ``group``,
+    the wire); a gate's points, from the ``skip``-th layer on, count as a layer nearer by
+    the difference of the two clearances (sigma)."""
     def gap_of(r) -> float:
-        m = _layers(r, geo, ext)[skip:]
+        layers = _layers(r, geo, ext)
+        m = layers[skip:]
         g = space.nearest(m, tag)
+        if skip:
+            g = min(g, space.nearest(layers[:skip], tag, exempt=group))
         if others_tree is not None and len(m):
             g = min(g, float(others_tree.query(m)[0].min()) + space_clear - GATE_CLEAR)
         return g
@@ -903,6 +937,9 @@ def _route_all(chains: list, routed: dict, lanes, space, space_clear: float, job
     from mlc.circuit.route import Prefetch
     ahead = max(int(jobs), 1) - 1
     started: set = set()                    # chains whose first solve was started ahead
+    for ch in chains:
+        if ch.skip:       # a branch's chain: its first layers are where they are, routed or not yet
+            space.add(_head_layers(ch), ch.tag, ch.skip, ch.ctx[0])
     with Prefetch(jobs) as pf:
         for i, ch in enumerate(chains):
             if progress:
@@ -923,6 +960,20 @@ def _route_all(chains: list, routed: dict, lanes, space, space_clear: float, job
                 raise MlcError(f"cannot route wire {wire[1]} to {ch.sink}: no connector chain reaches it",
                                source, "this is a placement limit of mlc; please report the netlist")
             routed[ch.tag] = ch
+
+
+def _head_layers(ch: _Chain) -> np.ndarray:
+    """The first ``ch.skip`` layer centres of branch chain ``ch`` before it is routed: straight
+    on from its branch page along its start tangent (its route may bend them by at most
+    ``END_BEND`` of the largest bend).  Held in the keep-apart space until ``ch`` is routed,
+    so that a sibling routed before it does not come back beside its start (session 39: in
+    the fast-built 7-bit adder, chain 0 of ``g19`` ran beside chain 1's first layers, which
+    a branch's floppy swing then pushed into it by 0.20 sigma in the all-ones row) (sigma)."""
+    start, geo = ch.ctx[1], ch.geo_ext[0]
+    t0 = np.asarray(ch.straight_kw["tangent"], float)
+    cs = start.centre + geo.pitch * np.arange(ch.skip + 1)[:, None] * t0
+    from mlc.circuit.lanes import layer_centres
+    return layer_centres(cs)
 
 
 def _plane_waypoints(ch: _Chain, plane: int) -> list:
@@ -947,6 +998,7 @@ def _route_chain(ch: _Chain, lanes, space, space_clear: float, pf=None) -> None:
     starting its next one at once was measured to waste more than it saved; the caller
     drops what is not needed)."""
     from mlc.circuit.route import solve_route
+    space.remove(ch.tag)                    # (a branch chain's head layers, held until now)
     lane = ch.lane
     plane = lanes.assign(lane)
     best = (-math.inf, None, plane, ())
@@ -979,7 +1031,7 @@ def _route_chain(ch: _Chain, lanes, space, space_clear: float, pf=None) -> None:
     ch.route, ch.gap, ch.plane = route, gap, plane
     if route is not None:
         lanes.take(lane, plane)
-        space.add(ch.layers(route), ch.tag)
+        space.add(ch.layers(route), ch.tag, ch.skip, ch.ctx[0])
 
 
 def _unplace(ch: _Chain, lanes, space) -> None:
@@ -1002,7 +1054,9 @@ def _rip_up(routed: dict, lanes, space, space_clear: float) -> list:
         ch.gap = ch.gap_of(ch.route)             # other chains may have moved since
         if ch.gap >= RIP_GAP:
             continue
-        _, owner = space.nearest_owner(ch.layers()[ch.skip:], tag)
+        layers = ch.layers()
+        _, owner = min(space.nearest_owner(layers[ch.skip:], tag),
+                       space.nearest_owner(layers[:ch.skip], tag, exempt=ch.ctx[0]), key=lambda h: h[0])
         if owner not in routed:              # a gate's points are nearest: nothing to move
             continue
         pair = [routed[owner], ch]
@@ -1021,7 +1075,7 @@ def _rip_up(routed: dict, lanes, space, space_clear: float) -> list:
             _unplace(c, lanes, space)
             c.route, c.gap, c.plane = route, gap, plane
             lanes.take(c.lane, plane)
-            space.add(c.layers(route), c.tag)
+            space.add(c.layers(route), c.tag, c.skip, c.ctx[0])
     return done
 
 
@@ -1065,7 +1119,7 @@ def _rip_up_contacts(routed: dict, lanes, space, space_clear: float, geo) -> tup
             _unplace(c, lanes, space)
             c.route, c.gap, c.plane = route, gap, plane
             lanes.take(c.lane, plane)
-            space.add(c.layers(route), c.tag)
+            space.add(c.layers(route), c.tag, c.skip, c.ctx[0])
     if done:
         contacts = _state_contacts(routed, geo, cache=boxes)
     return done, contacts

@@ -136,22 +136,27 @@ class Space:
 
     Each half-unit layer is bounded by a sphere of radius ``r`` about the midpoint of its
     two pairs; two layers of different chains cannot touch while their centres are more
-    than ``2 r`` apart.  Centres are hashed on a grid of cell ``2 r``."""
+    than ``2 r`` apart.  Centres are hashed on a grid of cell ``2 r``.  A chain's first
+    layers may be marked as its branch's (``add``'s ``head`` and ``group``): a test that
+    names that ``group`` (``nearest``'s ``exempt``) passes them by, so that sibling chains'
+    first layers, side by side at their branch, are not held apart from each other while
+    every other layer of theirs is."""
 
     def __init__(self, r: float):
         self.r = float(r)
         self.cell = 2.0 * self.r
         self.grid: dict[tuple, list] = {}
+        self.cells_of: dict = {}             # owner -> the cells holding its layers
 
     def _keys(self, p):
         return tuple(int(math.floor(v / self.cell)) for v in p)
 
-    def nearest(self, pts: np.ndarray, owner) -> float:
+    def nearest(self, pts: np.ndarray, owner, exempt=None) -> float:
         """Smallest centre distance from ``pts`` to layers of other owners (inf if none
-        within one cell)."""
-        return self.nearest_owner(pts, owner)[0]
+        within one cell), leaving out the first layers marked with group ``exempt``."""
+        return self.nearest_owner(pts, owner, exempt)[0]
 
-    def nearest_owner(self, pts: np.ndarray, owner) -> tuple[float, object]:
+    def nearest_owner(self, pts: np.ndarray, owner, exempt=None) -> tuple[float, object]:
         """:meth:`nearest` and the owner of that layer (None if none within one cell)."""
         best, who = math.inf, None
         for p in pts:
@@ -159,8 +164,8 @@ class Space:
             for di in (-1, 0, 1):
                 for dj in (-1, 0, 1):
                     for dk in (-1, 0, 1):
-                        for q, o in self.grid.get((i + di, j + dj, k + dk), ()):
-                            if o != owner:
+                        for q, o, g in self.grid.get((i + di, j + dj, k + dk), ()):
+                            if o != owner and (exempt is None or g != exempt):
                                 d = float(np.linalg.norm(q - p))
                                 if d < best:
                                     best, who = d, o
@@ -168,17 +173,21 @@ class Space:
 
     def points(self, owner) -> np.ndarray:
         """Every layer centre of the other owners, (m, 3)."""
-        pts = [q for cell in self.grid.values() for q, o in cell if o != owner]
+        pts = [q for cell in self.grid.values() for q, o, _ in cell if o != owner]
         return np.array(pts).reshape(-1, 3)
 
-    def add(self, pts: np.ndarray, owner) -> None:
-        for p in pts:
-            self.grid.setdefault(self._keys(p), []).append((np.asarray(p, float), owner))
+    def add(self, pts: np.ndarray, owner, head: int = 0, group=None) -> None:
+        """Place ``owner``'s layer centres ``pts``; its first ``head`` marked as ``group``'s."""
+        cells = self.cells_of.setdefault(owner, set())
+        for n, p in enumerate(pts):
+            key = self._keys(p)
+            self.grid.setdefault(key, []).append((np.asarray(p, float), owner, group if n < head else None))
+            cells.add(key)
 
     def remove(self, owner) -> None:
-        """Forget every layer of ``owner``."""
-        for key, cell in list(self.grid.items()):
-            kept = [(q, o) for q, o in cell if o != owner]
+        """Forget every layer of ``owner`` (none placed: nothing to do)."""
+        for key in self.cells_of.pop(owner, ()):
+            kept = [e for e in self.grid[key] if e[1] != owner]
             if kept:
                 self.grid[key] = kept
             else:
