@@ -848,10 +848,7 @@ def _chain_parts(ch: _Chain, geo, flip: int = 0, only=None):
                 return half_unit_parts(f"{tag}_{i}", cs[i], us[i], ts[i], (state + i) % 2, geo,
                                        in_stop=in0 if i == 0 else POST_WIDTH)
             cs_in = unit(last - 1)[2] if last > 0 else unit(0)[1]
-            out = unit(last)[2]
-            t_last = (out.centre - cs_in.centre) / np.linalg.norm(out.centre - cs_in.centre)
-            parts.add(half_unit_parts(f"{tag}_{last}", cs_in.centre, cs_in.axis, t_last, state ^ (last % 2), geo,
-                                      out_post=0.5 * geo.gap + ext, out_stop=LEVER_STOP)[0])
+            parts.add(_last_unit(tag, last, cs_in, unit(last)[2], state, geo, ext)[0])
         return parts, None, None
     parts, pairs = chain_parts(tag, route.centre, route.axis, route.tangent, route.bends, state, geo,
                                in_stop=in0, stops=True)
@@ -859,13 +856,19 @@ def _chain_parts(ch: _Chain, geo, flip: int = 0, only=None):
         if b.name.startswith(f"{tag}_{last}_"):
             parts.bodies.remove(b)
     parts.bonds = [bd for bd in parts.bonds if not bd.name.startswith(f"{tag}_{last}_")]
-    cs_in = pairs[-2]
-    t_last = (pairs[-1].centre - cs_in.centre) / np.linalg.norm(pairs[-1].centre - cs_in.centre)
-    lp, lin, lout = half_unit_parts(f"{tag}_{last}", cs_in.centre, cs_in.axis, t_last,
-                                    state ^ (last % 2), geo, out_post=0.5 * geo.gap + ext,
-                                    out_stop=LEVER_STOP)
+    lp, lin, lout = _last_unit(tag, last, pairs[-2], pairs[-1], state, geo, ext)
     parts.add(lp)
     return parts, pairs, lout
+
+
+def _last_unit(tag: str, last: int, pair_in, pair_out, state: int, geo, ext: float):
+    """The last half unit (index ``last``) of chain ``tag`` whose layers start in
+    ``state``: from its input pair ``pair_in`` towards where the chain's frames put its
+    output pair (``pair_out``), with an output post ``ext`` longer, so that its layer clears
+    the lever plane.  Returns ``half_unit_parts``'s (parts, input pair, output pair)."""
+    t_last = (pair_out.centre - pair_in.centre) / np.linalg.norm(pair_out.centre - pair_in.centre)
+    return half_unit_parts(f"{tag}_{last}", pair_in.centre, pair_in.axis, t_last, state ^ (last % 2), geo,
+                           out_post=0.5 * geo.gap + ext, out_stop=LEVER_STOP)
 
 
 def _state_contacts(routed: dict, geo, tags=None, cache: dict | None = None) -> list:
