@@ -33,7 +33,10 @@ Every row also gets ``prusa_before``: PrusaSlicer's figures for the same gate an
 the feet (the pose ``before`` of ``benchmarks/results/slicer_gates.json``: the model's z up, the
 parts without feet), with that file's mlc bed contact beside them (``mlc_contact_fraction``: the
 same geometry when it equals this row's ``before``).  ``--annotate`` only adds these to the rows
-already in ``--out``.
+already in ``--out``.  ``--table`` only prints the rows of ``--out`` (those of ``--gates``,
+``--signals`` and ``--profiles``) as the Markdown table of docs/printing.md, against the goals of
+issue 13 (bed contact at least 20 % of the footprint; support under 10 % of the part volume, none
+between parts).
 
 Each row records ``commit`` (the HEAD it ran on, with ``mlc_dirty``: files under ``mlc/`` that
 differed from it), ``export_s`` (``export_assembly``), ``slice_s`` (the three PrusaSlicer runs) and
@@ -97,6 +100,35 @@ def prusa_before(row: dict, ref: dict) -> dict | None:
     return None
 
 
+def _pct(x) -> str:
+    return "—" if x is None else f"{100 * x:.1f} %"
+
+
+def table(rows: list) -> str:
+    """The Markdown table of ``rows`` (docs/printing.md), one line a row, in the file's order."""
+    head = ("| gate | muscles | profile | commit | feet mm³ | mlc bed contact (goal ≥ 20 %) | "
+            "PrusaSlicer first layer mm² (of mlc's footprint) | mlc support mm³ (% of part volume; goal < 10 %) | "
+            "of it between parts mm³ (goal 0) | PrusaSlicer support mm³ (% of the filament without) | "
+            "of it on the print mm³ | walls | blocking checks |")
+    out = [head, "|" + "---|" * head.count(" |")]
+    for r in rows:
+        a = r["after"]["bed"]
+        pa = r.get("prusa_after") or {}
+        fl = (pa.get("none") or {}).get("first_layer_mm2")
+        fl_s = "—" if fl is None else f"{fl:.0f} ({_pct(fl / a['footprint_mm2'])})"
+        ps = pa.get("prusa_support_mm3")
+        ps_s = "—" if ps is None else f"{ps:.0f} ({_pct(pa.get('prusa_support_fraction'))})"
+        po = pa.get("prusa_support_on_print_mm3")
+        wt = r["wall_thickness"]
+        walls = "met" if wt["ok"] else f"{wt['value']:.3f} mm < {wt['limit']:g}"
+        out.append(f"| {r['gate']} | {r['signal']} | {r['profile']} | {r.get('commit') or '—'} | "
+                   f"{r['feet_total_mm3']:.0f} | {_pct(a['contact_fraction'])} | {fl_s} | "
+                   f"{a['support_mm3']:.0f} ({_pct(a['support_fraction'])}) | {a['support_inside_mm3']:.0f} | "
+                   f"{ps_s} | {'—' if po is None else f'{po:.0f}'} | {walls} | "
+                   f"{'pass' if r['ok'] else 'FAIL: ' + ', '.join(r['failed'])} |")
+    return "\n".join(out)
+
+
 def _git_state() -> tuple[str | None, list]:
     """The HEAD this runs on and the files under mlc/ that differ from it (benchmarks/gitstate.py)."""
     return gitstate.head(), gitstate.dirty()
@@ -122,7 +154,13 @@ def main() -> int:
     ap.add_argument("--out", default=str(RESULTS / "mesh_bed_feet.json"))
     ap.add_argument("--append", action="store_true")
     ap.add_argument("--annotate", action="store_true", help="only add prusa_before to the rows in --out")
+    ap.add_argument("--table", action="store_true", help="only print the rows of --out as a Markdown table")
     args = ap.parse_args()
+    if args.table:
+        rows = [r for r in json.loads(Path(args.out).read_text())["rows"]
+                if r["gate"] in args.gates and r["signal"] in args.signals and r["profile"] in args.profiles]
+        print(table(rows))
+        return 0
     if args.annotate:
         path = Path(args.out)
         _write(path, json.loads(path.read_text())["rows"])
