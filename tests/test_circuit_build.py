@@ -721,3 +721,32 @@ def test_the_fast_routers_two_way_branch_pages_are_held_clear_of_each_other():
         assert clearance(posed(at_stop)).min_clearance > 0    # clear at the stop's angle
         # and the stop is needed: the pages, free to close to 20 degrees apart, would touch
         assert clearance(posed(built - math.radians(20.0))).min_clearance < 0
+
+
+def test_layers_of_a_long_chain_are_its_built_frames_where_the_fast_recurrence_diverges():
+    """``_layers`` takes the router's quick frame recurrence, whose error grows along a
+    chain; on 150 half units of alternating bends it overflows to NaN (session 39: a chain
+    of the fast-built 4-bit adder stopped the build).  The layer centres are then those of
+    the exact frames that build the bodies (``chain_frames``), and where the recurrence
+    holds they are its own, unchanged."""
+    from types import SimpleNamespace
+
+    from mlc.circuit import build as B
+    from mlc.circuit.lanes import layer_centres
+    from mlc.circuit.route import _fk
+    from mlc.gates.connector import chain_frames
+    u0 = np.array([-0.21784433, 0.97598353, 0.0])
+    u0 /= np.linalg.norm(u0)
+    t0 = np.array([0.0, 0.0, 1.0])
+    geo = SimpleNamespace(pitch=1.0)
+    for n, expect_diverged in ((150, True), (40, False)):
+        bends = np.tile([0.386, -0.386, 0.386, 0.383, -0.386, -0.38], n)[:n]
+        route = SimpleNamespace(centre=np.zeros(3), axis=u0, tangent=t0, bends=bends)
+        with np.errstate(all="ignore"):
+            quick = layer_centres(_fk(route.centre, u0, t0, bends, 1.0)[0])
+        assert (not np.all(np.isfinite(quick))) == expect_diverged
+        got = B._layers(route, geo, 0.0)
+        want = layer_centres(chain_frames(route.centre, u0, t0, bends, 1.0)[0])
+        assert np.all(np.isfinite(got)) and np.allclose(got, want, atol=1e-9)
+        if not expect_diverged:
+            assert np.array_equal(got, quick)          # the recurrence's own bits where it holds

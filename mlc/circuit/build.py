@@ -104,6 +104,7 @@ RIP_GAP = 1.2               # sigma: a chain this much closer to another is rout
                             # measured: chains 1.29 sigma apart and more were clear in every row of every
                             # example, one 0.93 apart (3-bit adder) overlapped by 0.23 sigma
 BRANCH_LAYERS = 3           # layers of a chain next to its branch page, left out of the keep-apart test
+LAYER_DRIFT = 1e-3           # _layers: an axis this far off unit length (squared norm) -> exact frames
 LAYER_RADIUS = 0.9          # sigma: bounds a half unit's layer with its posts (reach 0.75, half pitch 0.5)
 GATE_POINT_STEP = 0.25      # sigma between the points that stand for a gate's slab (along its length)
 GATE_CLEAR = LAYER_RADIUS + 0.3   # sigma: a layer's centre stays this far from them (slab half width 0.25)
@@ -902,11 +903,24 @@ def _state_contacts(routed: dict, geo, tags=None, cache: dict | None = None) -> 
 
 
 def _layers(route, geo, ext: float) -> np.ndarray:
-    """Layer centres of a routed chain whose last half unit's post is ``ext`` longer (sigma)."""
+    """Layer centres of a routed chain whose last half unit's post is ``ext`` longer (sigma).
+
+    By ``route._fk``'s recurrence, whose error grows along the chain (its docstring); where
+    that has drifted (an axis off unit length by more than ``LAYER_DRIFT``, or not finite:
+    session 39, a 129-half-unit chain of the fast-built 4-bit adder overflowed to NaN), the
+    frames again with each axis and tangent renormalised (``exact``), as the bodies are built."""
     from mlc.circuit.lanes import layer_centres
-    from mlc.circuit.route import _fk
-    cs, _, _ = _fk(route.centre, route.axis, route.tangent, route.bends,
-                   [geo.pitch] * (len(route.bends) - 1) + [geo.pitch + ext])
+    from mlc.circuit.route import _fk, _fk_kernel
+    pitches = np.array([geo.pitch] * (len(route.bends) - 1) + [geo.pitch + ext], float)
+    cs, us, _ = _fk(route.centre, route.axis, route.tangent, route.bends, pitches)
+    with np.errstate(over="ignore", invalid="ignore"):
+        drift = np.abs(np.einsum("ij,ij->i", us, us) - 1.0)
+    if not np.all(drift <= LAYER_DRIFT):            # (NaN fails too)
+        b = np.ascontiguousarray(route.bends, dtype=np.float64)
+        n = len(b)
+        cs, us, ts = np.empty((n + 1, 3)), np.empty((n + 1, 3)), np.empty((n, 3))
+        _fk_kernel(np.asarray(route.centre, float), np.asarray(route.axis, float), np.asarray(route.tangent, float),
+                   b, pitches, cs, us, ts, True)
     return layer_centres(cs)
 
 
