@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -61,6 +62,12 @@ class Lane:
                 np.array([[self.x_in, self.z_in - CROSS_BELOW], [self.x_in, self.z_in + CROSS_ABOVE]]
                          + ([[self.x_end, self.z_end]] if self.x_end is not None else []))]
 
+    @cached_property
+    def shapes(self) -> tuple:
+        """(polyline, its bounding box), [(crossing, its box)...], made once (the lane does
+        not change once made): what :meth:`Lanes.conflicts` compares, lane by lane."""
+        return (_boxed(self.polyline()), [_boxed(c) for c in self.crossings()])
+
 
 def _seg_dist(p1, q1, p2, q2) -> float:
     """Smallest distance between 2-D segments p1q1 and p2q2."""
@@ -84,13 +91,23 @@ def _poly_dist(a: np.ndarray, b: np.ndarray) -> float:
     return min(_seg_dist(a[i], a[i + 1], b[j], b[j + 1]) for i in range(len(a) - 1) for j in range(len(b) - 1))
 
 
+def _boxed(a: np.ndarray) -> tuple:
+    """A polyline with its bounding box (x min, x max, z min, z max) as Python floats."""
+    return a, (float(a[:, 0].min()), float(a[:, 0].max()), float(a[:, 1].min()), float(a[:, 1].max()))
+
+
 def _near(a: np.ndarray, b: np.ndarray, sep: float) -> bool:
     """``_poly_dist(a, b) < sep``, without measuring where the polylines' bounding boxes
     are ``sep`` or more apart along x or z (then so are the polylines)."""
-    if (a[:, 0].min() - b[:, 0].max() >= sep or b[:, 0].min() - a[:, 0].max() >= sep
-            or a[:, 1].min() - b[:, 1].max() >= sep or b[:, 1].min() - a[:, 1].max() >= sep):
+    return _near_boxed(_boxed(a), _boxed(b), sep)
+
+
+def _near_boxed(a: tuple, b: tuple, sep: float) -> bool:
+    """:func:`_near` of two :func:`_boxed` polylines (their boxes made once)."""
+    (pa, (ax0, ax1, az0, az1)), (pb, (bx0, bx1, bz0, bz1)) = a, b
+    if ax0 - bx1 >= sep or bx0 - ax1 >= sep or az0 - bz1 >= sep or bz0 - az1 >= sep:
         return False
-    return _poly_dist(a, b) < sep
+    return _poly_dist(pa, pb) < sep
 
 
 class Lanes:
@@ -102,15 +119,15 @@ class Lanes:
 
     def conflicts(self, lane: Lane, k: int) -> int:
         """How many placed lanes ``lane`` would come too close to in plane ``k``."""
-        poly, cross = lane.polyline(), lane.crossings()
+        poly, cross = lane.shapes
         n = 0
+        sep = self.sep
         for k2, other in self.placed:
-            opoly, ocross = other.polyline(), other.crossings()
-            sep = self.sep
-            if ((k2 == k and _near(poly, opoly, sep))
-                    or (k2 < k and any(_near(c, opoly, sep) for c in cross))      # mine pass its plane
-                    or (k2 > k and any(_near(c, poly, sep) for c in ocross))     # its pass mine
-                    or any(_near(c, oc, sep) for c in cross for oc in ocross)):
+            opoly, ocross = other.shapes
+            if ((k2 == k and _near_boxed(poly, opoly, sep))
+                    or (k2 < k and any(_near_boxed(c, opoly, sep) for c in cross))      # mine pass its plane
+                    or (k2 > k and any(_near_boxed(c, poly, sep) for c in ocross))     # its pass mine
+                    or any(_near_boxed(c, oc, sep) for c in cross for oc in ocross)):
                 n += 1
         return n
 
