@@ -101,6 +101,11 @@ def test_a_branchs_first_layers_are_exempt_only_from_each_other():
     assert abs(sp.nearest(np.array([[1.0, 0.7, 0]]), "b") - 0.7) < 1e-12
     # a sibling's head beside a's layer far along (not a head): measured, exempt or not
     assert abs(sp.nearest(np.array([[5.0, 0.6, 0]]), "b", exempt="W") - 0.6) < 1e-12
+    # a whole chain as it keeps apart: its head passes a's head by, its later layer does not
+    chain = np.array([[0.0, 0.5, 0], [5.0, 0.8, 0]])
+    assert sp.nearest_chain(chain, "b", 1, "W") == (sp.nearest(chain[1:], "b"), "a")
+    assert abs(sp.nearest_chain(chain, "b", 1, "W")[0] - 0.8) < 1e-12
+    assert sp.nearest_chain(chain, "b")[0] == 0.5 and sp.nearest_chain(chain[:1], "b", 1, "W") == (np.inf, None)
     # another wire's head layers are not exempt from W's test
     sp.add(np.array([[0.0, -0.4, 0]]), "c", head=1, group="V")
     assert abs(sp.nearest(sib_head, "b", exempt="W") - 0.9) < 1e-12

@@ -934,9 +934,7 @@ def _gap_fn(space, tag: str, skip: int, group, others_tree, geo, ext: float, spa
     def gap_of(r) -> float:
         layers = _layers(r, geo, ext)
         m = layers[skip:]
-        g = space.nearest(m, tag)
-        if skip:
-            g = min(g, space.nearest(layers[:skip], tag, exempt=group))
+        g = space.nearest_chain(layers, tag, skip, group)[0]
         if others_tree is not None and len(m):
             g = min(g, float(others_tree.query(m)[0].min()) + space_clear - GATE_CLEAR)
         return g
@@ -1072,9 +1070,7 @@ def _rip_up(routed: dict, lanes, space, space_clear: float) -> list:
         ch.gap = ch.gap_of(ch.route)             # other chains may have moved since
         if ch.gap >= RIP_GAP:
             continue
-        layers = ch.layers()
-        _, owner = min(space.nearest_owner(layers[ch.skip:], tag),
-                       space.nearest_owner(layers[:ch.skip], tag, exempt=ch.ctx[0]), key=lambda h: h[0])
+        _, owner = space.nearest_chain(ch.layers(), tag, ch.skip, ch.ctx[0])
         if owner not in routed:              # a gate's points are nearest: nothing to move
             continue
         pair = [routed[owner], ch]

@@ -188,6 +188,16 @@ class Space:
                                     best, who = d, o
         return best, who
 
+    def nearest_chain(self, layers: np.ndarray, owner, head: int = 0, group=None) -> tuple[float, object]:
+        """:meth:`nearest_owner` of a chain's ``layers`` as it keeps apart: its first ``head``
+        layers (at its branch) leaving out group ``group``'s first layers, the rest none."""
+        best = self.nearest_owner(layers[head:], owner)
+        if head:
+            first = self.nearest_owner(layers[:head], owner, group)
+            if first[0] < best[0]:
+                best = first
+        return best
+
     def points(self, owner) -> np.ndarray:
         """Every layer centre of the other owners, (m, 3)."""
         pts = [q for cell in self.grid.values() for q, o, _ in cell if o != owner]
