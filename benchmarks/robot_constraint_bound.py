@@ -163,9 +163,9 @@ def plot(res: dict, path: Path) -> None:
     fig, ax = plt.subplots(figsize=(7.5, 4.2))
     labels, vals = [], []
     for case, c in res["cases"].items():
-        for key, name in (("speedup_bound_free_projection", "projection free"),
-                          ("speedup_bound_no_factor", "+ one solve a stage"),
-                          ("speedup_bound", "+ one factorisation a step")):
+        for key, name in (("speedup_bound_free_projection", "projection\nfree"),
+                          ("speedup_bound_no_factor", "+1 solve\na stage"),
+                          ("speedup_bound", "+1 factorisation\na step")):
             labels.append(f"{case}\n{name}")
             vals.append(c[key])
     ax.bar(range(len(vals)), vals, color=["#4c72b0", "#55a868", "#c44e52"] * 2)
