@@ -140,6 +140,7 @@ def measure(scene_path: str, stages: float, dt: float) -> dict:
 
     res = {"bodies": sim.N, "springs": len(kinds), "joint_constraints": int(joint.sum()),
            "junction_stops": int(stop.sum()), "constraint_rows": int(G.shape[0]),
+           "ggt_nonzeros": int(GG.nnz), "lu_nonzeros": int(lu.L.nnz + lu.U.nnz),
            "rho_kernel": rho_kernel, "rho_lanczos": rho_full, "wca_term": wca,
            "lanczos_cpu_s": round(t_lanczos, 2), "projection_leak": leak,
            "t_eval_s": t_eval, "t_factor_s": t_factor, "t_solve_s": t_solve,
