@@ -123,7 +123,8 @@ def _columns(V, F, h: float, overhang_deg: float, z0: float, own=None, island_mm
     same column or to the bed.  ``own``: the part of each triangle; ``inside``: the crossing
     below is a surface of another part (support between two parts); ``on_self``: of the same
     part (support inside a hole or a recess of one part).  ``island_mm`` > 0: the islands too
-    (:func:`_islands`), each a square column of that side down to the surface below."""
+    (:func:`_islands`), each a square column of that side down to the surface below (per grid
+    column of it: ``island_vol``, its part ``island_own`` and ``island_pts``, the island it holds, mm)."""
     A, B, C = V[F[:, 0]], V[F[:, 1]], V[F[:, 2]]
     nrm = np.cross(B - A, C - A)
     area2 = np.linalg.norm(nrm, axis=1)
@@ -157,7 +158,7 @@ def _columns(V, F, h: float, overhang_deg: float, z0: float, own=None, island_mm
     out = {"overhang_area": 0.5 * area2[over], "over_idx": np.nonzero(over)[0], "vol": height * h * h,
            "inside": on_part & ~same, "on_self": on_part & same, "tri_idx": tri_idx, "key": key, "z": z,
            "first": ~prev_same, "island_vol": np.zeros(0), "island_own": np.zeros(0, np.int64),
-           "island_inside": np.zeros(0, bool), "island_self": np.zeros(0, bool)}
+           "island_pts": np.zeros((0, 3)), "island_inside": np.zeros(0, bool), "island_self": np.zeros(0, bool)}
     if island_mm > 0:
         out.update(_islands(V, F, own, over, z0, island_mm, lo, h, nx, key, z, tri_idx))
     return out
@@ -248,7 +249,8 @@ def _islands(V, F, own, over, z0, side, lo, h, nx, key, z, tri_idx) -> dict:
     io = pown[isl]
     m = len(pts)
     return {"island_vol": vol, "island_own": io,
-            "island_inside": ok & (below != io), "island_self": ok & (below == io), "island_count": m}
+            "island_inside": ok & (below != io), "island_self": ok & (below == io), "island_count": m,
+            "island_pts": pts[isl]}
 
 
 def quick_stats(V, F, h: float, overhang_deg: float = 45.0, first_layer: float = 0.2, own=None,
