@@ -55,6 +55,7 @@ def breakdown(gate: str, signal: str, profile: str, near: float) -> dict:
     from mlc.mesh.build import transform_solid
     from mlc.mesh.checks import OVERHANG_DEG, island_side, print_size
     from mlc.mesh.pipeline import export_assembly
+    from mlc.mesh.pose import report_grid
     from mlc.mesh.printability import _columns, merged_mesh
     from mlc.mesh.profiles import load_profile
 
@@ -65,8 +66,7 @@ def breakdown(gate: str, signal: str, profile: str, near: float) -> dict:
     named = [(p.name, transform_solid(p.solid, asm.print_T(p.name))) for p in asm.parts]
     named = [(n, s) for n, s in named if not s.is_empty()]
     names = [n for n, _ in named]
-    size = print_size(asm) or [1.0]
-    h = max(0.05, min(prof.min_wall, max(size) / 150))       # as mlc.mesh.checks.bed_checks
+    h = report_grid(print_size(asm) or [1.0], prof.min_wall)      # the report's grid (checks.bed_checks)
     V, F, own = merged_mesh(named)
     c = _columns(V, F, h, OVERHANG_DEG, 0.5 * min(0.2, prof.min_wall / 2), own, island_side(prof))
     cent = V[F].mean(axis=1)
@@ -83,8 +83,8 @@ def breakdown(gate: str, signal: str, profile: str, near: float) -> dict:
     cls = np.where(np.isin(part, LEVER) & at_pivot, "pivot",
                    np.where(np.isin(part, LEVER), part, np.where(part == "ujoint_d", "ujoint_d", "loop")))
     total = float(vol.sum())
-    want = float(asm.bed.support_mm3) if getattr(asm, "bed", None) is not None else None
-    if want is not None and abs(total - want) > 1e-6 * max(1.0, want):
+    want = float(asm.bed.support_mm3)         # export_assembly's bed check (checks.bed_checks)
+    if abs(total - want) > 1e-6 * max(1.0, want):
         raise SystemExit(f"{gate} {signal} {profile}: breakdown {total} != report {want}")
     by = {}
     for k in ("pivot", "out_lo", "out_hi", "ujoint_d", "loop"):
@@ -93,11 +93,10 @@ def breakdown(gate: str, signal: str, profile: str, near: float) -> dict:
                  "fraction": round(float(vol[m].sum()) / total, 4) if total else 0.0,
                  "between_parts_mm3": round(float(vol[m & inside].sum()), 1)}
     return {"gate": gate, "signal": signal, "profile": profile, "support_mm3": round(total, 1),
-            "report_support_mm3": None if want is None else round(want, 1),
-            "part_volume_mm3": round(float(asm.bed.part_volume_mm3), 1) if want is not None else None,
+            "report_support_mm3": round(want, 1), "part_volume_mm3": round(float(asm.bed.part_volume_mm3), 1),
             "grid_mm": round(h, 4), "pivot_R_mm": round(float(R), 3), "near_mm": near,
             "by_feature": by, "export_cpu_s": round(export_cpu, 1),
-            "blocking_pass": bool(rep.ok) if hasattr(rep, "ok") else None}
+            "blocking_pass": bool(rep.ok)}
 
 
 def main():

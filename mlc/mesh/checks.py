@@ -395,11 +395,11 @@ def island_side(profile) -> float:
 
 def bed_checks(asm: Assembly, stats=None) -> list:
     """``bed_contact`` and ``supports`` of the assembly in its print frame."""
+    from mlc.mesh.pose import report_grid
     from mlc.mesh.printability import bed_stats
     if stats is None:
         solids = [(p.name, transform_solid(p.solid, asm.print_T(p.name))) for p in asm.parts]
-        size = print_size(asm) or [1.0]
-        h = max(0.05, min(asm.profile.min_wall, max(size) / 150))
+        h = report_grid(print_size(asm) or [1.0], asm.profile.min_wall)
         stats = bed_stats(solids, OVERHANG_DEG, h, first_layer=min(0.2, asm.profile.min_wall / 2),
                           island_mm=island_side(asm.profile))
     asm.bed = stats
