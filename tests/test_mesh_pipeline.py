@@ -36,3 +36,21 @@ def test_single_mechanism_path_and_no_states():
     assert not rep.check("states").ok                     # nothing posed: the states check fails
     asm, rep = export_assembly(sc, load_profile("mjp"))
     assert rep.ok and rep.check("states").detail.startswith("2 logic states")
+
+
+def test_state_poses_side_by_side_are_the_poses_one_after_the_other(monkeypatch):
+    """state_poses runs a large scene's minimisations on threads (_in_threads): the same keys in
+    the same order and the same poses to the bit as one after the other, for the coarse paths
+    and for the dense paths and switches (a NAND forced onto threads; a thread that shared a
+    pose array with another, or a result out of its place, would show here)."""
+    import mlc.mesh.pipeline as pl
+    from mlc.gates.library import gate_scene
+    scene = gate_scene("NAND", "expand")
+    runs = {}
+    for floor in (10 ** 9, 1):
+        monkeypatch.setattr(pl, "THREADS_MIN_BODIES", floor)
+        runs[floor] = (pl.state_poses(scene, path_steps=2)[0], pl.state_poses(scene, path_steps=1, max_move=0.05)[0])
+    for one, two in zip(runs[10 ** 9], runs[1]):
+        assert list(one) == list(two) and len(one) > 4
+        for key in one:
+            assert np.array_equal(one[key][0], two[key][0]) and np.array_equal(one[key][1], two[key][1]), key

@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import copy
 import itertools
+import os
 import time
 from dataclasses import dataclass, field
 
@@ -134,6 +135,28 @@ def _with_muscles(scene: Scene, rest, actuated) -> Scene:
     return part
 
 
+#: bodies from which :func:`state_poses` runs its minimisations side by side (:func:`_in_threads`)
+THREADS_MIN_BODIES = 64
+
+
+def _in_threads(fn, jobs, threads: bool = True):
+    """``fn(*job)`` for each job of ``jobs``, in order, on up to one thread per core the process
+    may use (one when ``threads`` is False).  For the minimisations of :func:`state_poses`: each
+    is independent of the others and gives the same poses on any thread; in a large scene most
+    of its time is in SuperLU and NumPy, which release the GIL (the Tetris robot's rows 01 and
+    10 took 73 s one after the other and 47 s side by side on 2 cores, the same bits; scratch,
+    session 42), in a library gate's in Python, which does not (the NAND's dense paths took
+    longer side by side: 7.9 s against 6.2)."""
+    jobs = list(jobs)
+    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
+    workers = min(len(jobs), cores if threads else 1)
+    if workers <= 1:
+        return [fn(*job) for job in jobs]
+    from concurrent.futures import ThreadPoolExecutor
+    with ThreadPoolExecutor(workers) as ex:
+        return list(ex.map(lambda job: fn(*job), jobs))
+
+
 def state_poses(scene: Scene, max_states: int = MAX_STATES, path_steps: int = PATH_STEPS,
                 max_move: float | None = None) -> tuple[dict, str | None]:
     """Body poses (sigma) at the equilibrium of the input states: ``{state: (pos, quat)}``,
@@ -174,23 +197,20 @@ def state_poses(scene: Scene, max_states: int = MAX_STATES, path_steps: int = PA
         states = sorted(pick)[:max(max_states, 2 * n + 2)]
         note = (f"{scene.name}: {len(scene.inputs)} inputs; posed {len(states)} of {2 ** n} input states "
                 f"(all zero, all one, each input alone on and off, then a fixed random sample)")
-    out = {}
-    eqs = {}
-    for st in states:
-        eqs[st] = eq = equilibrium(scene, st)
-        out[st] = (np.asarray(eq.pos, float), np.asarray(eq.quat, float))
     rest = "0" * len(scene.inputs)
     if max_move is not None and not max_move > 0:
         raise ValueError(f"max_move must be positive, not {max_move}")
+    jobs = [(st, scene, st) for st in states]
+    big = len(scene.bodies) >= THREADS_MIN_BODIES
     if max_move is None:
         for k in range(1, path_steps + 1):
             f = k / (path_steps + 1)
             part = _with_muscles(scene, [m.rest for m in scene.muscles],
                                  [m.rest + f * (m.actuated - m.rest) for m in scene.muscles])
-            for st in states:
-                if st != rest:
-                    eq = equilibrium(part, st)
-                    out[f"{st}@{f:.2f}"] = (np.asarray(eq.pos, float), np.asarray(eq.quat, float))
+            jobs += [(f"{st}@{f:.2f}", part, st) for st in states if st != rest]
+    eqs = dict(zip([key for key, _, _ in jobs], _in_threads(equilibrium, [(sc, st) for _, sc, st in jobs], big)))
+    out = {key: (np.asarray(eq.pos, float), np.asarray(eq.quat, float)) for key, eq in eqs.items()}
+    if max_move is None:
         return out, note
 
     A = scene.arrays()
@@ -207,33 +227,34 @@ def state_poses(scene: Scene, max_states: int = MAX_STATES, path_steps: int = PA
             poses.append(pq)
         return poses
 
+    def path(a, b):
+        """(its name, its fractions, their poses, its largest step) for the move from ``a`` to ``b``."""
+        La = A.muscle_lengths(np.array([int(x) for x in a], float))
+        Lb = A.muscle_lengths(np.array([int(x) for x in b], float))
+        fs = list(np.arange(1, path_steps + 2) / (path_steps + 1))
+        poses = follow(a, La, Lb, fs)
+        for refined in range(4):    # refine (three times at most) until every step moves at most max_move
+            seq = [(eqs[a].pos, eqs[a].quat)] + poses
+            mv = [_moves(p, q, reach) for p, q in zip(seq, seq[1:])]
+            if max(mv) <= max_move or refined == 3:
+                break
+            f0 = [0.0] + fs
+            new = sorted(set(fs) | {f0[i] + (fs[i] - f0[i]) * j / m for i, m in
+                                    enumerate(int(np.ceil(1.1 * d / max_move)) for d in mv)
+                                    for j in range(1, m)})
+            if len(new) > MAX_PATH_POSES:
+                break
+            fs, poses = new, follow(a, La, Lb, new)
+        return (b if a == rest else f"{a}>{b}"), fs, poses, max(mv)
+
     coarse = []
-    if scene.muscles:
-        for a, b in itertools.product(states, states):
-            if a == b or (a != rest and len(states) > TRANSITION_STATES):
-                continue
-            La = A.muscle_lengths(np.array([int(x) for x in a], float))
-            Lb = A.muscle_lengths(np.array([int(x) for x in b], float))
-            fs = list(np.arange(1, path_steps + 2) / (path_steps + 1))
-            poses = follow(a, La, Lb, fs)
-            for refined in range(4):    # refine (three times at most) until every step moves at most max_move
-                seq = [(eqs[a].pos, eqs[a].quat)] + poses
-                mv = [_moves(p, q, reach) for p, q in zip(seq, seq[1:])]
-                if max(mv) <= max_move or refined == 3:
-                    break
-                f0 = [0.0] + fs
-                new = sorted(set(fs) | {f0[i] + (fs[i] - f0[i]) * j / m for i, m in
-                                        enumerate(int(np.ceil(1.1 * d / max_move)) for d in mv)
-                                        for j in range(1, m)})
-                if len(new) > MAX_PATH_POSES:
-                    break
-                fs, poses = new, follow(a, La, Lb, new)
-            worst = max(mv)
-            name = b if a == rest else f"{a}>{b}"
-            if worst > max_move:
-                coarse.append(f"{name} ({worst:.3g} sigma)")
-            for f, pq in zip(fs, poses):
-                out[f"{name}@{f:.3f}" if f < 1.0 or a == rest else name] = pq
+    moves = [(a, b) for a, b in itertools.product(states, states) if scene.muscles and a != b
+             and not (a != rest and len(states) > TRANSITION_STATES)]
+    for (a, _), (name, fs, poses, worst) in zip(moves, _in_threads(path, moves, big)):
+        if worst > max_move:
+            coarse.append(f"{name} ({worst:.3g} sigma)")
+        for f, pq in zip(fs, poses):
+            out[f"{name}@{f:.3f}" if f < 1.0 or a == rest else name] = pq
     if coarse:
         extra = (f"{scene.name}: poses on the way more than {max_move:.3g} sigma apart on "
                  + ", ".join(coarse[:4]) + (" ..." if len(coarse) > 4 else ""))

@@ -56,7 +56,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from numba import njit
+from numba import njit, prange
 
 
 #: cells of the largest grid measured at once (memory: about 40 bytes a cell during the transforms)
@@ -265,22 +265,38 @@ def _closest(px, py, pz, ax, ay, az, bx, by, bz, cx, cy, cz):
     return ax + abx * v + acx * w, ay + aby * v + acy * w, az + abz * v + acz * w
 
 
-@njit(cache=True)
+#: points per block of :func:`_nearest`: the blocks run in parallel, the points of a block in
+#: order (a fixed size: the same results whatever the thread count)
+NEAR_BLOCK = 64
+
+
+@njit(cache=True, parallel=True)
 def _nearest(P, V, F, N, nlo, nhi, left, right, start, count, perm):
     """For each row of P: distance to the mesh, nearest point, and the triangle whose plane
-    is farthest among those at that distance (the one whose normal tells the side)."""
+    is farthest among those at that distance (the one whose normal tells the side).  Blocks
+    of ``NEAR_BLOCK`` points run in parallel threads."""
     n = P.shape[0]
     D = np.empty(n)
     Q = np.empty((n, 3))
     T = np.empty(n, np.int64)
+    nblk = (n + NEAR_BLOCK - 1) // NEAR_BLOCK
+    for blk in prange(nblk):
+        _nearest_block(blk * NEAR_BLOCK, min(n, (blk + 1) * NEAR_BLOCK), P, V, F, N, nlo, nhi,
+                       left, right, start, count, perm, D, Q, T)
+    return D, Q, T
+
+
+@njit(cache=True)
+def _nearest_block(i0, i1, P, V, F, N, nlo, nhi, left, right, start, count, perm, D, Q, T):
+    """:func:`_nearest` for the points ``i0 <= i < i1``, in order."""
     stack = np.empty(256, np.int64)
-    for i in range(n):
+    for i in range(i0, i1):
         px, py, pz = P[i, 0], P[i, 1], P[i, 2]
         best = np.inf
         bq0 = bq1 = bq2 = np.nan
         bt = -1
         bplane = -1.0
-        if i > 0:       # the previous point's nearest triangle first (the points come in runs of
+        if i > i0:      # the previous point's nearest triangle first (the points come in runs of
             t = T[i - 1]    # neighbours): a tight bound from the start, the same result
             a, b, c = F[t, 0], F[t, 1], F[t, 2]
             qx, qy, qz = _closest(px, py, pz, V[a, 0], V[a, 1], V[a, 2], V[b, 0], V[b, 1], V[b, 2],
@@ -333,7 +349,6 @@ def _nearest(P, V, F, N, nlo, nhi, left, right, start, count, perm):
         D[i] = np.sqrt(best)
         Q[i, 0], Q[i, 1], Q[i, 2] = bq0, bq1, bq2
         T[i] = bt
-    return D, Q, T
 
 
 class _Surface:
