@@ -13,7 +13,8 @@ them).  Each part is measured by the old code, then by the new: every part of th
 part of the circuit (the whole circuit's wall time as ``mlc stl`` would spend it, without the
 per-shape reuse of congruent parts, which finds few in a circuit: ``distinct_shapes``).
 
-Per part: seconds (old, new), the number of thin regions and the thinnest (``thickness_mm``) by
+Both measures are run once on a thin plate before any timing (Numba's kernels compiled; the
+old module's are compiled afresh, from a temporary file).  Per part: seconds (old, new), the number of thin regions and the thinnest (``thickness_mm``) by
 each.  Totals and the ratio old / new.  One process; ``commit`` as benchmarks/gitstate.py.
 """
 from __future__ import annotations
@@ -120,7 +121,12 @@ def main() -> int:
     from mlc.mesh import walls as new
     old = old_walls(args.old)
     import manifold3d as mf
-    new.thin_walls("warm", mf.Manifold.cube([1, 1, 1]), 0.6)     # Numba's compiled kernels loaded
+    # Numba's kernels compiled or loaded before any timing, old and new alike: a plate thinner than
+    # the minimum wall takes every measure (a thin region, its balls and chords, the surface's
+    # distances); the old module, loaded from a temporary file, compiles its kernels afresh
+    for mod in (old, new):
+        mod.thin_walls("warm", mf.Manifold.cube([1, 1, 1]), 0.6)
+        assert mod.thin_walls("warm plate", mf.Manifold.cube([3, 3, 0.4]), 0.6), "the warm-up plate is thin"
     out = {"old_commit": args.old, "commit": commit(), "machine": platform.machine(),
            "python": platform.python_version(), "load_start": os.getloadavg()[0]}
     t0 = time.perf_counter()
