@@ -89,12 +89,9 @@ def run(args) -> int:
                        "give a sampling interval of at most --time (t0); the default takes about 2000 samples")
     if args.threads < 1:
         raise MlcError(f"--threads must be >= 1, got {args.threads}", "--threads")
-    import os
-    try:
-        cores = len(os.sched_getaffinity(0))       # the cores this process may use
-    except (AttributeError, OSError):
-        cores = os.cpu_count() or 1
-    if args.threads > max(cores, 1):
+    from mlc.io.cores import usable_cores
+    cores = usable_cores()
+    if args.threads > cores:
         raise MlcError(f"--threads {args.threads} is more than the {cores} cores of this machine", "--threads",
                        f"use at most {cores}")
     if args.fluct and args.scheme != "stiff":

@@ -13,12 +13,12 @@ from __future__ import annotations
 
 import copy
 import itertools
-import os
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from mlc.io.cores import usable_cores
 from mlc.mesh.build import Assembly, Part, _log, _orientation, build_assembly, transform_solid
 from mlc.mesh.checks import (GAP_EPS, VOL_EPS, Check, Report, _bbox, _pairs, bed_checks,
                              check_assembly, print_size)
@@ -148,8 +148,7 @@ def _in_threads(fn, jobs, threads: bool = True):
     session 42), in a library gate's in Python, which does not (the NAND's dense paths took
     longer side by side: 7.9 s against 6.2)."""
     jobs = list(jobs)
-    cores = len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else (os.cpu_count() or 1)
-    workers = min(len(jobs), cores if threads else 1)
+    workers = min(len(jobs), usable_cores() if threads else 1)
     if workers <= 1:
         return [fn(*job) for job in jobs]
     from concurrent.futures import ThreadPoolExecutor
