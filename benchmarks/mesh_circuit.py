@@ -16,6 +16,14 @@ examples/tetris.robot.yaml: ``mlc compile --robot``'s scene), ``full_adder``
 (examples/full_adder.tt), ``expr`` (the expression ``(a & b) | c``: two gates and one chain).
 Writes benchmarks/results/mesh_circuit.json (one row per case; a case that hits ``--limit``
 seconds is recorded as not finished).  Wall-clock seconds on the shared 2-core machine.
+
+Each row also sorts every failure of the blocking checks ``part_count``, ``min_gap`` and
+``states`` (the full lists, not the report's first 20) by where it is (``failure_kinds``): a
+body's kind from its name (``g<n>_`` gate, ``w_`` circuit wire, ``src_`` input source, ``rc_``
+robot coupling chain, ``skel_`` skeleton), a pair by its two kinds, and within a gate by its
+two library parts (``a_lo-a_hi``).  ``--outside``: the written 3MF read by third-party clients
+when installed, lib3mf (the 3MF Consortium's library, strict mode: its warnings counted) and
+PrusaSlicer's command line (``--info``: objects, parts, manifold).
 """
 from __future__ import annotations
 
@@ -42,7 +50,7 @@ CASES = {"tetris": ("examples/tetris.tt", None), "full_adder": ("examples/full_a
 ROBOTS = {"tetris_robot": "examples/tetris.robot.yaml"}
 
 
-def run_case(name: str, profile: str, queue, keep: str | None = None) -> None:
+def run_case(name: str, profile: str, queue, keep: str | None = None, outside: bool = False) -> None:
     import numpy as np
     import trimesh
 
@@ -101,6 +109,7 @@ def run_case(name: str, profile: str, queue, keep: str | None = None) -> None:
         pieces = whole.split(only_watertight=False)
         vols = read_3mf(mf3)
         sizes = {"stl_bytes": stl.stat().st_size, "threemf_bytes": mf3.stat().st_size}
+        reads = outside_reads(mf3) if outside else None
     row = {"case": name, "source": path or expr, "profile": profile, "bodies": len(scene.bodies),
            "mechanisms": len(mechs), "inputs": len(scene.inputs), "parts": len(asm.parts),
            "triangles": int(sum(len(m.faces) for _, m in meshes)), **sizes,
@@ -120,7 +129,105 @@ def run_case(name: str, profile: str, queue, keep: str | None = None) -> None:
         row["reuse"] = {"hits": cg.hits, "misses": cg.misses}
     row["report"] = {c.name: {"ok": c.ok, "blocking": c.blocking, "detail": c.detail[:300],
                               "failures": len(c.failures)} for c in rep.checks}
+    row["failure_kinds"] = failure_kinds(rep)
+    if reads is not None:
+        row["outside"] = reads
     queue.put(row)
+
+
+KINDS = (("g", r"g\d+_"), ("wire", r"w_"), ("source", r"src_"), ("coupling", r"rc_"), ("skeleton", r"skel_"))
+
+
+def kind_of(body: str) -> str:
+    import re
+    for k, pat in KINDS:
+        if re.match(pat, body):
+            return "gate" if k == "g" else k
+    return "other"
+
+
+def failure_kinds(rep) -> dict:
+    """Every failure of part_count, min_gap and states, counted by the kinds of its bodies (and,
+    inside one gate, by its two library parts); states by distinct pairs and summed mm^3."""
+    import collections
+    import re
+    out = {}
+    for c in rep.checks:
+        if c.name not in ("part_count", "min_gap", "states") or c.ok:
+            continue
+        kinds, inside, pairs, vol = collections.Counter(), collections.Counter(), {}, collections.Counter()
+        for f in c.failures:
+            f = re.sub(r"^\S+\[[^]]*\]: ", "", f)          # the mechanism's name
+            m = re.search(r"(\S+) is in \d+ pieces", f)
+            names = [m.group(1)] if m else list(re.findall(r"(\S+) (?:-|intersects) (\S+?):?(?: |$)", f)[:1] or [()])[0]
+            if not names:
+                kinds["unparsed"] += 1
+                continue
+            key = "-".join(sorted(kind_of(n) for n in names))
+            kinds[key] += 1
+            gates = {n.split("_", 1)[0] for n in names}
+            if key in ("gate", "gate-gate") and len(gates) == 1:
+                inside["-".join(sorted(n.split("_", 1)[1] for n in names))] += 1
+            v = re.search(r"\(([0-9.e+-]+) mm\^3\)", f)
+            if v:
+                pairs.setdefault(key, set()).add(tuple(sorted(names)))
+                vol[key] += float(v.group(1))
+        out[c.name] = {"failures": len(c.failures), "by_kind": dict(kinds.most_common()),
+                       "inside_one_gate": dict(inside.most_common())}
+        if pairs:
+            out[c.name]["distinct_pairs_by_kind"] = {k: len(v) for k, v in pairs.items()}
+            out[c.name]["mm3_by_kind"] = {k: round(v, 3) for k, v in vol.most_common()}
+    return out
+
+
+def outside_reads(mf3: Path) -> dict:
+    """The 3MF as third-party clients read it: lib3mf (strict) and ``prusa-slicer --info``."""
+    import shutil
+    import subprocess
+    res = {}
+    try:
+        import lib3mf
+        w = lib3mf.get_wrapper()
+        model = w.CreateModel()
+        reader = model.QueryReader("3mf")
+        reader.SetStrictModeActive(True)
+        t = time.perf_counter()
+        reader.ReadFromFile(str(mf3))
+        objs = model.GetObjects()
+        n_mesh = n_comp = tris = 0
+        while objs.MoveNext():
+            o = objs.GetCurrentObject()
+            if o.IsMeshObject():
+                n_mesh += 1
+                tris += model.GetMeshObjectByID(o.GetResourceID()).GetTriangleCount()
+            elif o.IsComponentsObject():
+                n_comp += 1
+        items = model.GetBuildItems()
+        n_items = 0
+        while items.MoveNext():
+            n_items += 1
+        res["lib3mf"] = {"version": ".".join(str(x) for x in w.GetLibraryVersion()[:3]), "strict": True,
+                         "warnings": reader.GetWarningCount(), "mesh_objects": n_mesh,
+                         "components_objects": n_comp, "build_items": n_items, "triangles": tris,
+                         "seconds": round(time.perf_counter() - t, 1)}
+    except ImportError:
+        res["lib3mf"] = "not installed"
+    except Exception as e:        # a reader error is the finding
+        res["lib3mf"] = {"error": str(e)[:300]}
+    exe = shutil.which("prusa-slicer")
+    if exe:
+        t = time.perf_counter()
+        r = subprocess.run([exe, "--info", str(mf3)], capture_output=True, text=True, timeout=3600)
+        info = {}
+        for line in r.stdout.splitlines():
+            if "=" in line:
+                k, v = line.split("=", 1)
+                info[k.strip()] = v.strip()
+        res["prusa_slicer_info"] = {"exit": r.returncode, "info": info, "seconds": round(time.perf_counter() - t, 1),
+                                    "stderr_tail": r.stderr.strip().splitlines()[-3:]}
+    else:
+        res["prusa_slicer_info"] = "not installed"
+    return res
 
 
 def plot(rows, path: Path) -> None:
@@ -158,12 +265,13 @@ def main() -> int:
     ap.add_argument("--limit", type=float, default=1800.0, help="seconds per case before it is recorded unfinished")
     ap.add_argument("--out", default=str(RESULTS / "mesh_circuit.json"))
     ap.add_argument("--keep", metavar="DIR", help="keep the STL, 3MF and JSON report of each case in DIR")
+    ap.add_argument("--outside", action="store_true", help="read the 3MF back with lib3mf and prusa-slicer --info")
     args = ap.parse_args()
     rows = []
     for name in args.cases.split(","):
         q = mp.get_context("fork").Queue()
         t = time.perf_counter()
-        p = mp.get_context("fork").Process(target=run_case, args=(name, args.profile, q, args.keep))
+        p = mp.get_context("fork").Process(target=run_case, args=(name, args.profile, q, args.keep, args.outside))
         p.start()
         peak = 0        # resident memory of the case's process, polled every second (MB)
         while p.is_alive() and time.perf_counter() - t < args.limit:
