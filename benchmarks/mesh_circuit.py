@@ -293,7 +293,8 @@ def main() -> int:
         row["wall_s"] = round(time.perf_counter() - t, 1)
         rows.append(row)
         print(json.dumps(row), flush=True)
-    out = {"benchmark": "mesh_circuit", "python": platform.python_version(), "machine": platform.machine(),
+    from gitstate import commit
+    out = {"benchmark": "mesh_circuit", "commit": commit(), "python": platform.python_version(), "machine": platform.machine(),
            "cpus": os.cpu_count(), "load_average": [round(x, 2) for x in os.getloadavg()],
            "note": "wall-clock seconds on a shared 2-core machine (other jobs running); mesh_s = mlc stl's "
                    "export_assembly (poses + build + report), write_s = STL + 3MF", "rows": rows}

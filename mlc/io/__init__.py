@@ -1,1 +1,2 @@
-"""File formats shared by several stages: YAML with source lines, schema validation."""
+"""What several stages share: file formats (YAML with source lines, schema validation, atomic
+writes), progress lines, the cores this process may use."""
