@@ -56,16 +56,9 @@ def chain_of(n: str) -> str:
 
 
 def sub_scene(big, sel):
-    from mlc.scene.model import Scene
+    from mlc.mesh.pipeline import sub_scene as take
     idx = [i for i, b in enumerate(big.bodies) if b.name in sel]
-    sub = Scene(name=f"{big.name}_sub", bodies=[big.bodies[i] for i in idx],
-                bonds=[x for x in big.bonds if x.a.split(".")[0] in sel and x.b.split(".")[0] in sel],
-                muscles=[x for x in big.muscles if x.a.split(".")[0] in sel and x.b.split(".")[0] in sel],
-                probes=[x for x in big.probes if x.a.split(".")[0] in sel and x.b.split(".")[0] in sel],
-                units=big.units, source=big.source)
-    sub.inputs = [q for q in big.inputs if any(m.input == q for m in sub.muscles)]
-    sub.outputs = [q for q in big.outputs if any(p.output == q for p in sub.probes)]
-    return sub, idx
+    return take(big, idx, f"{big.name}_sub"), idx
 
 
 def twist_of(big, names, poses, prof, res) -> dict:

@@ -109,8 +109,7 @@ def test_a_circuits_gates_keep_their_library_configurations_and_print_alone():
     from mlc.commands.stl import load_target
     from mlc.geometry.rotation import quat_to_matrix
     from mlc.mesh.checks import check_assembly
-    from mlc.mesh.pipeline import state_poses
-    from mlc.scene.model import Scene
+    from mlc.mesh.pipeline import state_poses, sub_scene
 
     built = pipeline.build(pipeline.compile_spec(pipeline.load(None, "(a & b) | c")))
     scene = built.circuit.scene
@@ -120,8 +119,8 @@ def test_a_circuits_gates_keep_their_library_configurations_and_print_alone():
     index = {b.name: i for i, b in enumerate(scene.bodies)}
     parts = ["core_ab", "core_cd", "a_lo", "a_hi", "b_lo", "b_hi", "out_lo", "out_hi"]
 
-    def turn(sc, ix, pq, a, b):
-        p, q = pq
+    def turn(ix, pq, a, b):
+        _, q = pq
         return quat_to_matrix(q[ix[a]]).T @ quat_to_matrix(q[ix[b]])
 
     def tip(sc, ix, pq, ref):
@@ -143,18 +142,14 @@ def test_a_circuits_gates_keep_their_library_configurations_and_print_alone():
             seen.add((g.id, state))
             for i, A in enumerate(parts):
                 for B in parts[i + 1:]:
-                    dR = turn(lib, lix, lib_poses[state], A, B).T @ turn(scene, index, pq, f"{g.id}_{A}", f"{g.id}_{B}")
+                    dR = turn(lix, lib_poses[state], A, B).T @ turn(index, pq, f"{g.id}_{A}", f"{g.id}_{B}")
                     ang = np.degrees(np.arccos(np.clip((np.trace(dR) - 1) / 2, -1, 1)))
                     assert ang < 0.05, (g.id, g.type, row, state, A, B, ang)
     assert len(seen) >= 6          # the gates pass through most of their input states
 
     g = built.netlist.gates[-1]     # the gate a chain drives: its parts alone, in the circuit's poses
     idx = [i for i, b in enumerate(scene.bodies) if b.name.startswith(f"{g.id}_")]
-    keep = {scene.bodies[i].name for i in idx}
-    sub = Scene(name="gate_alone", bodies=[scene.bodies[i] for i in idx],
-                bonds=[x for x in scene.bonds if x.a.split(".")[0] in keep and x.b.split(".")[0] in keep],
-                muscles=[x for x in scene.muscles if x.a.split(".")[0] in keep and x.b.split(".")[0] in keep],
-                units=scene.units, source=scene.source)
+    sub = sub_scene(scene, idx, "gate_alone")
     sub_poses = {k: (np.asarray(p)[idx], np.asarray(q)[idx]) for k, (p, q) in rows.items()}
     rep = check_assembly(build_assembly(sub, load_profile("mjp"), sub_poses), walls=False)
     for c in rep.checks:

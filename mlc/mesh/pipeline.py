@@ -65,20 +65,23 @@ def split_mechanisms(scene: Scene) -> list[Mechanism]:
         groups.setdefault(find(i), []).append(i)
     if len(groups) == 1:
         return [Mechanism(scene, list(range(n)))]
-    out = []
-    for members in sorted(groups.values()):
-        names = {scene.bodies[i].name for i in members}
-        sub = Scene(
-            name=f"{scene.name}[{scene.bodies[members[0]].name}]",
-            bodies=[scene.bodies[i] for i in members],
-            bonds=[x for x in scene.bonds if x.a.split(".")[0] in names],
-            muscles=[x for x in scene.muscles if x.a.split(".")[0] in names],
-            probes=[x for x in scene.probes if x.a.split(".")[0] in names],
-            units=scene.units, source=scene.source)
-        sub.inputs = [s for s in scene.inputs if any(m.input == s for m in sub.muscles)]
-        sub.outputs = [s for s in scene.outputs if any(p.output == s for p in sub.probes)]
-        out.append(Mechanism(sub, members))
-    return out
+    return [Mechanism(sub_scene(scene, members, f"{scene.name}[{scene.bodies[members[0]].name}]"), members)
+            for members in sorted(groups.values())]
+
+
+def sub_scene(scene: Scene, members: list[int], name: str) -> Scene:
+    """The bodies ``members`` (indices into ``scene.bodies``, kept in that order) with every bond,
+    muscle and probe between two of them, and the inputs and outputs those still carry."""
+    names = {scene.bodies[i].name for i in members}
+
+    def inside(x):
+        return x.a.split(".")[0] in names and x.b.split(".")[0] in names
+    sub = Scene(name=name, bodies=[scene.bodies[i] for i in members],
+                bonds=[x for x in scene.bonds if inside(x)], muscles=[x for x in scene.muscles if inside(x)],
+                probes=[x for x in scene.probes if inside(x)], units=scene.units, source=scene.source)
+    sub.inputs = [s for s in scene.inputs if any(m.input == s for m in sub.muscles)]
+    sub.outputs = [s for s in scene.outputs if any(p.output == s for p in sub.probes)]
+    return sub
 
 
 def _signature(scene: Scene):
