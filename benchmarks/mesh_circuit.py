@@ -183,7 +183,6 @@ def failure_kinds(rep) -> dict:
 def outside_reads(mf3: Path) -> dict:
     """The 3MF as third-party clients read it: lib3mf (strict) and ``prusa-slicer --info``."""
     import shutil
-    import subprocess
     res = {}
     try:
         import lib3mf
@@ -216,15 +215,9 @@ def outside_reads(mf3: Path) -> dict:
         res["lib3mf"] = {"error": str(e)[:300]}
     exe = shutil.which("prusa-slicer")
     if exe:
+        from slicer_gates import info        # benchmarks/slicer_gates.py: its --info reader
         t = time.perf_counter()
-        r = subprocess.run([exe, "--info", str(mf3)], capture_output=True, text=True, timeout=3600)
-        info = {}
-        for line in r.stdout.splitlines():
-            if "=" in line:
-                k, v = line.split("=", 1)
-                info[k.strip()] = v.strip()
-        res["prusa_slicer_info"] = {"exit": r.returncode, "info": info, "seconds": round(time.perf_counter() - t, 1),
-                                    "stderr_tail": r.stderr.strip().splitlines()[-3:]}
+        res["prusa_slicer_info"] = {**info(exe, mf3), "seconds": round(time.perf_counter() - t, 1)}
     else:
         res["prusa_slicer_info"] = "not installed"
     return res

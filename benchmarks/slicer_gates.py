@@ -230,7 +230,9 @@ def info(exe, path: Path) -> dict:
     return {"objects": txt.count(f"[{path.name}]"),
             "parts": [int(x) for x in re.findall(r"number_of_parts =\s*(\d+)", txt)],
             "min_z": [float(x) for x in re.findall(r"min_z = ([-\d.]+)", txt)],
-            "size": [[float(x) for x in m] for m in re.findall(r"size_x = ([\d.]+)\s+size_y = ([\d.]+)\s+size_z = ([\d.]+)", txt)]}
+            "size": [[float(x) for x in m] for m in re.findall(r"size_x = ([\d.]+)\s+size_y = ([\d.]+)\s+size_z = ([\d.]+)", txt)],
+            "manifold": re.findall(r"manifold = (\w+)", txt),
+            "volume_mm3": [float(x) for x in re.findall(r"volume = ([\d.]+)", txt)], "exit": r.returncode}
 
 
 def posed_solids(asm, R, config: bool = False):
