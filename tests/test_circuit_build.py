@@ -750,3 +750,46 @@ def test_layers_of_a_long_chain_are_its_built_frames_where_the_fast_recurrence_d
         assert np.all(np.isfinite(got)) and np.allclose(got, want, atol=1e-9)
         if not expect_diverged:
             assert np.array_equal(got, quick)          # the recurrence's own bits where it holds
+
+
+def test_a_chain_ends_under_its_input_levers_on_their_pivot_axis_clear_of_the_joint_at_d():
+    """A chain into a gate's input ends on sites ``in_end``: the levers' ``in`` sites moved
+    END_DROP down the pivot axis, so they turn as ``in`` does (the lever's stroke is the
+    same), carried by a post.  In every row the end joints stay at least 0.48 sigma (a
+    junction's ball and collar) from the sink gate's universal joint at d, where ``in``
+    itself comes within 0.3 sigma in some row of (a & b) | c (docs/circuits.md)."""
+    from mlc.circuit.build import END_DROP, POST_WIDTH
+    from mlc.geometry.rotation import quat_to_matrix
+    from mlc.verify.static import solve_states
+
+    spec = load(None, "(a & b) | c")
+    sc = build_circuit(compile_spec(spec).netlist, spec).scene
+    ends = [bd for bd in sc.bonds if bd.name.startswith("w_") and "_end_" in bd.name]
+    assert len(ends) == 2
+    sinks = {bd.b.split(".")[0] for bd in ends}
+    assert all(bd.b.endswith(".in_end") for bd in ends) and len(sinks) == 2
+    for bn in sinks:
+        b = sc.body(bn)
+        axis = b.sites["piv_1"] - b.sites["piv_0"]
+        axis /= np.linalg.norm(axis)
+        off = b.sites["in_end"] - b.sites["in"]
+        assert abs(np.linalg.norm(off) - END_DROP) < 1e-9
+        assert np.linalg.norm(np.cross(off, axis)) < 1e-9          # on the pivot axis through in
+        post = b.boxes[-1]                                          # the post ends POST_WIDTH short of it
+        tip = post.center + 0.5 * post.size[0] * (quat_to_matrix(post.orientation) @ [1.0, 0, 0])
+        assert abs(np.linalg.norm(tip - b.sites["in_end"]) - POST_WIDTH) < 1e-9
+    gid = next(iter(sinks)).split("_")[0]
+    idx = {b.name: i for i, b in enumerate(sc.bodies)}
+
+    def at(eq, ref):
+        bn, site = ref.split(".")
+        return eq.pos[idx[bn]] + quat_to_matrix(eq.quat[idx[bn]]) @ sc.body(bn).sites[site]
+
+    near_in, near_end = np.inf, np.inf
+    for row, eq in solve_states(sc).items():
+        d = at(eq, f"{gid}_core_cd.d")
+        for bn in sinks:
+            near_in = min(near_in, np.linalg.norm(at(eq, f"{bn}.in") - d))
+            near_end = min(near_end, np.linalg.norm(at(eq, f"{bn}.in_end") - d))
+        assert sc.truth_table[row] == "".join("1" if L > 1.25 else "0" for L in eq.probes.values())
+    assert near_in < 0.3 < 0.48 <= near_end, (near_in, near_end)

@@ -68,3 +68,55 @@ def test_library_gate_has_no_compound_junction():
     asm = build_assembly(gate_scene("NAND"), load_profile("mjp"), None, resolve=False)
     assert all(uj.host is None for uj in asm.ujoints)
     assert all(ax.joint is None for ax in asm.axes)
+
+
+def test_a_yoke_plate_into_a_rod_stops_over_the_knuckles_and_into_a_slab_reaches_on():
+    """_yoke_plates: a plate from a joint's pin into a rod (two thin sides: the post that
+    carries a circuit chain's end joint under a gate's input lever) reaches only
+    ``rod_reach`` from the pin, not the full ``reach`` along the rod, where it was a fin
+    that met the gate's core (session 44); a plate into a flat slab still reaches on."""
+    from mlc.mesh.build import SlabBox, _yoke_plates
+    t, reach, rod_reach = 0.6, 6.0, 2.3
+    origin, d = np.zeros(3), np.array([1.0, 0, 0])               # the second pin along x
+    R = np.eye(3)[:, [2, 1, 0]]                                  # box length along z, up from the pin
+    rod = SlabBox(np.array([0.0, 0.0, 4.0]), R, np.array([7.6, 0.6, 0.6]), 2)
+    flat = SlabBox(np.array([0.0, 0.0, 4.0]), R, np.array([7.6, 2.5, 0.6]), 2)
+    for sb, want in ((rod, rod_reach), (flat, reach)):
+        plates = _yoke_plates([sb], origin, d, [(-2.4, 2.4)], reach, t, rod_reach=rod_reach)
+        assert len(plates) == 1
+        p = plates[0]
+        assert abs(p.size[1] - want) < 1e-9 and abs(p.center[2] - want / 2) < 1e-9, (p.size, p.center)
+    # without rod_reach (every other caller) the rod's plate is as long as before
+    assert abs(_yoke_plates([rod], origin, d, [(-2.4, 2.4)], reach, t)[0].size[1] - reach) < 1e-9
+
+
+def test_a_free_second_pin_turns_its_yoke_away_from_a_part_it_would_meet():
+    """_PinClearance: where the other body's hinges give no second pin, the joint keeps the
+    first direction when its yoke knuckles clear every other part in every posed state, and
+    otherwise takes the direction about the first pin that clears them (mm)."""
+    from mlc.mesh.build import _PinClearance
+    R, c, t, reach = 1.1, 0.2, 0.6, 5.0
+    radii = np.array([1.3, 1.85, 2.4])
+    center, u, v = np.zeros(3), np.array([0.0, 0, 1]), np.array([1.0, 0, 0])
+    wall = np.array([[3.0, y, z] for y in np.linspace(-1, 1, 5) for z in np.linspace(-1, 1, 5)])   # a slab at x = 3
+    eye = np.eye(4)
+    moved = np.eye(4)
+    moved[0, 3] = 2.0                                            # ... or at x = 5
+    far = {"lever": np.zeros((0, 3)), "chain": np.zeros((0, 3)), "other": wall}
+    pc = _PinClearance(far, [("0", {"lever": eye, "chain": eye, "other": moved}),
+                             ("1", {"lever": eye, "chain": eye, "other": moved})], R, c, t, reach)
+    assert np.allclose(pc.choose(center, u, v, "chain", "lever", radii), v)      # clear (2.6 mm): kept
+    pc = _PinClearance(far, [("0", {"lever": eye, "chain": eye, "other": eye}),
+                             ("1", {"lever": eye, "chain": eye, "other": moved})], R, c, t, reach)
+    got = pc.choose(center, u, v, "chain", "lever", radii)
+    assert abs(np.dot(got, u)) < 1e-12 and abs(np.linalg.norm(got) - 1) < 1e-12
+    assert abs(got[0]) < 0.3                                     # turned across, away from the slab
+    kn = np.outer(np.r_[radii, -radii], got)
+    assert np.min(np.linalg.norm(kn[:, None] - wall[None], axis=2)) >= R + c + t / 2
+    # a knuckle laid out before counts as a part to clear
+    pc.add("neighbour", np.array([0.0, 3.0, 0.0]), np.array([1.0, 0, 0]), radii)
+    pc.state_T = [("0", {"lever": eye, "chain": eye, "other": moved, "neighbour": eye})]
+    got2 = pc.choose(center, u, np.array([0.0, 1.0, 0.0]), "chain", "lever", radii)
+    kn2 = np.outer(np.r_[radii, -radii], got2)
+    nb = np.array([0.0, 3.0, 0.0]) + np.outer(np.r_[radii, -radii], [1.0, 0, 0])
+    assert np.min(np.linalg.norm(kn2[:, None] - nb[None], axis=2)) >= 2 * R + c

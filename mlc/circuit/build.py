@@ -44,7 +44,7 @@ from mlc.errors import MlcError
 from mlc.gates.connector import (POST_WIDTH, Pair, Parts, branch_angles, chain_frames, chain_parts,
                                  connector_geometry, half_unit_parts, half_unit_prefix, join, junction_stops,
                                  max_bend, rotate)
-from mlc.gates.parts import slab_body
+from mlc.gates.parts import segment_box, slab_body
 from mlc.scene.model import Body, Bond, Muscle, Probe, Scene
 
 # Build CPU grows as gates^2.18 (least-rise levels, session 23: bodies ~ gates^1.17, build CPU
@@ -89,6 +89,10 @@ MAX_INPUTS = 14             # the scene's truth table lists every row
 LEVEL_PITCH = 23.0          # sigma between logic levels (z), plus LAYER_PITCH per route arriving
 GATE_PITCH = 12.0           # sigma between gates of one level (x)
 TERMINAL_POST = 0.8         # sigma: the last half unit's layer stays this far below a lever's plane
+END_DROP = 1.5              # sigma: a chain ends on its input levers' ``in`` sites moved this far down their
+                            # pivot's axis (``_pin_pair``), clear of the joint at d (docs/circuits.md)
+END_POST_FROM = 0.75        # ... each on a post from this fraction of the way from the pivot to ``in``
+END_POST = 0.3              # sigma: ... and the last half unit's layer stays at least this far below them
 LEVER_STOP = 0.35           # sigma: the last posts stop this short of a lever's joint sites (the lever is 0.5 wide)
 PAGE_CLEAR = 0.2           # sigma: extra post length that keeps a branch page clear of the driving lever
 LAYER_PITCH = 2.5           # sigma between the horizontal layers of the routes into one level
@@ -314,6 +318,34 @@ def _pair(bodies_by_name, lo: str, hi: str) -> Pair:
     p, q = _world(bodies_by_name, lo), _world(bodies_by_name, hi)
     L = float(np.linalg.norm(q - p))
     return Pair(lo, hi, 0.5 * (p + q), (q - p) / L, L)
+
+
+def _pin_pair(by_name, gid: str, pin: str) -> Pair:
+    """The pair a chain into gate ``gid``'s input ``pin`` ends on (sigma): sites ``in_end``
+    on the two input levers, their ``in`` sites moved ``END_DROP`` along the levers' pivot
+    axis towards ``piv_0``, the side the chains come from (-z), each carried by a post.
+
+    A point on the pivot axis through ``in`` turns with the lever exactly as ``in`` does, so
+    the gate's stroke and states stay as they are.  But the chain's end joints then sit
+    under the gate, where there is room for a junction's ball and collar: at ``in`` itself
+    the lower lever's tip passes 0.27 sigma from the gate's universal joint at d in one state
+    of most library gates, and the ball needs 0.48 (docs/circuits.md, "Where a chain ends").
+    The post (``POST_WIDTH`` square) runs from ``END_POST_FROM`` of the way out along the
+    lever (the tip itself passes the joint at d) to ``POST_WIDTH`` short of the joint.  The
+    sites and posts are added on first use."""
+    levers = [by_name[f"{gid}_{pin}_{e}"] for e in ("lo", "hi")]
+    for b in levers:
+        if "in_end" in b.sites:
+            continue
+        down = b.sites["piv_0"] - b.sites["piv_1"]
+        down /= np.linalg.norm(down)
+        end = b.sites["in"] + END_DROP * down
+        mid = 0.5 * (b.sites["piv_0"] + b.sites["piv_1"])
+        start = mid + END_POST_FROM * (b.sites["in"] - mid)
+        run = (end - start) / np.linalg.norm(end - start)
+        b.sites = {**b.sites, "in_end": end}
+        b.boxes = [*b.boxes, segment_box(start, end - POST_WIDTH * run, np.cross(down, run), POST_WIDTH, POST_WIDTH)]
+    return _pair(by_name, *(f"{b.name}.in_end" for b in levers))
 
 
 def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, progress=None) -> Circuit:
@@ -648,15 +680,15 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                 probes.append(Probe(c[1], c[1], end.lo, end.hi, geo.L0, geo.L1))
                 continue
             gid, pin_name = c[1], c[2]
-            target = _pair(by_name, f"{gid}_{pin_name}_lo.in", f"{gid}_{pin_name}_hi.in")
-            ext = TERMINAL_POST - 0.5 * geo.gap
+            target = _pin_pair(by_name, gid, pin_name)
+            ext = max(TERMINAL_POST - END_DROP, END_POST) - 0.5 * geo.gap
             app = np.array([0.0, 0.0, 1.0])
             d_sink = lvl[gid]
             k_layer = layer_next[d_sink]
             layer_next[d_sink] += 1
             z_run = zlevel[d_sink - 1] + RUN_BASE + LAYER_PITCH * k_layer
             x_rise = tap.centre[0] + RISER_PITCH * (k - 0.5 * (len(starts) - 1))
-            xp, yp, zp = target.centre
+            xp, yp, zp = _pair(by_name, f"{gid}_{pin_name}_lo.in", f"{gid}_{pin_name}_hi.in").centre   # the lane: as before
             # the two inputs of a gate are near one x and differ in y: come in from either side
             # (the input with the smaller x from -x), the far one (larger y) crossing lower
             other = _pair(by_name, *(f"{gid}_{'b' if pin_name == 'a' else 'a'}_{e}.in" for e in ("lo", "hi")))
@@ -785,7 +817,7 @@ def _check_reach(netlist, taps, consumers, by_name, level, geo) -> None:
         for c in consumers.get(wire, []):
             if c[0] != "pin":
                 continue
-            target = _pair(by_name, f"{c[1]}_{c[2]}_lo.in", f"{c[1]}_{c[2]}_hi.in")
+            target = _pin_pair(by_name, c[1], c[2])
             d = float(np.linalg.norm(target.centre - tap.centre))
             if d > reach:
                 src = "input" if wire[0] == "input" else "gate"

@@ -229,6 +229,8 @@ class UJoint:
     o_axis: HingeAxis | None = None  # compound junction: O's own hinge on the same line (re-laid), if any
     primary: bool = True      # branch junction: False for every page but the first (the part is the first's)
     mates: list = field(default_factory=list)  # branch junction: the other pages on the same joint part
+    free_pin: bool = False    # O's hinges run along u, so _PinClearance chose v: its yoke plate into a
+                              # rod stops over the knuckles (_yoke_plates' rod_reach)
 
 
 @dataclass
@@ -508,6 +510,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
     # pages of a connector branch on its source half unit) share one joint part
     groups = _branch_groups(joints, scene)
     done: set = set()
+    pin_clear = _PinClearance(base_samples, state_T, R, c, t, reach)
     for jname, bonds in joints.items():
         if bonds[0].kind != "universal" or jname in done:
             continue
@@ -560,7 +563,11 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
                 notes.append(f"universal joint {jname}: no room for a compound junction on hinge {hx.name}")
         u = _hinge_dir(cb, axes, slabs, center) if compound is None else compound["u"]
         v = _hinge_dir(ob, axes, slabs, center)
-        if abs(np.dot(u, v)) > 0.95:
+        parallel = abs(np.dot(u, v)) > 0.95
+        # ... and the joint hangs on a post, farther than ``reach`` from every hinge of O's (a
+        # chain's junction is nearer its next half unit's hinges, whose trims settle it)
+        free_v = parallel and all(_axis_distance(center, ax) > reach for ax in axes if ob in ax.bodies)
+        if parallel:
             w = np.mean([sb.center for sb in slabs[ob]], axis=0) - center
             v = np.cross(u, w)
             if np.linalg.norm(v) < 1e-9:
@@ -569,6 +576,10 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         v /= np.linalg.norm(v)
         hub = 2 * (R + c)
         ky = max(kmin, R)
+        radii = (compound["hub_v"] if compound is not None else hub) / 2 + g + ky * np.array([0.0, 0.5, 1.0])
+        if free_v:      # no hinge of its own gives the second pin: the one whose yoke stays clear
+            v = pin_clear.choose(center, u, v, cb, ob, radii)
+        pin_clear.add(ob, center, v, radii)
         cap = max(kmin, prof.min_wall)
         W = (_extent_along(slabs[cb], center, u), _extent_along(slabs[ob], center, v))
         best = None
@@ -584,6 +595,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
             part_name = jname if jname not in bodies else f"joint_{jname}"
             uj = UJoint(jname, part_name, center, (cb, ob), (u, v), lays, hub, R, r_pin, r_hole,
                         (float(np.hypot(lays[1].extent, R)) + c, float(np.hypot(lays[0].extent, R)) + c))
+            uj.free_pin = free_v
             if compound is not None:
                 uj.host, uj.hub_r, uj.collar = compound["axis"], compound["hub_r"], compound["collar"]
                 if np.isfinite(compound["dO"]):
@@ -962,6 +974,81 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
 
 # --------------------------------------------------------------------------- helpers
 _CONE_PROBE = [False]      # building to find the smallest sigma at which cones fit: never refuse
+
+
+SECOND_PIN_TRIES = 12      # second-pin directions tried, every 15 degrees about the first pin
+
+
+class _PinClearance:
+    """Chooses a universal joint's second pin where no hinge of the other body gives it: its
+    hinges run along the first pin and all of them are farther than the yoke's reach from the
+    joint (the joint hangs on a post, as a circuit chain's end under a gate's input lever;
+    not a chain's own junction, which is nearer the next half unit's hinges): of ``SECOND_PIN_TRIES`` directions about the first pin,
+    the one whose yoke knuckles (axis points at ``radii`` mm either side of the joint) stay
+    farthest, in every posed state, from the slabs of the other bodies and the knuckles of
+    the joints laid out before, measured past what each needs (a slab: R + c + t/2; a
+    knuckle: 2 R + c; mm).  The first direction (across the body's slabs, as before) is kept
+    when it clears all of them."""
+
+    def __init__(self, base_samples: dict, state_T: list, R: float, c: float, t: float, reach: float):
+        names = [bn for bn in base_samples if len(base_samples[bn])]
+        self.state_T, self.crop = state_T, reach + 4 * R
+        self.slab_need, self.knuckle_need = R + c + 0.5 * t, 2 * R + c
+        self.names, self.base = names, base_samples
+        self.knuckles: list = []        # (body, knuckle axis points)
+        self._tree = None
+
+    def add(self, body: str, center, v, radii) -> None:
+        """Knuckle axis points of a laid-out yoke (on ``body``), for the joints after it."""
+        self.knuckles.append((body, center + np.outer(np.r_[radii, -radii], v)))
+
+    def _near(self, center, cb: str, ob: str) -> list:
+        """[(body, points, need)] of the other bodies' slab samples and knuckles within the crop."""
+        if self._tree is None:
+            from scipy.spatial import cKDTree
+            self._owner = np.concatenate([np.full(len(self.base[bn]), i) for i, bn in enumerate(self.names)])
+            self._P = np.concatenate([self.base[bn] for bn in self.names])
+            self._tree = cKDTree(self._P)
+        ix = np.asarray(self._tree.query_ball_point(center, self.crop), dtype=int)
+        out = []
+        for i in np.unique(self._owner[ix]) if len(ix) else []:
+            bn = self.names[i]
+            if bn not in (cb, ob):
+                out.append((bn, self._P[ix[self._owner[ix] == i]], self.slab_need))
+        for bn, k in self.knuckles:
+            if bn not in (cb, ob) and np.min(np.linalg.norm(k - center, axis=1)) < self.crop:
+                out.append((bn, k, self.knuckle_need))
+        return out
+
+    def _score(self, center, v, ob: str, radii, near) -> float:
+        kn = center + np.outer(np.r_[radii, -radii], v)
+        worst = np.inf
+        for _, Ts in self.state_T:
+            To = Ts[ob]
+            k = kn @ To[:3, :3].T + To[:3, 3]
+            for bn, P, need in near:
+                Tb = Ts[bn]
+                q = P @ Tb[:3, :3].T + Tb[:3, 3]
+                worst = min(worst, float(np.linalg.norm(q[:, None, :] - k[None, :, :], axis=2).min()) - need)
+        return worst
+
+    def choose(self, center, u, v, cb: str, ob: str, radii) -> np.ndarray:
+        if not self.state_T:
+            return v
+        near = self._near(center, cb, ob)
+        if not near:
+            return v
+        best = (self._score(center, v, ob, radii, near), v)
+        if best[0] >= 0.0:
+            return v
+        w = np.cross(u, v)
+        for k in range(1, SECOND_PIN_TRIES):
+            a = np.pi * k / SECOND_PIN_TRIES
+            vk = np.cos(a) * v + np.sin(a) * w
+            sc = self._score(center, vk, ob, radii, near)
+            if sc > best[0] + 1e-9:
+                best = (sc, vk)
+        return best[1]
 
 
 def _cone_conflicts(asm: "Assembly", cores: dict) -> list:
@@ -2797,6 +2884,13 @@ def _hinge_dir(bn, axes, slabs, center) -> np.ndarray:
     return near.R[:, order[1]].copy()   # the width direction (middle dimension)
 
 
+def _axis_distance(p, ax: HingeAxis) -> float:
+    """Distance of point ``p`` from hinge ``ax``'s knuckle span (the segment of its line)."""
+    r = np.asarray(p, float) - ax.origin
+    a = float(np.clip(np.dot(r, ax.direction), -ax.span / 2, ax.span / 2))
+    return float(np.linalg.norm(r - a * ax.direction))
+
+
 def _extent_along(sbs, center, d) -> float:
     near = min(sbs, key=lambda sb: np.linalg.norm(sb.center - center))
     return float(np.sum(np.abs(near.R.T @ d) * near.size))
@@ -2835,12 +2929,18 @@ def _uj_plates(uj: UJoint, side: int, sbs, reach, t):
             out.append(SlabBox(uj.center + v * 0.5 * (b0 + b1) + u * 0.5 * hgt, np.column_stack([v, u, np.cross(v, u)]),
                                np.array([abs(b1 - b0), hgt, t]), 2))
         return out
-    return _yoke_plates(sbs, uj.center, uj.axes[side], [lay.plate], reach, t)
+    return _yoke_plates(sbs, uj.center, uj.axes[side], [lay.plate], reach, t,
+                        rod_reach=max(uj.R, uj.hub_r) + 2 * t if side == 1 and uj.free_pin else None)
 
 
-def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False):
+def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False, rod_reach=None):
     """Plates (as slab boxes) widening a body's slabs over ``intervals`` of an axis (``along``:
-    only slabs whose extent along the axis overlaps the interval)."""
+    only slabs whose extent along the axis overlaps the interval).  ``rod_reach`` (mm; given
+    for the yoke of a body whose hinges run along the first pin, ``UJoint.free_pin``): a
+    plate into a rod (a slab with two thin sides, such as the post that carries a circuit
+    chain's end joint under a gate's input lever) reaches only this far from the axis, over
+    the knuckles and the hub, and the rod carries it on; a plate as long as ``reach`` there
+    was a fin along the rod that met the gate's core (session 44)."""
     out = []
     for sb in sbs:
         rel = sb.center - origin
@@ -2860,6 +2960,8 @@ def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False):
         if np.linalg.norm(perp) - half > t:     # this slab does not reach the axis
             continue
         reach_b = min(reach, 2 * half)
+        if rod_reach is not None and sorted(sb.size)[1] <= 2 * t:
+            reach_b = min(reach_b, rod_reach)
         Rm = np.column_stack([d, w, np.cross(d, w)])
         # a slab printed from one face (_offset_slabs): its plate too, flush with it
         shift = 0.0 if rod else sb.offset * nrm
