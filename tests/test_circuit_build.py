@@ -793,3 +793,20 @@ def test_a_chain_ends_under_its_input_levers_on_their_pivot_axis_clear_of_the_jo
             near_end = min(near_end, np.linalg.norm(at(eq, f"{bn}.in_end") - d))
         assert sc.truth_table[row] == "".join("1" if L > 1.25 else "0" for L in eq.probes.values())
     assert near_in < 0.3 < 0.48 <= near_end, (near_in, near_end)
+
+
+def test_end_drop_0_ends_chains_on_the_in_sites_as_a_robots_circuit_does():
+    """CircuitOptions(end_drop=0), which mlc compile --robot uses (mlc.robot.build.CIRCUIT_END_DROP),
+    ends every chain on the levers' in sites with no post: the scene before session 44."""
+    from mlc.circuit.build import CircuitOptions
+    from mlc.robot.build import CIRCUIT_END_DROP
+    spec = load(None, "(a & b) | c")
+    net = compile_spec(spec).netlist
+    flat = build_circuit(net, spec, CircuitOptions(end_drop=CIRCUIT_END_DROP)).scene
+    low = build_circuit(net, spec).scene
+    for sc, site in ((flat, ".in"), (low, ".in_end")):
+        ends = [bd for bd in sc.bonds if bd.name.startswith("w_") and "_end_" in bd.name]
+        assert len(ends) == 2 and all(bd.b.endswith(site) for bd in ends), [bd.b for bd in ends]
+    assert not any("in_end" in b.sites for b in flat.bodies)
+    assert sum(len(b.boxes) for b in low.bodies if b.name.startswith("g2_")) == \
+        sum(len(b.boxes) for b in flat.bodies if b.name.startswith("g2_")) + 2     # the two posts

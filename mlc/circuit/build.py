@@ -147,6 +147,9 @@ class CircuitOptions:
                                      # (route.Prefetch); the scene is the same, bit for bit, for any jobs
     router: str = "auto"             # "ik": every chain solved whole (mlc.circuit.route); "fast": steered and
                                      # closed at its end; "auto": "fast" from FAST_FROM gates on, else "ik"
+    end_drop: float = END_DROP       # sigma: chains end this far under their input levers' in sites (_pin_pair);
+                                     # 0: on the in sites, as before session 44 (a robot's circuit:
+                                     # mlc.robot.build.CIRCUIT_END_DROP)
 
 
 @dataclass
@@ -320,10 +323,11 @@ def _pair(bodies_by_name, lo: str, hi: str) -> Pair:
     return Pair(lo, hi, 0.5 * (p + q), (q - p) / L, L)
 
 
-def _pin_pair(by_name, gid: str, pin: str) -> Pair:
+def _pin_pair(by_name, gid: str, pin: str, drop: float = END_DROP) -> Pair:
     """The pair a chain into gate ``gid``'s input ``pin`` ends on (sigma): sites ``in_end``
-    on the two input levers, their ``in`` sites moved ``END_DROP`` along the levers' pivot
-    axis towards ``piv_0``, the side the chains come from (-z), each carried by a post.
+    on the two input levers, their ``in`` sites moved ``drop`` along the levers' pivot
+    axis towards ``piv_0``, the side the chains come from (-z), each carried by a post
+    (``drop`` 0: the ``in`` sites themselves, no post).
 
     A point on the pivot axis through ``in`` turns with the lever exactly as ``in`` does, so
     the gate's stroke and states stay as they are.  But the chain's end joints then sit
@@ -334,12 +338,14 @@ def _pin_pair(by_name, gid: str, pin: str) -> Pair:
     lever (the tip itself passes the joint at d) to ``POST_WIDTH`` short of the joint.  The
     sites and posts are added on first use."""
     levers = [by_name[f"{gid}_{pin}_{e}"] for e in ("lo", "hi")]
+    if drop <= 0.0:
+        return _pair(by_name, *(f"{b.name}.in" for b in levers))
     for b in levers:
         if "in_end" in b.sites:
             continue
         down = b.sites["piv_0"] - b.sites["piv_1"]
         down /= np.linalg.norm(down)
-        end = b.sites["in"] + END_DROP * down
+        end = b.sites["in"] + drop * down
         mid = 0.5 * (b.sites["piv_0"] + b.sites["piv_1"])
         start = mid + END_POST_FROM * (b.sites["in"] - mid)
         run = (end - start) / np.linalg.norm(end - start)
@@ -600,7 +606,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                      if not (w[0] == "gate" and len(c) == 1 and c[0][0] == "pin"
                              and direct.get(c[0][1], (None,))[0] == w[1])}
     n_half += n_direct_half
-    _check_reach(netlist, taps, consumers, by_name, level, geo)
+    _check_reach(netlist, taps, consumers, by_name, level, geo, opt.end_drop)
     wires = [w for w in taps if consumers.get(w)]
     wires.sort(key=lambda w: w[1] not in first_wires)          # stable: the rest keep their order
     chains: list[_Chain] = []               # in routing order (routed after the loop, see _route_all)
@@ -680,8 +686,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                 probes.append(Probe(c[1], c[1], end.lo, end.hi, geo.L0, geo.L1))
                 continue
             gid, pin_name = c[1], c[2]
-            target = _pin_pair(by_name, gid, pin_name)
-            ext = max(TERMINAL_POST - END_DROP, END_POST) - 0.5 * geo.gap
+            target = _pin_pair(by_name, gid, pin_name, opt.end_drop)
+            ext = (max(TERMINAL_POST - opt.end_drop, END_POST) if opt.end_drop > 0 else TERMINAL_POST) - 0.5 * geo.gap
             app = np.array([0.0, 0.0, 1.0])
             d_sink = lvl[gid]
             k_layer = layer_next[d_sink]
@@ -806,7 +812,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     return _Routed(tight, min((g for _, g in tight), default=float("inf")), contacts, seconds, _assemble)
 
 
-def _check_reach(netlist, taps, consumers, by_name, level, geo) -> None:
+def _check_reach(netlist, taps, consumers, by_name, level, geo, drop: float = END_DROP) -> None:
     """Refuse, before any routing, a wire whose sink is farther from its tap in a straight line
     than the longest chain the router tries (``route.MAX_HALF`` half units of ``geo.pitch``):
     no route can close it (a route is never shorter than the straight line), and finding
@@ -817,7 +823,7 @@ def _check_reach(netlist, taps, consumers, by_name, level, geo) -> None:
         for c in consumers.get(wire, []):
             if c[0] != "pin":
                 continue
-            target = _pin_pair(by_name, c[1], c[2])
+            target = _pin_pair(by_name, c[1], c[2], drop)
             d = float(np.linalg.norm(target.centre - tap.centre))
             if d > reach:
                 src = "input" if wire[0] == "input" else "gate"

@@ -295,6 +295,9 @@ def run(args) -> int:
         from mlc.pipeline import build
         from mlc.scene.io import dump_scene
         extra = {} if joint_k is None else {"joint_k": joint_k}
+        if args.robot:
+            from mlc.robot.build import CIRCUIT_END_DROP
+            extra["end_drop"] = CIRCUIT_END_DROP
         opts = CircuitOptions(direct=bool(getattr(args, "direct", False)), max_gates=max_gates, jobs=args.jobs,
                               router=getattr(args, "router", "auto"), **extra)
         with Progress("placing and routing", total=1) as bar:
