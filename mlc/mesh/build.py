@@ -983,12 +983,13 @@ class _PinClearance:
     """Chooses a universal joint's second pin where no hinge of the other body gives it: its
     hinges run along the first pin and all of them are farther than the yoke's reach from the
     joint (the joint hangs on a post, as a circuit chain's end under a gate's input lever;
-    not a chain's own junction, which is nearer the next half unit's hinges): of ``SECOND_PIN_TRIES`` directions about the first pin,
-    the one whose yoke knuckles (axis points at ``radii`` mm either side of the joint) stay
-    farthest, in every posed state, from the slabs of the other bodies and the knuckles of
-    the joints laid out before, measured past what each needs (a slab: R + c + t/2; a
-    knuckle: 2 R + c; mm).  The first direction (across the body's slabs, as before) is kept
-    when it clears all of them."""
+    not a chain's own junction, which is nearer the next half unit's hinges).  Of
+    ``SECOND_PIN_TRIES`` directions about the first pin, the one whose yoke knuckles (axis
+    points at ``radii`` mm either side of the joint) stay farthest, in every posed state,
+    from the slabs of the other bodies and the knuckles of the joints laid out before,
+    measured past what each needs (a slab: R + c + t/2; a knuckle: 2 R + c; mm).  The first
+    direction (across the body's slabs, as before) is kept when it clears all of them.  Only
+    parts within ``reach + 4 R`` of the joint at rest are looked at."""
 
     def __init__(self, base_samples: dict, state_T: list, R: float, c: float, t: float, reach: float):
         names = [bn for bn in base_samples if len(base_samples[bn])]
