@@ -33,7 +33,7 @@ def test_direct_joins_the_pairs(two_gates):
     by = {b.name: b for b in sc.bodies}
     for e in ("lo", "hi"):                                              # the unit's end on the sink's pair
         b = bonds[f"d_{drv}_end_{e}"]
-        assert b.kind == "universal" and b.b == f"{sink}_{pin}_{e}.in"
+        assert b.kind == "universal" and b.b == f"{sink}_{pin}_{e}.in_end"
         pa, sa = b.a.split(".")
         pb, sb = b.b.split(".")
         assert np.linalg.norm(by[pa].world(sa) - by[pb].world(sb)) < 1e-9      # closed at build
@@ -51,6 +51,39 @@ def test_direct_two_gates_static_every_row(two_gates):
     assert rep.ok and len(rep.rows) == 8
     for r in rep.rows:
         assert r["joint_stretch"] < TOL_STRETCH and r["clearance"] > 0.0
+
+
+def test_a_direct_unit_ends_where_a_chain_does_clear_of_the_sinks_joint_at_d(two_gates):
+    """The unit ends on the sink's in_end sites (END_DROP under in, on the levers' pivot
+    axis), as a chain does; in every row of the independent static solve its end joints stay
+    at least 0.48 sigma (a printed junction's ball and collar) from the sink's universal
+    joint at d, and the table is computed.  end_drop 0 ends it on in, as before session 45."""
+    from mlc.circuit.build import END_DROP
+    from mlc.geometry.rotation import quat_to_matrix
+    from mlc.verify.static import solve_states
+    (net, circ), _ = two_gates
+    sc = circ.scene
+    drv, sink, pin = sc.meta["connector"]["direct"][0]
+    idx = {b.name: i for i, b in enumerate(sc.bodies)}
+    for e in ("lo", "hi"):
+        b = sc.body(f"{sink}_{pin}_{e}")
+        assert abs(np.linalg.norm(b.sites["in_end"] - b.sites["in"]) - END_DROP) < 1e-9
+
+    def at(eq, ref):
+        bn, site = ref.split(".")
+        return eq.pos[idx[bn]] + quat_to_matrix(eq.quat[idx[bn]]) @ sc.body(bn).sites[site]
+
+    near = np.inf
+    for row, eq in solve_states(sc).items():
+        d = at(eq, f"{sink}_core_cd.d")
+        near = min(near, *(np.linalg.norm(at(eq, f"{sink}_{pin}_{e}.in_end") - d) for e in ("lo", "hi")))
+        assert sc.truth_table[row] == "".join("1" if L > 1.25 else "0" for L in eq.probes.values())
+    assert near >= 0.48, near
+    spec = load(None, "f = ~(a & b) & c")
+    flat = build_circuit(compile_spec(spec).netlist, spec, options=CircuitOptions(direct=True, end_drop=0.0)).scene
+    ends = [bd.b for bd in flat.bonds if bd.name.startswith(f"d_{drv}_end_")]
+    assert ends == [f"{sink}_{pin}_lo.in", f"{sink}_{pin}_hi.in"]
+    assert not any("in_end" in b.sites for b in flat.bodies)
 
 
 @pytest.mark.parametrize("expr", ["f = ~(a & b) & c; g = ~(a & b)",       # the net is also read by an output

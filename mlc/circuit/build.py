@@ -90,7 +90,7 @@ LEVEL_PITCH = 23.0          # sigma between logic levels (z), plus LAYER_PITCH p
 GATE_PITCH = 12.0           # sigma between gates of one level (x)
 TERMINAL_POST = 0.8         # sigma: the last half unit's layer stays this far below a lever's plane
 END_DROP = 1.5              # sigma: a chain ends on its input levers' ``in`` sites moved this far down their
-                            # pivot's axis (``_pin_pair``), clear of the joint at d (docs/circuits.md)
+                            # pivot's axis (``_add_end_sites``), clear of the joint at d (docs/circuits.md)
 END_POST_FROM = 0.75        # ... each on a post from this fraction of the way from the pivot to ``in``
 END_POST = 0.3              # sigma: ... and the last half unit's layer stays at least this far below them
 LEVER_STOP = 0.35           # sigma: the last posts stop this short of a lever's joint sites (the lever is 0.5 wide)
@@ -147,7 +147,7 @@ class CircuitOptions:
                                      # (route.Prefetch); the scene is the same, bit for bit, for any jobs
     router: str = "auto"             # "ik": every chain solved whole (mlc.circuit.route); "fast": steered and
                                      # closed at its end; "auto": "fast" from FAST_FROM gates on, else "ik"
-    end_drop: float = END_DROP       # sigma: chains end this far under their input levers' in sites (_pin_pair);
+    end_drop: float = END_DROP       # sigma: chains end this far under their input levers' in sites (_add_end_sites);
                                      # 0: on the in sites, as before session 44 (a robot's circuit:
                                      # mlc.robot.build.CIRCUIT_END_DROP)
 
@@ -323,11 +323,11 @@ def _pair(bodies_by_name, lo: str, hi: str) -> Pair:
     return Pair(lo, hi, 0.5 * (p + q), (q - p) / L, L)
 
 
-def _pin_pair(by_name, gid: str, pin: str, drop: float = END_DROP) -> Pair:
-    """The pair a chain into gate ``gid``'s input ``pin`` ends on (sigma): sites ``in_end``
-    on the two input levers, their ``in`` sites moved ``drop`` along the levers' pivot
-    axis towards ``piv_0``, the side the chains come from (-z), each carried by a post
-    (``drop`` 0: the ``in`` sites themselves, no post).
+def _add_end_sites(by_name, gid: str, pin: str, drop: float = END_DROP) -> None:
+    """Give gate ``gid``'s two input levers of ``pin`` the sites a chain ends on (sigma):
+    ``in_end``, their ``in`` sites moved ``drop`` along the levers' pivot axis towards
+    ``piv_0``, the side the chains come from (-z), each carried by a post (``drop`` 0:
+    nothing is added; chains end on ``in``).  Idempotent.
 
     A point on the pivot axis through ``in`` turns with the lever exactly as ``in`` does, so
     the gate's stroke and states stay as they are.  But the chain's end joints then sit
@@ -335,23 +335,40 @@ def _pin_pair(by_name, gid: str, pin: str, drop: float = END_DROP) -> Pair:
     the lower lever's tip passes 0.27 sigma from the gate's universal joint at d in one state
     of most library gates, and the ball needs 0.48 (docs/circuits.md, "Where a chain ends").
     The post (``POST_WIDTH`` square) runs from ``END_POST_FROM`` of the way out along the
-    lever (the tip itself passes the joint at d) to ``POST_WIDTH`` short of the joint.  The
-    sites and posts are added on first use."""
-    levers = [by_name[f"{gid}_{pin}_{e}"] for e in ("lo", "hi")]
-    if drop <= 0.0:
-        return _pair(by_name, *(f"{b.name}.in" for b in levers))
-    for b in levers:
-        if "in_end" in b.sites:
-            continue
-        down = b.sites["piv_0"] - b.sites["piv_1"]
-        down /= np.linalg.norm(down)
-        end = b.sites["in"] + drop * down
-        mid = 0.5 * (b.sites["piv_0"] + b.sites["piv_1"])
-        start = mid + END_POST_FROM * (b.sites["in"] - mid)
-        run = (end - start) / np.linalg.norm(end - start)
-        b.sites = {**b.sites, "in_end": end}
-        b.boxes = [*b.boxes, segment_box(start, end - POST_WIDTH * run, np.cross(down, run), POST_WIDTH, POST_WIDTH)]
-    return _pair(by_name, *(f"{b.name}.in_end" for b in levers))
+    lever (the tip itself passes the joint at d) to ``POST_WIDTH`` short of the joint."""
+    if drop > 0.0:
+        for e in ("lo", "hi"):
+            end_site(by_name[f"{gid}_{pin}_{e}"], drop)
+
+
+def end_site(b: Body, drop: float) -> None:
+    """Give one input lever ``b`` its site ``in_end`` and the post carrying it
+    (:func:`_add_end_sites`; body-local, so the same in any pose).  Idempotent."""
+    if "in_end" in b.sites:
+        return
+    down = b.sites["piv_0"] - b.sites["piv_1"]
+    down /= np.linalg.norm(down)
+    end = b.sites["in"] + drop * down
+    mid = 0.5 * (b.sites["piv_0"] + b.sites["piv_1"])
+    start = mid + END_POST_FROM * (b.sites["in"] - mid)
+    run = (end - start) / np.linalg.norm(end - start)
+    b.sites = {**b.sites, "in_end": end}
+    b.boxes = [*b.boxes, segment_box(start, end - POST_WIDTH * run, np.cross(down, run), POST_WIDTH, POST_WIDTH)]
+
+
+def end_post(drop: float) -> float:
+    """How far (sigma) the last half unit's layer stays below the pair a chain ends on:
+    ``TERMINAL_POST`` below the lever plane when it ends on ``in`` (``drop`` 0), else
+    ``TERMINAL_POST - drop`` but at least ``END_POST`` below the ``in_end`` sites."""
+    return max(TERMINAL_POST - drop, END_POST) if drop > 0.0 else TERMINAL_POST
+
+
+def _pin_pair(by_name, gid: str, pin: str, drop: float = END_DROP) -> Pair:
+    """The pair a chain into gate ``gid``'s input ``pin`` ends on (sigma): the levers'
+    ``in_end`` sites (:func:`_add_end_sites`, which must have run), or with ``drop`` 0 their
+    ``in`` sites.  Reads only."""
+    site = "in_end" if drop > 0.0 else "in"
+    return _pair(by_name, *(f"{gid}_{pin}_{e}.{site}" for e in ("lo", "hi")))
 
 
 def build_circuit(netlist, spec=None, options: CircuitOptions | None = None, progress=None) -> Circuit:
@@ -556,7 +573,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         if g.id in direct:
             from mlc.circuit.direct import place_direct
             parts, R, t = place_direct(g.id, *direct[g.id], sc, pos, quat, by_name, zero[("gate", direct[g.id][0])],
-                                       geo, LEVER_STOP, TERMINAL_POST)
+                                       geo, LEVER_STOP, opt.end_drop)
             add(parts)
             gate_owned.append((parts.bodies, frozenset((g.id, direct[g.id][0]))))
             n_direct_half += 2
@@ -606,6 +623,10 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                      if not (w[0] == "gate" and len(c) == 1 and c[0][0] == "pin"
                              and direct.get(c[0][1], (None,))[0] == w[1])}
     n_half += n_direct_half
+    for wire in taps:                         # the sites chains end on (after gate_pts: their posts
+        for c in consumers.get(wire, []):     # are not among the points other chains keep from)
+            if c[0] == "pin":
+                _add_end_sites(by_name, c[1], c[2], opt.end_drop)
     _check_reach(netlist, taps, consumers, by_name, level, geo, opt.end_drop)
     wires = [w for w in taps if consumers.get(w)]
     wires.sort(key=lambda w: w[1] not in first_wires)          # stable: the rest keep their order
@@ -687,7 +708,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                 continue
             gid, pin_name = c[1], c[2]
             target = _pin_pair(by_name, gid, pin_name, opt.end_drop)
-            ext = (max(TERMINAL_POST - opt.end_drop, END_POST) if opt.end_drop > 0 else TERMINAL_POST) - 0.5 * geo.gap
+            ext = end_post(opt.end_drop) - 0.5 * geo.gap
             app = np.array([0.0, 0.0, 1.0])
             d_sink = lvl[gid]
             k_layer = layer_next[d_sink]

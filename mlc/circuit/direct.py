@@ -172,29 +172,42 @@ def pure_clearance(drv_type: str, drv_state: str, snk_type: str, snk_state: str,
 
 
 def place_direct(sid: str, drv: str, pin: str, sc, pos, quat, by_name: dict, state: int, geo: ConnectorGeometry,
-                 lever_stop: float, terminal_post: float) -> tuple[Parts, np.ndarray, np.ndarray]:
+                 lever_stop: float, drop: float) -> tuple[Parts, np.ndarray, np.ndarray]:
     """The direct connection from gate ``drv`` (already in ``by_name``) to input ``pin`` of
     gate ``sid`` (library scene ``sc`` posed at ``pos``/``quat``, its frame): the full unit
     straight up (+z) from the driver's output pair carrying ``state``, the sink on its end
     pair (lo-lo, hi-hi) with its core plane horizontal, and the three junction stops.
-    Returns (parts: the unit's and the sink's bodies and bonds, R, t: the sink's frame)."""
-    from mlc.circuit.build import _pair
+    The unit ends where a chain does (``drop``, sigma; :func:`mlc.circuit.build.end_site`):
+    on the sink's input levers' ``in_end`` sites, ``drop`` under ``in`` on their pivot
+    axis, its last layer :func:`mlc.circuit.build.end_post` below them (``drop`` 0: on
+    ``in``).  Returns (parts: the unit's and the sink's bodies and bonds, R, t: the sink's
+    frame)."""
+    from mlc.circuit.build import _pair, end_post, end_site
     tap = _pair(by_name, f"{drv}_out_lo.out", f"{drv}_out_hi.out")
     z = np.array([0.0, 0.0, 1.0])
     up = z - float(z @ tap.axis) * tap.axis        # up, normal to the pair (a posed pair may tilt a little)
     up /= np.linalg.norm(up)
     tag = f"d_{drv}"
-    parts, in0, mid, end = unit_parts(tag, tap, up, state, geo, lever_stop, terminal_post)
+    parts, in0, mid, end = unit_parts(tag, tap, up, state, geo, lever_stop, end_post(drop))
+    site = "in_end" if drop > 0.0 else "in"
     local = {b.name: Body(b.name, np.asarray(p, float), np.asarray(q, float), b.boxes, dict(b.sites))
              for b, p, q in zip(sc.bodies, pos, quat)}
-    inp = _pair(local, f"{pin}_lo.in", f"{pin}_hi.in")
+    if drop > 0.0:                       # body-local: the same site and post in any frame
+        for e in ("lo", "hi"):
+            end_site(local[f"{pin}_{e}"], drop)
+    inp = _pair(local, f"{pin}_lo.{site}", f"{pin}_hi.{site}")
     R, t = place_on_pair(inp, z, end, up)
     bodies, bonds = moved_bodies(sid, sc, pos, quat, R, t)
+    if drop > 0.0:
+        for b in bodies:
+            if b.name in (f"{sid}_{pin}_lo", f"{sid}_{pin}_hi"):
+                end_site(b, drop)
     parts.bodies += bodies
     parts.bonds += bonds
     names = {b.name: b for b in parts.bodies}
-    parts.bonds.append(Bond(f"{tag}_end_lo", end.lo, f"{sid}_{pin}_lo.in", geo.k, 0.0, 0.0, "universal", f"{tag}_end_lo"))
-    parts.bonds.append(Bond(f"{tag}_end_hi", end.hi, f"{sid}_{pin}_hi.in", geo.k, 0.0, 0.0, "universal", f"{tag}_end_hi"))
+    for e in ("lo", "hi"):
+        parts.bonds.append(Bond(f"{tag}_end_{e}", getattr(end, e), f"{sid}_{pin}_{e}.{site}", geo.k, 0.0, 0.0,
+                                "universal", f"{tag}_end_{e}"))
     lever = by_name[tap.lo.split(".")[0]]
     body = lambda ref: names[ref.split(".")[0]]
     world = lambda ref: body(ref).world(ref.split(".")[1])
@@ -204,5 +217,5 @@ def place_direct(sid: str, drv: str, pin: str, sc, pos, quat, by_name: dict, sta
                                   body(f"{tag}_1_AB.A"), world(f"{tag}_1_AB.A"), up, geo.k))
     sink_lever = names[f"{sid}_{pin}_lo"]
     parts.bonds.append(swing_stop(f"{tag}_s2", body(end.lo), world(end.lo), up,
-                                  sink_lever, sink_lever.world("in"), up, geo.k))
+                                  sink_lever, sink_lever.world(site), up, geo.k))
     return parts, R, t
