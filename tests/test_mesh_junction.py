@@ -90,6 +90,35 @@ def test_a_yoke_plate_into_a_rod_stops_over_the_knuckles_and_into_a_slab_reaches
     assert abs(_yoke_plates([rod], origin, d, [(-2.4, 2.4)], reach, t)[0].size[1] - reach) < 1e-9
 
 
+def test_a_yoke_plate_across_a_slab_stays_on_the_slab():
+    """_yoke_plates with ``fin_min`` (a universal joint's yokes): where the joint's pin crosses the
+    slab's plane (a circuit chain's first junction on a gate's output lever), the plate is a fin
+    standing across the slab; it reaches only as far as its mid-line stays on the slab, at least
+    ``fin_min``.  Past the slab's outline it was a free fin that met the fin of the other output
+    lever's junction in the rows where the two levers turn against each other (``(a & b) | c``:
+    g1_out_lo against g1_out_hi, 0.46 mm^3 in rows 110 and 111; session 45).  A plate whose pin
+    lies in the slab's plane (a widened slab) is as before (mm)."""
+    from mlc.mesh.build import SlabBox, _yoke_plates
+    t, reach = 0.6, 6.4
+    origin = np.zeros(3)                                       # the joint at the slab's tip
+    slab = SlabBox(np.array([-2.8, 0.0, 0.0]), np.eye(3), np.array([5.6, 2.5, 0.6]), 2)   # along x, 2.5 wide (y)
+    tilted = np.array([0.6, 0.5, 0.62])
+    tilted /= np.linalg.norm(tilted)                           # the pin out of the slab's plane (z its normal)
+    long_ = _yoke_plates([slab], origin, tilted, [(-2.6, 2.6)], reach, t)[0]
+    got = _yoke_plates([slab], origin, tilted, [(-2.6, 2.6)], reach, t, fin_min=1.7)[0]
+    w = got.R[:, 1]
+    end = origin + w * got.size[1]                             # the end of the fin's mid-line
+    assert got.size[1] < long_.size[1] - 1.0, (got.size, long_.size)
+    assert abs(abs(end[1]) - 1.25) < 1e-9 and -5.6 <= end[0] <= 0.0, end      # it leaves the slab at its side
+    assert np.allclose(got.center, origin + w * got.size[1] / 2)
+    # at least fin_min, however soon the mid-line leaves the slab
+    assert abs(_yoke_plates([slab], origin, tilted, [(-2.6, 2.6)], reach, t, fin_min=4.0)[0].size[1] - 4.0) < 1e-9
+    # a pin in the slab's plane: the slab widened as before
+    flat = np.array([0.0, 1.0, 0.0])
+    a, b = (_yoke_plates([slab], origin, flat, [(-2.6, 2.6)], reach, t, fin_min=f)[0] for f in (None, 1.7))
+    assert np.allclose(a.size, b.size) and np.allclose(a.center, b.center)
+
+
 def test_a_free_second_pin_turns_its_yoke_away_from_a_part_it_would_meet():
     """_PinClearance: where the other body's hinges give no second pin, the joint keeps the
     first direction when its yoke knuckles clear every other part in every posed state, and

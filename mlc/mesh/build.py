@@ -976,6 +976,9 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
 _CONE_PROBE = [False]      # building to find the smallest sigma at which cones fit: never refuse
 
 
+#: a yoke plate whose axis leaves the slab's plane by more than this (sine) is a fin across
+#: the slab, kept on it (:func:`_yoke_plates`)
+FIN_SIN = 0.05
 SECOND_PIN_TRIES = 12      # second-pin directions tried, every 15 degrees about the first pin
 
 
@@ -2931,17 +2934,26 @@ def _uj_plates(uj: UJoint, side: int, sbs, reach, t):
                                np.array([abs(b1 - b0), hgt, t]), 2))
         return out
     return _yoke_plates(sbs, uj.center, uj.axes[side], [lay.plate], reach, t,
-                        rod_reach=max(uj.R, uj.hub_r) + 2 * t if side == 1 and uj.free_pin else None)
+                        rod_reach=max(uj.R, uj.hub_r) + 2 * t if side == 1 and uj.free_pin else None,
+                        fin_min=uj.R + t)
 
 
-def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False, rod_reach=None):
+def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False, rod_reach=None, fin_min=None):
     """Plates (as slab boxes) widening a body's slabs over ``intervals`` of an axis (``along``:
     only slabs whose extent along the axis overlaps the interval).  ``rod_reach`` (mm; given
     for the yoke of a body whose hinges run along the first pin, ``UJoint.free_pin``): a
     plate into a rod (a slab with two thin sides, such as the post that carries a circuit
     chain's end joint under a gate's input lever) reaches only this far from the axis, over
     the knuckles and the hub, and the rod carries it on; a plate as long as ``reach`` there
-    was a fin along the rod that met the gate's core (session 44)."""
+    was a fin along the rod that met the gate's core (session 44).
+
+    ``fin_min`` (mm; given for a universal joint's yokes): a plate whose axis crosses the
+    slab's plane (not a widened slab but a fin standing across it: a circuit chain's first
+    junction on a gate's output lever, whose second pin is the lever's hinge made square to
+    the chain's first hinge, 38 degrees out of the lever's plane in ``(a & b) | c``) reaches
+    only as far as its mid-line stays on the slab, and at least ``fin_min``; past the slab's
+    outline it was a free fin, off the lever's layer, that met the fin of the other output
+    lever's junction where the two levers turn against each other (session 45)."""
     out = []
     for sb in sbs:
         rel = sb.center - origin
@@ -2963,6 +2975,8 @@ def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False, rod_reach=Non
         reach_b = min(reach, 2 * half)
         if rod_reach is not None and sorted(sb.size)[1] <= 2 * t:
             reach_b = min(reach_b, rod_reach)
+        if fin_min is not None and not rod and abs(float(np.dot(d, nrm))) > FIN_SIN:
+            reach_b = min(reach_b, max(_on_slab(sb, origin, w), fin_min))
         Rm = np.column_stack([d, w, np.cross(d, w)])
         # a slab printed from one face (_offset_slabs): its plate too, flush with it
         shift = 0.0 if rod else sb.offset * nrm
@@ -2972,6 +2986,19 @@ def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False, rod_reach=Non
             out.append(SlabBox(origin + d * 0.5 * (a0 + a1) + w * reach_b / 2 + shift, Rm,
                                np.array([a1 - a0, reach_b, t]), 2, sb.offset))
     return out
+
+
+def _on_slab(sb: SlabBox, p, w) -> float:
+    """How far (mm) the line from ``p`` along ``w`` (a unit vector in the slab's plane) stays in
+    the slab box ``sb``'s outline (0 when it is not in it there)."""
+    o = sb.R.T @ (np.asarray(p, float) - sb.center)
+    wl = sb.R.T @ w
+    out = np.inf
+    for i in range(3):
+        if i == sb.normal_axis or abs(wl[i]) < 1e-9:
+            continue
+        out = min(out, (np.sign(wl[i]) * 0.5 * sb.size[i] - o[i]) / wl[i])
+    return max(float(out), 0.0)
 
 
 def _near_axis(bn, p, axes, ujoints, dist) -> bool:
