@@ -752,18 +752,22 @@ def test_layers_of_a_long_chain_are_its_built_frames_where_the_fast_recurrence_d
             assert np.array_equal(got, quick)          # the recurrence's own bits where it holds
 
 
-def test_a_chain_ends_under_its_input_levers_on_their_pivot_axis_clear_of_the_joint_at_d():
+@pytest.mark.parametrize("which", ["circuit", "robot"])
+def test_a_chain_ends_under_its_input_levers_on_their_pivot_axis_clear_of_the_joint_at_d(which):
     """A chain into a gate's input ends on sites ``in_end``: the levers' ``in`` sites moved
-    END_DROP down the pivot axis, so they turn as ``in`` does (the lever's stroke is the
-    same), carried by a post.  In every row the end joints stay at least 0.48 sigma (a
-    junction's ball and collar) from the sink gate's universal joint at d, where ``in``
-    itself comes within 0.3 sigma in some row of (a & b) | c (docs/circuits.md)."""
-    from mlc.circuit.build import END_DROP, POST_WIDTH
+    END_DROP (a robot's circuit: CIRCUIT_END_DROP) down the pivot axis, so they turn as
+    ``in`` does (the lever's stroke is the same), carried by a post.  In every row the end
+    joints stay at least 0.48 sigma (a junction's ball and collar) from the sink gate's
+    universal joint at d, where ``in`` itself comes within 0.3 sigma in some row of
+    (a & b) | c (docs/circuits.md)."""
+    from mlc.circuit.build import END_DROP, POST_WIDTH, CircuitOptions
     from mlc.geometry.rotation import quat_to_matrix
+    from mlc.robot.build import CIRCUIT_END_DROP
     from mlc.verify.static import solve_states
 
+    drop = END_DROP if which == "circuit" else CIRCUIT_END_DROP
     spec = load(None, "(a & b) | c")
-    sc = build_circuit(compile_spec(spec).netlist, spec).scene
+    sc = build_circuit(compile_spec(spec).netlist, spec, CircuitOptions(end_drop=drop)).scene
     ends = [bd for bd in sc.bonds if bd.name.startswith("w_") and "_end_" in bd.name]
     assert len(ends) == 2
     sinks = {bd.b.split(".")[0] for bd in ends}
@@ -773,7 +777,7 @@ def test_a_chain_ends_under_its_input_levers_on_their_pivot_axis_clear_of_the_jo
         axis = b.sites["piv_1"] - b.sites["piv_0"]
         axis /= np.linalg.norm(axis)
         off = b.sites["in_end"] - b.sites["in"]
-        assert abs(np.linalg.norm(off) - END_DROP) < 1e-9
+        assert abs(np.linalg.norm(off) - drop) < 1e-9
         assert np.linalg.norm(np.cross(off, axis)) < 1e-9          # on the pivot axis through in
         post = b.boxes[-1]                                          # the post ends POST_WIDTH short of it
         tip = post.center + 0.5 * post.size[0] * (quat_to_matrix(post.orientation) @ [1.0, 0, 0])
@@ -795,14 +799,13 @@ def test_a_chain_ends_under_its_input_levers_on_their_pivot_axis_clear_of_the_jo
     assert near_in < 0.3 < 0.48 <= near_end, (near_in, near_end)
 
 
-def test_end_drop_0_ends_chains_on_the_in_sites_as_a_robots_circuit_does():
-    """CircuitOptions(end_drop=0), which mlc compile --robot uses (mlc.robot.build.CIRCUIT_END_DROP),
-    ends every chain on the levers' in sites with no post: the scene before session 44."""
+def test_end_drop_0_ends_chains_on_the_in_sites_as_before_session_44():
+    """CircuitOptions(end_drop=0) ends every chain on the levers' in sites with no post: the
+    scene before session 44 (a robot's circuit until session 45)."""
     from mlc.circuit.build import CircuitOptions
-    from mlc.robot.build import CIRCUIT_END_DROP
     spec = load(None, "(a & b) | c")
     net = compile_spec(spec).netlist
-    flat = build_circuit(net, spec, CircuitOptions(end_drop=CIRCUIT_END_DROP)).scene
+    flat = build_circuit(net, spec, CircuitOptions(end_drop=0.0)).scene
     low = build_circuit(net, spec).scene
     for sc, site in ((flat, ".in"), (low, ".in_end")):
         ends = [bd for bd in sc.bonds if bd.name.startswith("w_") and "_end_" in bd.name]

@@ -85,10 +85,11 @@ from mlc.scene.model import Body, Bond, Probe, Scene
 JOINT_LENGTH = 2.0       # sigma: length of a unit's joint piece (between its up and down hinges)
 POST = 0.6               # sigma: the lever sites sit this far below the skeleton plane
 #: sigma: the circuit a robot is built on ends its chains this far under the gates' input levers
-#: (mlc.circuit.build.CircuitOptions.end_drop).  0, the in sites as before session 44: with the
-#: ends 1.5 sigma under them the Tetris circuit's chains change, and the coupling to u3_up found no
-#: route clear of them ("cannot route output u3_up"); the couplings are not re-routed for it yet
-CIRCUIT_END_DROP = 0.0
+#: (mlc.circuit.build.CircuitOptions.end_drop), less than a circuit's END_DROP (1.5): with the
+#: ends 1.5 sigma under them the Tetris circuit's chains change so that the coupling to u3_up
+#: found no route clear of them ("cannot route output u3_up"); with 1.0 every coupling routes
+#: clear, and the end joints still keep 0.48 sigma from the gate's joint at d (docs/robot.md 6)
+CIRCUIT_END_DROP = 1.0
 HINGE_WIDTH = 0.5        # sigma between the two bonds of a skeleton hinge (along z)
 APPROACH_RUN = 4.0       # sigma: the chain's last stretch rises straight into the skeleton
 FAN_ANGLES = (0.0, 70.0, -70.0, 140.0, -140.0, 180.0)   # deg: a chain's first tangent turned about its output pair
