@@ -148,8 +148,8 @@ class CircuitOptions:
     router: str = "auto"             # "ik": every chain solved whole (mlc.circuit.route); "fast": steered and
                                      # closed at its end; "auto": "fast" from FAST_FROM gates on, else "ik"
     end_drop: float = END_DROP       # sigma: chains end this far under their input levers' in sites (_add_end_sites);
-                                     # 0: on the in sites, as before session 44 (a robot's circuit:
-                                     # mlc.robot.build.CIRCUIT_END_DROP)
+                                     # 0: on the in sites, as before session 44 (a robot's circuit
+                                     # takes mlc.robot.build.CIRCUIT_END_DROP, 1.0)
 
 
 @dataclass
