@@ -113,6 +113,13 @@ def test_a_yoke_plate_across_a_slab_stays_on_the_slab():
     assert np.allclose(got.center, origin + w * got.size[1] / 2)
     # at least fin_min, however soon the mid-line leaves the slab
     assert abs(_yoke_plates([slab], origin, tilted, [(-2.6, 2.6)], reach, t, fin_min=4.0)[0].size[1] - 4.0) < 1e-9
+    # a body with a post (an input lever carrying a chain's end joint): the plate into its slab
+    # is what joins the post's knuckles to it, so no limit (the Tetris circuit's g1_a_lo and
+    # g2_b_lo came out in 3 pieces with it)
+    post = SlabBox(np.array([0.0, 0.0, -1.0]), np.eye(3), np.array([0.4, 0.4, 2.0]), 2)
+    a, b = (_yoke_plates([slab, post], origin, tilted, [(-2.6, 2.6)], reach, t, fin_min=f) for f in (None, 1.7))
+    assert len(a) == len(b) >= 1 and all(np.allclose(x.size, y.size) for x, y in zip(a, b))
+    assert any(abs(x.size[1] - long_.size[1]) < 1e-9 for x in b)
     # a pin in the slab's plane: the slab widened as before
     flat = np.array([0.0, 1.0, 0.0])
     a, b = (_yoke_plates([slab], origin, flat, [(-2.6, 2.6)], reach, t, fin_min=f)[0] for f in (None, 1.7))

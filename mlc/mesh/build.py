@@ -2955,6 +2955,9 @@ def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False, rod_reach=Non
     outline it was a free fin, off the lever's layer, that met the fin of the other output
     lever's junction where the two levers turn against each other (session 45)."""
     out = []
+    # a body with a post (a rod: two thin sides), such as an input lever carrying a chain's end
+    # joint: its plate into the slab is what joins the post's knuckles to it; no fin limit
+    post = any(sorted(sb.size)[1] <= 2 * t for sb in sbs)
     for sb in sbs:
         rel = sb.center - origin
         if along:
@@ -2975,7 +2978,7 @@ def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False, rod_reach=Non
         reach_b = min(reach, 2 * half)
         if rod_reach is not None and sorted(sb.size)[1] <= 2 * t:
             reach_b = min(reach_b, rod_reach)
-        if fin_min is not None and not rod and abs(float(np.dot(d, nrm))) > FIN_SIN:
+        if fin_min is not None and not post and not rod and abs(float(np.dot(d, nrm))) > FIN_SIN:
             reach_b = min(reach_b, max(_on_slab(sb, origin, w), fin_min))
         Rm = np.column_stack([d, w, np.cross(d, w)])
         # a slab printed from one face (_offset_slabs): its plate too, flush with it
