@@ -198,10 +198,11 @@ def place_direct(sid: str, drv: str, pin: str, sc, pos, quat, by_name: dict, sta
     inp = _pair(local, f"{pin}_lo.{site}", f"{pin}_hi.{site}")
     R, t = place_on_pair(inp, z, end, up)
     bodies, bonds = moved_bodies(sid, sc, pos, quat, R, t)
-    if drop > 0.0:
+    if drop > 0.0:                       # the posed levers take the local ones' site and post
         for b in bodies:
             if b.name in (f"{sid}_{pin}_lo", f"{sid}_{pin}_hi"):
-                end_site(b, drop)
+                src = local[b.name[len(sid) + 1:]]
+                b.sites, b.boxes = dict(src.sites), list(src.boxes)
     parts.bodies += bodies
     parts.bonds += bonds
     names = {b.name: b for b in parts.bodies}

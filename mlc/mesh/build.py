@@ -2938,6 +2938,12 @@ def _uj_plates(uj: UJoint, side: int, sbs, reach, t):
                         fin_min=uj.R + t)
 
 
+def _is_rod(sb: SlabBox, t) -> bool:
+    """A slab box with two thin sides (at most ``2 t`` mm), a rod rather than a plate: a page's
+    arm, or the post that carries a circuit chain's end joint under a gate's input lever."""
+    return sorted(sb.size)[1] <= 2 * t
+
+
 def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False, rod_reach=None, fin_min=None):
     """Plates (as slab boxes) widening a body's slabs over ``intervals`` of an axis (``along``:
     only slabs whose extent along the axis overlaps the interval).  ``rod_reach`` (mm; given
@@ -2957,7 +2963,7 @@ def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False, rod_reach=Non
     out = []
     # a body with a post (a rod: two thin sides), such as an input lever carrying a chain's end
     # joint: its plate into the slab is what joins the post's knuckles to it; no fin limit
-    post = any(sorted(sb.size)[1] <= 2 * t for sb in sbs)
+    post = any(_is_rod(sb, t) for sb in sbs)
     for sb in sbs:
         rel = sb.center - origin
         if along:
@@ -2967,7 +2973,7 @@ def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False, rod_reach=Non
         perp = rel - np.dot(rel, d) * d
         nrm = sb.R[:, sb.normal_axis]
         # in the slab's plane; a rod (two thin sides: a page's arm) has no plane: straight at it
-        rod = along and sorted(sb.size)[1] <= 2 * t
+        rod = along and _is_rod(sb, t)
         w = perp if rod else perp - np.dot(perp, nrm) * nrm
         if np.linalg.norm(w) < 1e-6:
             continue
@@ -2976,7 +2982,7 @@ def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False, rod_reach=Non
         if np.linalg.norm(perp) - half > t:     # this slab does not reach the axis
             continue
         reach_b = min(reach, 2 * half)
-        if rod_reach is not None and sorted(sb.size)[1] <= 2 * t:
+        if rod_reach is not None and _is_rod(sb, t):
             reach_b = min(reach_b, rod_reach)
         if fin_min is not None and not post and not rod and abs(float(np.dot(d, nrm))) > FIN_SIN:
             reach_b = min(reach_b, max(_on_slab(sb, origin, w), fin_min))
