@@ -204,3 +204,23 @@ def test_dynamic_verify_bar_moves_within_a_fold(robot, monkeypatch):
     assert len(mids) >= 3 and [d for d, _ in mids] == sorted(d for d, _ in mids)
     assert all("0/1" in t for _, t in mids) and any("ETA     ? s" not in t for _, t in mids)
     assert seen[-1][0] == 1
+
+
+def test_the_tetris_robot_with_a_muscle_per_lever_folds_every_shape(tmp_path, capsys):
+    """The paper's robot with a muscle on every input lever (docs/robot.md 3.4, session 46):
+    a third of the default build's bodies, and the static verifier reads I, L, S and O."""
+    root = Path(__file__).resolve().parents[1] / "examples"
+    out = tmp_path / "r"
+    assert main(["compile", str(root / "tetris.tt"), "--robot", str(root / "tetris.robot.yaml"),
+                 "--muscle-per-lever", "-o", str(out)]) == 0
+    sc = load_scene(out / "robot.yaml")
+    assert sc.meta["circuit"]["connector"]["muscle_per_lever"] is True
+    assert len(sc.bodies) < 800 and not any(b.name.startswith(("w_y_", "w_b_")) and "_stub" not in b.name
+                                            for b in sc.bodies)
+    assert sum(m.input == "y" for m in sc.muscles) == 4 and sum(m.input == "b" for m in sc.muscles) == 3
+    capsys.readouterr()
+    assert main(["verify", str(out / "robot.yaml"), "--json"]) == 0
+    rep = json.loads(capsys.readouterr().out)
+    rows = {r["state"]: r for r in rep["rows"]}
+    assert {s: r["shape_read"] for s, r in rows.items()} == {"00": "I", "01": "L", "10": "S", "11": "O"}
+    assert all(r["max_dof_error_deg"] < 0.01 for r in rows.values())

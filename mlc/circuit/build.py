@@ -18,7 +18,10 @@ Rules (docs/circuits.md):
   input drives that input lever directly (the library gate's own muscle); otherwise
   the muscle spans the input diagonal of a *source* half unit (at level 0, or one level
   below its lowest consumer), whose output pair (carrying the inverted signal) is the
-  tap of the wire.
+  tap of the wire.  With ``CircuitOptions.muscle_per_lever`` (a global stimulus: every
+  muscle of an input's material responds to it, as the paper's colours) every input
+  lever an input drives carries a muscle of its own, and only an output that reads an
+  input directly still needs the input's source.
 * **Taps and fan-out.**  A wire's tap is a gate's output pair (or a source's).  One
   consumer: a chain hangs on the tap.  Several: a branch: one half unit (a page) per
   consumer hangs on the tap, turned about the tap's axis, and each page's chain goes on.
@@ -147,6 +150,8 @@ class CircuitOptions:
                                      # (route.Prefetch); the scene is the same, bit for bit, for any jobs
     router: str = "auto"             # "ik": every chain solved whole (mlc.circuit.route); "fast": steered and
                                      # closed at its end; "auto": "fast" from FAST_FROM gates on, else "ik"
+    muscle_per_lever: bool = False   # every input lever a circuit input drives carries its own muscle of that
+                                     # input (a global stimulus); no chains from the inputs to the gates
     end_drop: float = END_DROP       # sigma: chains end this far under their input levers' in sites (_add_end_sites);
                                      # 0: on the in sites, as before session 44 (a robot's circuit
                                      # takes mlc.robot.build.CIRCUIT_END_DROP, 1.0)
@@ -230,7 +235,7 @@ def _wire_values(netlist, bits: dict) -> dict:
     return val
 
 
-def place_levels(netlist, sources) -> dict[tuple, int]:
+def place_levels(netlist, sources, muscled=()) -> dict[tuple, int]:
     """Level of every gate (``("gate", id)``) and of every input source (``("input", name)``
     for the inputs in ``sources``; the other inputs drive one lever directly and have no place).
 
@@ -241,7 +246,8 @@ def place_levels(netlist, sources) -> dict[tuple, int]:
     constraints are differences, so the optimal vertex is integral).  Among the least, the
     lowest levels win (a term ``eps * sum(levels)`` with ``eps`` too small to trade one level
     of rise).  A logic-depth placement (every gate at its depth, sources at 0) is a feasible
-    point, so the rise is never more than that placement's.  Returns ints; a result that
+    point, so the rise is never more than that placement's.  ``muscled``: the (gate id, pin)s
+    driven by a muscle of their own, which no chain reaches.  Returns ints; a result that
     is not integral or breaks a constraint is an internal error."""
     from scipy.optimize import linprog
 
@@ -256,8 +262,8 @@ def place_levels(netlist, sources) -> dict[tuple, int]:
     cost = np.zeros(n)
     for g in netlist.gates:
         v = ix[("gate", g.id)]
-        for p in (g.a, g.b):
-            if p.src in ix:                              # a chain from a source or a gate
+        for pin, p in (("a", g.a), ("b", g.b)):
+            if p.src in ix and (g.id, pin) not in muscled:   # a chain from a source or a gate
                 row = np.zeros(n)
                 row[ix[p.src]], row[v] = 1.0, -1.0       # l(src) - l(g) <= -1
                 rows.append(row)
@@ -483,16 +489,26 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     for o in netlist.outputs:
         if o.kind != "const":
             consumers.setdefault(o.src, []).append(("out", o.name, int(o.half_unit)))
+    # input levers driven by a muscle of their own: an input's one gate input, or with
+    # muscle_per_lever every gate input it feeds (those leave the input's consumers)
+    muscled: dict[tuple, str] = {}           # (gate id, pin) -> circuit input
+    n_muscles: dict[str, int] = {}
+    for w in netlist.inputs:
+        cons = consumers.get(("input", w.name), [])
+        pins = [c for c in cons if c[0] == "pin"]
+        if pins and (opt.muscle_per_lever or len(cons) == 1):
+            for c in pins:
+                muscled[(c[1], c[2])] = w.name
+            n_muscles[w.name] = len(pins)
+            consumers[("input", w.name)] = [c for c in cons if c[0] != "pin"]
     consumers_all = consumers
 
     from mlc.circuit.direct import direct_nets
     direct = direct_nets(netlist, consumers, opt.direct_skip) if opt.direct else {}   # sink -> (driver, pin)
 
     # ---- placement -----------------------------------------------------------------
-    sources = [w for w in netlist.inputs
-               if not (len(consumers.get(("input", w.name), [])) == 1
-                       and consumers[("input", w.name)][0][0] == "pin")]
-    level = place_levels(netlist, sources)
+    sources = [w for w in netlist.inputs if consumers.get(("input", w.name)) or w.name not in n_muscles]
+    level = place_levels(netlist, sources, muscled=muscled)
     lvl = {g.id: level[("gate", g.id)] for g in netlist.gates}
     levels: dict[int, list] = {}
     for g in netlist.gates:
@@ -512,8 +528,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     arriving: dict[int, int] = {}
     for g in netlist.gates:
         for pin, p in (("a", g.a), ("b", g.b)):
-            if not (p.src[0] == "input" and len(consumers.get(p.src, [])) == 1) and direct.get(g.id) != (
-                    p.src[1], pin):
+            if (g.id, pin) not in muscled and direct.get(g.id) != (p.src[1], pin):
                 arriving[lvl[g.id]] = arriving.get(lvl[g.id], 0) + 1
     zlevel = {0: 0.0}
     for d in range(1, max(level.values(), default=0) + 1):
@@ -559,11 +574,6 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             by_name[b.name] = b
 
     # ---- gates ---------------------------------------------------------------------
-    direct_input: dict[tuple, str] = {}      # (gate id, pin) -> circuit input driving the lever directly
-    for w in netlist.inputs:
-        cons = consumers.get(("input", w.name), [])
-        if len(cons) == 1 and cons[0][0] == "pin":
-            direct_input[(cons[0][1], cons[0][2])] = w.name
     n_direct_half = 0
     gate_owned: list[tuple[list[Body], frozenset]] = []   # bodies of each gate (and direct unit), their owners
     for g in [g for g in netlist.gates if g.id not in direct] + sorted(
@@ -584,12 +594,13 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             add(Parts(bs, bd, []))
             gate_owned.append((bs, frozenset((g.id,))))
         for m in sc.muscles:                     # muscle_a / muscle_b: kept where an input drives the lever
-            key = (g.id, m.input)
-            if key in direct_input:
+            inp = muscled.get((g.id, m.input))
+            if inp is not None:
                 ba, sa = m.a.split(".", 1)
                 bb, sb = m.b.split(".", 1)
-                muscles.append(Muscle(f"muscle_{direct_input[key]}", direct_input[key], f"{g.id}_{ba}.{sa}",
-                                      f"{g.id}_{bb}.{sb}", m.rest, m.actuated, m.k))
+                name = f"muscle_{inp}" if n_muscles[inp] == 1 and inp not in {w.name for w in sources} else \
+                    f"muscle_{inp}_{g.id}_{m.input}"
+                muscles.append(Muscle(name, inp, f"{g.id}_{ba}.{sa}", f"{g.id}_{bb}.{sb}", m.rest, m.actuated, m.k))
 
     # ---- sources of inputs that fan out (or reach an output) --------------------------
     taps: dict[tuple, tuple[Pair, int]] = {}     # wire -> (tap pair, its polarity: 1 = carries NOT wire)
@@ -823,6 +834,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         touching = [k for k in contacts if k.clearance < CONTACT_MARGIN]
         if touching:        # layers that may touch in some row: named, with their clearance (sigma)
             scene.meta["connector"]["state_contacts"] = [[k.a, k.i, k.b, k.j, round(k.clearance, 4)] for k in touching]
+        if opt.muscle_per_lever:
+            scene.meta["connector"]["muscle_per_lever"] = True
         if opt.direct:
             scene.meta["connector"]["direct"] = [[d, s, p] for s, (d, p) in direct.items()]
         scene.check()

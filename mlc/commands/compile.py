@@ -87,6 +87,10 @@ def register(sub):
     p.add_argument("--direct", action="store_true",
                    help="join a gate whose output feeds exactly one gate input by one full connector unit, "
                         "the sink placed on it (docs/circuits.md section 3, 'Direct connection')")
+    p.add_argument("--muscle-per-lever", dest="muscle_per_lever", action="store_true",
+                   help="every gate input lever a circuit input drives carries its own muscle of that input "
+                        "(a global stimulus, as the paper's colours), instead of one muscle per input and "
+                        "connector chains to the levers (docs/circuits.md, 'A muscle per lever')")
     p.add_argument("--verify", action="store_true",
                    help="verify the circuit on every row of its truth table (static; with --dynamic by Brownian dynamics)")
     p.add_argument("--dynamic", action="store_true", help="with --verify: Brownian dynamics from rest, until relaxed")
@@ -268,6 +272,8 @@ def run(args) -> int:
         raise MlcError("--router only applies to the circuit", "--no-circuit", "drop --no-circuit")
     if getattr(args, "direct", False) and not want_circuit:
         raise MlcError("--direct only applies to the circuit", "--no-circuit", "drop --no-circuit")
+    if getattr(args, "muscle_per_lever", False) and not want_circuit:
+        raise MlcError("--muscle-per-lever only applies to the circuit", "--no-circuit", "drop --no-circuit")
     if getattr(args, "robot", None):
         if not want_circuit:
             raise MlcError("--robot needs the circuit", "--no-circuit", "drop --no-circuit")
@@ -299,7 +305,8 @@ def run(args) -> int:
             from mlc.robot.build import CIRCUIT_END_DROP
             extra["end_drop"] = CIRCUIT_END_DROP
         opts = CircuitOptions(direct=bool(getattr(args, "direct", False)), max_gates=max_gates, jobs=args.jobs,
-                              router=getattr(args, "router", "auto"), **extra)
+                              router=getattr(args, "router", "auto"),
+                              muscle_per_lever=bool(getattr(args, "muscle_per_lever", False)), **extra)
         with Progress("placing and routing", total=1) as bar:
             build(c, progress=lambda done, total: (setattr(bar, "total", total), bar.update(done)), options=opts)
         scene = c.circuit.scene

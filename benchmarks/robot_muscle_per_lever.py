@@ -1,0 +1,166 @@
+"""The Tetris robot with a muscle per input lever against the default build (issue 10 item 6;
+docs/robot.md 3.4, "Session 46"): both compiled here from ``examples/tetris.tt`` and
+``examples/tetris.robot.yaml`` (``mlc compile --robot``, and the same with
+``--muscle-per-lever``), then every row and seed verified exactly as ``mlc verify ROBOT
+--dynamic`` does (:func:`robot_dynamic.run_one` at mlc.robot.verify's step, drift bound and
+tau: from rest at kT = 1e-5, stiff scheme, until relaxed).  The two builds alternate run by
+run in one process, so the machine's load falls on both alike; the cost ratio is of CPU
+seconds over the same (row, seed) runs.
+
+What it records, per build: bodies, every run's shape and relax time and CPU; per row and
+DOF the seed mean of the time-averaged angle, and the per-lever build's difference to the
+default with the error bar sqrt(sd^2/n + sd_ref^2/n) of the two seed spreads.
+
+    python benchmarks/robot_muscle_per_lever.py [--rows 00 01 10 11] [--seeds 0 1 2]
+    python benchmarks/robot_muscle_per_lever.py --plot benchmarks/results/robot_muscle_per_lever.json
+
+Writes benchmarks/results/robot_muscle_per_lever.json (merged run by run, so it resumes) and .png.
+Units: t0 (times), degrees (angles), CPU seconds.
+"""
+from __future__ import annotations
+
+import argparse
+import json
+import math
+import os
+import platform
+import sys
+import tempfile
+from pathlib import Path
+
+import mlc  # noqa: F401 -- before numpy: pins OpenBLAS's kernels (mlc/__init__.py)
+
+from mlc.io.atomic import atomic_path
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+RESULTS = HERE / "results"
+BUILDS = {"default": [], "per_lever": ["--muscle-per-lever"]}
+GOAL_CPU_S = 120.0          # issue 10: 4 rows x 3 seeds in under 2 minutes on one core
+
+
+def compile_robot(flags: list[str], out: Path):
+    """``mlc compile examples/tetris.tt --robot examples/tetris.robot.yaml`` (plus ``flags``)
+    into ``out``; the robot scene."""
+    from mlc.cli import main
+    from mlc.scene.io import load_scene
+    rc = main(["compile", str(ROOT / "examples" / "tetris.tt"), "--robot", str(ROOT / "examples" / "tetris.robot.yaml"),
+               "-o", str(out), *flags])
+    if rc != 0:
+        raise SystemExit(f"mlc compile {' '.join(flags)} exited {rc}")
+    return load_scene(out / "robot.yaml")
+
+
+def compare(runs: list[dict]) -> dict:
+    import numpy as np
+    out = {"builds": {}, "angle_diffs": {}}
+    for name in BUILDS:
+        rs = [r for r in runs if r["build"] == name]
+        if not rs:
+            continue
+        out["builds"][name] = {"runs": len(rs), "bodies": rs[0]["bodies"], "all_right": all(r["ok"] for r in rs),
+                               "relaxed": sum(bool(r["relaxed"]) for r in rs),
+                               "cpu_s": round(sum(r["cpu_s"] for r in rs), 1),
+                               "wall_s": round(sum(r["wall_s"] for r in rs), 1),
+                               "t0": round(sum(r["time_t0"] for r in rs), 1),
+                               "cpu_per_t0_s": round(sum(r["cpu_s"] for r in rs) / sum(r["time_t0"] for r in rs), 4),
+                               "worst_clearance_end": min(r["clearance_end"] for r in rs)}
+    ref = {(r["row"], r["seed"]): r for r in runs if r["build"] == "default"}
+    mine = {(r["row"], r["seed"]): r for r in runs if r["build"] == "per_lever"}
+    both = sorted(set(ref) & set(mine))
+    if both:
+        out["cpu_ratio_default_over_per_lever"] = round(sum(ref[k]["cpu_s"] for k in both) /
+                                                        sum(mine[k]["cpu_s"] for k in both), 2)
+        out["pairs"] = len(both)
+    largest = (0.0, None)
+    for row in sorted({k[0] for k in both}):
+        keys = [k for k in both if k[0] == row]
+        if len(keys) < 2:
+            continue
+        for j, d in enumerate(ref[keys[0]]["dof_angles"]):
+            a = np.array([ref[k]["dof_angles"][j]["mean_angle"] for k in keys])
+            b = np.array([mine[k]["dof_angles"][j]["mean_angle"] for k in keys])
+            diff = float(b.mean() - a.mean())
+            bar = math.sqrt(a.std(ddof=1) ** 2 / len(a) + b.std(ddof=1) ** 2 / len(b))
+            out["angle_diffs"].setdefault(row, {})[d["name"]] = {
+                "default_deg": round(float(a.mean()), 3), "per_lever_deg": round(float(b.mean()), 3),
+                "diff_deg": round(diff, 3), "bar_deg": round(bar, 3), "resolved": abs(diff) > 2 * bar}
+            if abs(diff) > abs(largest[0]):
+                largest = (diff, f"{row} {d['name']} ({diff:+.2f} +- {bar:.2f} deg)")
+    out["largest_angle_diff"] = largest[1]
+    return out
+
+
+def plot(path: str) -> str:
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    data = json.loads(Path(path).read_text())
+    runs = data["runs"]
+    rows = sorted({r["row"] for r in runs})
+    fig, ax = plt.subplots(1, 2, figsize=(10, 4))
+    for i, (name, color) in enumerate((("default", "tab:gray"), ("per_lever", "tab:blue"))):
+        cpu = [sum(r["cpu_s"] for r in runs if r["build"] == name and r["row"] == row) for row in rows]
+        ax[0].bar([k + 0.38 * i for k in range(len(rows))], cpu, 0.38, color=color,
+                  label=f"{name} ({data['summary']['builds'].get(name, {}).get('bodies', '?')} bodies)")
+    ax[0].set_xticks([k + 0.19 for k in range(len(rows))], rows)
+    ax[0].set_xlabel("row (y b)")
+    ax[0].set_ylabel("CPU s, all seeds")
+    ax[0].legend()
+    ax[0].set_title("dynamic verification, CPU per row")
+    tot = [data["summary"]["builds"].get(n, {}).get("cpu_s", 0) for n in ("default", "per_lever")]
+    ax[1].bar(["default", "per lever"], tot, color=["tab:gray", "tab:blue"])
+    ax[1].axhline(GOAL_CPU_S, color="tab:red", ls="--", label="issue 10 goal (120 s)")
+    ax[1].set_ylabel("CPU s, all rows and seeds")
+    ax[1].legend()
+    ax[1].set_title(f"ratio {data['summary'].get('cpu_ratio_default_over_per_lever', '?')}x")
+    fig.tight_layout()
+    png = str(Path(path).with_suffix(".png"))
+    fig.savefig(png, dpi=110)
+    return png
+
+
+def main(argv=None) -> int:
+    sys.path.insert(0, str(HERE))
+    from gitstate import commit
+    from robot_dynamic import run_one
+
+    from mlc.robot.verify import ROBOT_DISP_ACC, ROBOT_DT, ROBOT_TAU
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--rows", nargs="*", default=["00", "01", "10", "11"])
+    ap.add_argument("--seeds", nargs="*", type=int, default=[0, 1, 2])
+    ap.add_argument("--kT", type=float, default=1e-5)
+    ap.add_argument("-o", "--out", default=str(RESULTS / "robot_muscle_per_lever.json"))
+    ap.add_argument("--plot", metavar="JSON", help="only redraw the plot of a results file")
+    a = ap.parse_args(argv)
+    if a.plot:
+        print(plot(a.plot))
+        return 0
+    out = Path(a.out)
+    data = json.loads(out.read_text()) if out.exists() else {"runs": []}
+    done = {(r["build"], r["row"], r["seed"]) for r in data["runs"]}
+    with tempfile.TemporaryDirectory() as tmp:
+        scenes = {name: compile_robot(flags, Path(tmp) / name) for name, flags in BUILDS.items()}
+    for row in a.rows:
+        for seed in a.seeds:
+            for name, sc in scenes.items():
+                if (name, row, seed) in done:
+                    continue
+                r = run_one(sc, row, seed, ROBOT_DT, ROBOT_TAU, 1800.0, a.kT, disp_acc=ROBOT_DISP_ACC)
+                r.pop("history", None)
+                r.update(build=name, bodies=len(sc.bodies))
+                data["runs"].append(r)
+                data.update(commit=commit(), machine=platform.machine(), cpus=os.cpu_count(),
+                            settings={"dt": ROBOT_DT, "disp_acc": ROBOT_DISP_ACC, "tau": ROBOT_TAU, "kT": a.kT},
+                            summary=compare(data["runs"]))
+                with atomic_path(out) as tmpf:
+                    Path(tmpf).write_text(json.dumps(data, indent=1))
+                print(f"{name:9s} row {row} seed {seed}: {r['shape_read']} (want {r['shape_expected']}) "
+                      f"{r['time_t0']:.0f} t0, {r['cpu_s']:.1f} s CPU", flush=True)
+    print(json.dumps(data["summary"], indent=1))
+    print(plot(str(out)))
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
