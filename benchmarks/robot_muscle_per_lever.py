@@ -12,6 +12,7 @@ DOF the seed mean of the time-averaged angle, and the per-lever build's differen
 default with the error bar sqrt(sd^2/n + sd_ref^2/n) of the two seed spreads.
 
     python benchmarks/robot_muscle_per_lever.py [--rows 00 01 10 11] [--seeds 0 1 2]
+        [--builds default per_lever] [--ref default]
     python benchmarks/robot_muscle_per_lever.py --plot benchmarks/results/robot_muscle_per_lever.json
 
 Writes benchmarks/results/robot_muscle_per_lever.json (merged run by run, so it resumes) and .png.
@@ -35,7 +36,8 @@ from mlc.io.atomic import atomic_path
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 RESULTS = HERE / "results"
-BUILDS = {"default": [], "per_lever": ["--muscle-per-lever"]}
+BUILDS = {"default": [], "per_lever": ["--muscle-per-lever"],
+          "per_lever_k10": ["--muscle-per-lever", "--joint-k", "10"]}     # name: mlc compile flags
 GOAL_CPU_S = 120.0          # issue 10: 4 rows x 3 seeds in under 2 minutes on one core
 
 
@@ -51,9 +53,13 @@ def compile_robot(flags: list[str], out: Path):
     return load_scene(out / "robot.yaml")
 
 
-def compare(runs: list[dict]) -> dict:
+def compare(runs: list[dict], ref_name: str = "default") -> dict:
+    """Per build: bodies, all right?, CPU; each other build against ``ref_name``: the CPU ratio over
+    the (row, seed) runs both made, and per row and DOF the seed means of the time-averaged angles
+    and their difference with its error bar (degrees)."""
     import numpy as np
-    out = {"builds": {}, "angle_diffs": {}}
+    out = {"reference": ref_name, "builds": {}, "angle_diffs": {}, "cpu_ratio_vs_reference": {},
+           "largest_angle_diff": {}}
     for name in BUILDS:
         rs = [r for r in runs if r["build"] == name]
         if not rs:
@@ -65,29 +71,34 @@ def compare(runs: list[dict]) -> dict:
                                "t0": round(sum(r["time_t0"] for r in rs), 1),
                                "cpu_per_t0_s": round(sum(r["cpu_s"] for r in rs) / sum(r["time_t0"] for r in rs), 4),
                                "worst_clearance_end": min(r["clearance_end"] for r in rs)}
-    ref = {(r["row"], r["seed"]): r for r in runs if r["build"] == "default"}
-    mine = {(r["row"], r["seed"]): r for r in runs if r["build"] == "per_lever"}
-    both = sorted(set(ref) & set(mine))
-    if both:
-        out["cpu_ratio_default_over_per_lever"] = round(sum(ref[k]["cpu_s"] for k in both) /
-                                                        sum(mine[k]["cpu_s"] for k in both), 2)
-        out["pairs"] = len(both)
-    largest = (0.0, None)
-    for row in sorted({k[0] for k in both}):
-        keys = [k for k in both if k[0] == row]
-        if len(keys) < 2:
+    ref = {(r["row"], r["seed"]): r for r in runs if r["build"] == ref_name}
+    for name in [n for n in out["builds"] if n != ref_name]:
+        mine = {(r["row"], r["seed"]): r for r in runs if r["build"] == name}
+        both = sorted(set(ref) & set(mine))
+        if not both:
             continue
-        for j, d in enumerate(ref[keys[0]]["dof_angles"]):
-            a = np.array([ref[k]["dof_angles"][j]["mean_angle"] for k in keys])
-            b = np.array([mine[k]["dof_angles"][j]["mean_angle"] for k in keys])
-            diff = float(b.mean() - a.mean())
-            bar = math.sqrt(a.std(ddof=1) ** 2 / len(a) + b.std(ddof=1) ** 2 / len(b))
-            out["angle_diffs"].setdefault(row, {})[d["name"]] = {
-                "default_deg": round(float(a.mean()), 3), "per_lever_deg": round(float(b.mean()), 3),
-                "diff_deg": round(diff, 3), "bar_deg": round(bar, 3), "resolved": abs(diff) > 2 * bar}
-            if abs(diff) > abs(largest[0]):
-                largest = (diff, f"{row} {d['name']} ({diff:+.2f} +- {bar:.2f} deg)")
-    out["largest_angle_diff"] = largest[1]
+        out["cpu_ratio_vs_reference"][name] = {"ratio": round(sum(ref[k]["cpu_s"] for k in both) /
+                                                              sum(mine[k]["cpu_s"] for k in both), 2),
+                                               "pairs": len(both)}
+        largest = (0.0, None)
+        for row in sorted({k[0] for k in both}):
+            keys = [k for k in both if k[0] == row]
+            if len(keys) < 2:
+                continue
+            for j, d in enumerate(ref[keys[0]]["dof_angles"]):
+                a = np.array([ref[k]["dof_angles"][j]["mean_angle"] for k in keys])
+                b = np.array([mine[k]["dof_angles"][j]["mean_angle"] for k in keys])
+                diff = float(b.mean() - a.mean())
+                bar = math.sqrt(a.std(ddof=1) ** 2 / len(a) + b.std(ddof=1) ** 2 / len(b))
+                out["angle_diffs"].setdefault(name, {}).setdefault(row, {})[d["name"]] = {
+                    "reference_deg": round(float(a.mean()), 3), "deg": round(float(b.mean()), 3),
+                    "diff_deg": round(diff, 3), "bar_deg": round(bar, 3), "resolved": abs(diff) > 2 * bar}
+                if abs(diff) > abs(largest[0]):
+                    largest = (diff, f"{row} {d['name']} ({diff:+.2f} +- {bar:.2f} deg)")
+        out["largest_angle_diff"][name] = largest[1]
+    for name, b in out["builds"].items():       # how far the shapes sit from the targets (seed means)
+        rs = [r for r in runs if r["build"] == name]
+        b["worst_time_averaged_dof_error_deg"] = max(r["max_dof_mean_error_deg"] for r in rs)
     return out
 
 
@@ -98,22 +109,26 @@ def plot(path: str) -> str:
     data = json.loads(Path(path).read_text())
     runs = data["runs"]
     rows = sorted({r["row"] for r in runs})
+    names = list(data["summary"]["builds"])
+    colors = dict(zip(BUILDS, ("tab:gray", "tab:blue", "tab:orange")))
+    wid = 0.8 / len(names)
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))
-    for i, (name, color) in enumerate((("default", "tab:gray"), ("per_lever", "tab:blue"))):
+    for i, name in enumerate(names):
         cpu = [sum(r["cpu_s"] for r in runs if r["build"] == name and r["row"] == row) for row in rows]
-        ax[0].bar([k + 0.38 * i for k in range(len(rows))], cpu, 0.38, color=color,
-                  label=f"{name} ({data['summary']['builds'].get(name, {}).get('bodies', '?')} bodies)")
-    ax[0].set_xticks([k + 0.19 for k in range(len(rows))], rows)
+        ax[0].bar([k + wid * i for k in range(len(rows))], cpu, wid, color=colors.get(name),
+                  label=f"{name} ({data['summary']['builds'][name]['bodies']} bodies)")
+    ax[0].set_xticks([k + 0.4 - 0.5 * wid for k in range(len(rows))], rows)
     ax[0].set_xlabel("row (y b)")
     ax[0].set_ylabel("CPU s, all seeds")
     ax[0].legend()
     ax[0].set_title("dynamic verification, CPU per row")
-    tot = [data["summary"]["builds"].get(n, {}).get("cpu_s", 0) for n in ("default", "per_lever")]
-    ax[1].bar(["default", "per lever"], tot, color=["tab:gray", "tab:blue"])
+    tot = [data["summary"]["builds"][n]["cpu_s"] for n in names]
+    ax[1].bar(names, tot, color=[colors.get(n) for n in names])
     ax[1].axhline(GOAL_CPU_S, color="tab:red", ls="--", label="issue 10 goal (120 s)")
     ax[1].set_ylabel("CPU s, all rows and seeds")
     ax[1].legend()
-    ax[1].set_title(f"ratio {data['summary'].get('cpu_ratio_default_over_per_lever', '?')}x")
+    ratios = ", ".join(f"{n} {v['ratio']}x" for n, v in data["summary"]["cpu_ratio_vs_reference"].items())
+    ax[1].set_title(f"CPU of {data['summary']['reference']} over: {ratios}", fontsize=9)
     fig.tight_layout()
     png = str(Path(path).with_suffix(".png"))
     fig.savefig(png, dpi=110)
@@ -129,6 +144,8 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rows", nargs="*", default=["00", "01", "10", "11"])
     ap.add_argument("--seeds", nargs="*", type=int, default=[0, 1, 2])
+    ap.add_argument("--builds", nargs="*", default=["default", "per_lever"], choices=list(BUILDS))
+    ap.add_argument("--ref", default="default", choices=list(BUILDS), help="the build the others are compared with")
     ap.add_argument("--kT", type=float, default=1e-5)
     ap.add_argument("-o", "--out", default=str(RESULTS / "robot_muscle_per_lever.json"))
     ap.add_argument("--plot", metavar="JSON", help="only redraw the plot of a results file")
@@ -140,7 +157,7 @@ def main(argv=None) -> int:
     data = json.loads(out.read_text()) if out.exists() else {"runs": []}
     done = {(r["build"], r["row"], r["seed"]) for r in data["runs"]}
     with tempfile.TemporaryDirectory() as tmp:
-        scenes = {name: compile_robot(flags, Path(tmp) / name) for name, flags in BUILDS.items()}
+        scenes = {name: compile_robot(BUILDS[name], Path(tmp) / name) for name in a.builds}
     for row in a.rows:
         for seed in a.seeds:
             for name, sc in scenes.items():
@@ -152,7 +169,7 @@ def main(argv=None) -> int:
                 data["runs"].append(r)
                 data.update(commit=commit(), machine=platform.machine(), cpus=os.cpu_count(),
                             settings={"dt": ROBOT_DT, "disp_acc": ROBOT_DISP_ACC, "tau": ROBOT_TAU, "kT": a.kT},
-                            summary=compare(data["runs"]))
+                            summary=compare(data["runs"], a.ref))
                 with atomic_path(out) as tmpf:
                     Path(tmpf).write_text(json.dumps(data, indent=1))
                 print(f"{name:9s} row {row} seed {seed}: {r['shape_read']} (want {r['shape_expected']}) "
