@@ -17,9 +17,11 @@ from the reference (sigma), its largest DOF-angle difference (degrees) and its w
 CPU time.
 
     python benchmarks/robot_euler_reference.py OUT/robot.yaml [--row 01] [--time 2]
-        [--every 0.25] [--dts 0.2 0.05 0.01] [--euler-check 0.5]
+        [--every 0.25] [--dts 0.2 0.05 0.01] [--euler-check 0.5] [--disp-acc 0.1] [-o OUT.json]
 
-Writes benchmarks/results/robot_euler_reference.json and .png (atomic).  Units: sigma,
+``--disp-acc`` gives the stiff runs that drift bound (sigma; mlc.robot.verify.ROBOT_DISP_ACC
+is the verifier's), else the integrator's default.  Writes benchmarks/results/robot_euler_reference.json
+(or ``-o``) and its .png (atomic).  Units: sigma,
 t0, degrees, seconds.  One process; Euler's steps dominate (about 0.3 ms of CPU a step for
 2448 bodies).
 """
@@ -70,7 +72,7 @@ def compare(run: dict, ref: dict) -> list[dict]:
     return out
 
 
-def plot(res: dict) -> None:
+def plot(res: dict, out: Path = OUT) -> None:
     runs, ref, row = res["runs"], res["reference"], res["row"]
     import matplotlib
     matplotlib.use("Agg")
@@ -87,7 +89,7 @@ def plot(res: dict) -> None:
         a.legend(fontsize=8)
     fig.suptitle(f"Tetris robot row {row}: stiff scheme against Euler at dt = {ref['dt']:.2g} t0")
     fig.tight_layout()
-    with atomic_path(OUT.with_suffix(".png")) as tmp:
+    with atomic_path(out.with_suffix(".png")) as tmp:
         fig.savefig(tmp, dpi=110, format="png")
 
 
@@ -100,9 +102,11 @@ def main():
     ap.add_argument("--every", type=float, default=0.25)
     ap.add_argument("--dts", nargs="*", type=float, default=[0.2, 0.05, 0.01])
     ap.add_argument("--euler-check", type=float, default=0.5)
+    ap.add_argument("--disp-acc", type=float, default=None, help="the stiff runs' drift bound (sigma)")
+    ap.add_argument("-o", "--out", type=Path, default=OUT)
     args = ap.parse_args()
     if args.plot:
-        plot(json.loads(OUT.read_text()))
+        plot(json.loads(args.out.read_text()), args.out)
         return
     if not args.scene:
         ap.error("give the robot scene (mlc compile ... --robot ... -o OUT: OUT/robot.yaml)")
@@ -117,24 +121,26 @@ def main():
                              "vs_reference": compare(half, ref)}
     print("euler dt/2:", runs["euler_half_dt"]["vs_reference"][-1], flush=True)
     for dt in args.dts:
-        r = trajectory(sc, args.row, "stiff", dt, args.time, args.every)
+        r = trajectory(sc, args.row, "stiff", dt, args.time, args.every,
+                       **({} if args.disp_acc is None else {"disp_acc": args.disp_acc}))
         runs[f"stiff_dt_{dt:g}"] = {"dt": dt, "wall_s": r["wall_s"], "cpu_s": r["cpu_s"],
                                     "vs_reference": compare(r, ref)}
         print(f"stiff dt {dt:g}: {r['wall_s']:.1f} s wall, {r['cpu_s']:.1f} s CPU, at {args.time:g} t0:",
               runs[f"stiff_dt_{dt:g}"]["vs_reference"][-1], flush=True)
     motion = [float(np.max(np.linalg.norm(p - ref["pos"][0], axis=1))) for p in ref["pos"]]
     res = {"scene": str(args.scene), "bodies": len(sc.bodies), "row": args.row, "kT": 0.0, "time_t0": args.time,
+           "stiff_disp_acc": args.disp_acc,
            "reference": {"scheme": "euler", "dt": ref["dt"], "euler_limit": ref["euler_limit"],
                          "wall_s": ref["wall_s"], "cpu_s": ref["cpu_s"], "t": ref["t"],
                          "max_body_motion_since_first_checkpoint_sigma": motion,
                          "dof_angles_deg": [[float(x) for x in a] for a in ref["ang"]]},
            "runs": runs,
            "machine": {"platform": platform.platform(), "cpus": os.cpu_count(), "load": os.getloadavg()[0]}}
-    OUT.parent.mkdir(exist_ok=True)
-    with atomic_path(OUT) as tmp:
+    args.out.parent.mkdir(exist_ok=True)
+    with atomic_path(args.out) as tmp:
         tmp.write_text(json.dumps(res, indent=1))
-    plot(res)
-    print(f"wrote {OUT}")
+    plot(res, args.out)
+    print(f"wrote {args.out}")
 
 
 if __name__ == "__main__":
