@@ -24,6 +24,15 @@ amplifies those too: the full adder built with these five functions one ulp off 
 had 4012 bodies instead of 3948 (``benchmarks/build_ulp_sensitivity.py``).  Without AVX-512 numpy
 computes them with the C library, the same bits as :mod:`math`.
 
+It makes Numba prefer OpenMP to TBB for its parallel kernels (``NUMBA_THREADING_LAYER_PRIORITY``
+"omp tbb workqueue", unless the user set it or ``NUMBA_THREADING_LAYER``), in every process that
+imports mlc, not only those that load the integrator (:mod:`mlc.sim.kernels` made this choice
+alone before session 46).  With TBB on the machine (Debian's libtbb12 comes with PrusaSlicer),
+``mlc stl`` of the Tetris circuit ran its wall check's parallel kernel under TBB from worker
+threads, wrote every file, and then never exited: the interpreter's exit hung in Numba's
+``unload_tbb`` -> ``tbb::finalize``, spinning on ``sched_yield`` (a known Numba and oneTBB
+problem with parallel code run from threads other than the main one: numba issue 10556).
+
 When neither mlc's folder nor the user's cache directory is writable (a read-only install run
 by a user without a writable home), it points Numba's kernel cache at a private temporary
 directory (:mod:`mlc.io.numba_cache`), which Numba would otherwise refuse with "cannot cache".
@@ -92,3 +101,10 @@ __version__ = "0.1.0"
 from mlc.io.numba_cache import ensure as _ensure_numba_cache  # noqa: E402  (before Numba is loaded)
 
 _ensure_numba_cache()
+
+#: Numba's threading layers in mlc's order of preference (see the module docstring)
+THREADING_LAYERS = ("omp", "tbb", "workqueue")
+if "NUMBA_THREADING_LAYER" not in _os.environ and "NUMBA_THREADING_LAYER_PRIORITY" not in _os.environ:
+    _os.environ["NUMBA_THREADING_LAYER_PRIORITY"] = " ".join(THREADING_LAYERS)   # read when Numba loads
+    if "numba" in _sys.modules:                  # Numba already loaded: its configuration directly
+        _sys.modules["numba"].config.THREADING_LAYER_PRIORITY = list(THREADING_LAYERS)

@@ -2,7 +2,8 @@
 that a circuit routes to the same bodies on every x86-64 CPU with AVX2 (the router's SVDs
 amplify last-bit differences between kernels: docs/circuits.md, "Reproducibility"), and on CPUs
 with AVX-512 turns off numpy's AVX-512 code paths (NPY_DISABLE_CPU_FEATURES), whose float64
-sin, cos, arcsin, arctan2 differ from the C library's in the last bits."""
+sin, cos, arcsin, arctan2 differ from the C library's in the last bits.  It also puts Numba's
+OpenMP threading layer before TBB in every process (with TBB, ``mlc stl`` hung at exit)."""
 import os
 import subprocess
 import sys
@@ -22,6 +23,36 @@ def _run(code: str, **env_set) -> str:
     env.update(env_set)
     return subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
                           check=True).stdout.strip()
+
+
+def _run_numba(code: str, **env_set) -> str:
+    """``code`` in a fresh interpreter whose environment has no Numba threading-layer choice
+    (this test's own ``import mlc`` put one in os.environ)."""
+    env = {k: v for k, v in os.environ.items() if not k.startswith("NUMBA_THREADING_LAYER")}
+    env.update(env_set)
+    return subprocess.run([sys.executable, "-c", code], env=env, capture_output=True, text=True,
+                          check=True).stdout.strip()
+
+
+PRIORITY = "import numba; print(numba.config.THREADING_LAYER, ' '.join(numba.config.THREADING_LAYER_PRIORITY))"
+
+
+def test_numba_prefers_openmp_in_a_process_without_the_integrator():
+    # the mesher's parallel wall kernel alone: before session 46 only mlc.sim.kernels chose the
+    # order, and `mlc stl` ran that kernel under TBB from worker threads, then hung at exit
+    out = _run_numba("import sys, mlc.mesh.walls\n" + PRIORITY + "\nprint('mlc.sim.kernels' in sys.modules)")
+    assert out.split("\n") == ["default omp tbb workqueue", "False"]
+
+
+def test_numba_loaded_before_mlc_is_configured_too():
+    assert _run_numba("import numba, mlc\n" + PRIORITY) == "default omp tbb workqueue"
+
+
+def test_numba_user_choice_kept():
+    assert _run_numba("import mlc\n" + PRIORITY, NUMBA_THREADING_LAYER="workqueue") == \
+        "workqueue tbb omp workqueue"
+    assert _run_numba("import mlc\n" + PRIORITY, NUMBA_THREADING_LAYER_PRIORITY="workqueue omp tbb") == \
+        "default workqueue omp tbb"
 
 
 @avx2

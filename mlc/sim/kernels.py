@@ -23,19 +23,16 @@ functions compiled without ``parallel`` (see the bottom of this module).
 from __future__ import annotations
 
 import math
-import os
 import types
 
-import numba
 import numpy as np
 from numba import njit, prange
 
-# Parallel kernels (threads > 1) prefer OpenMP over TBB unless the user chose a layer: with
-# TBB, one advance() of many tiny parallel steps slows down as it runs (8 bodies, 2 threads,
-# idle machine: 0.025 ms/step over 200 steps, 0.24 over 2000, 6.7 over 20000), while OpenMP
-# stays at 0.0054 ms/step (docs/simulation.md, "Benchmarks", throughput).
-if "NUMBA_THREADING_LAYER" not in os.environ and "NUMBA_THREADING_LAYER_PRIORITY" not in os.environ:
-    numba.config.THREADING_LAYER_PRIORITY = ["omp", "tbb", "workqueue"]
+# Parallel kernels (threads > 1) prefer OpenMP over TBB unless the user chose a layer (set by
+# mlc/__init__.py for every process that imports mlc): with TBB, one advance() of many tiny
+# parallel steps slows down as it runs (8 bodies, 2 threads, idle machine: 0.025 ms/step over
+# 200 steps, 0.24 over 2000, 6.7 over 20000), while OpenMP stays at 0.0054 ms/step
+# (docs/simulation.md, "Benchmarks", throughput).
 
 # failure codes returned in status[0]
 OK, STRETCH, WCA_CLOSE, DISPLACEMENT, NONFINITE, OVERFLOW = 0, 1, 2, 3, 4, 5
