@@ -492,14 +492,12 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     # input levers driven by a muscle of their own: an input's one gate input, or with
     # muscle_per_lever every gate input it feeds (those leave the input's consumers)
     muscled: dict[tuple, str] = {}           # (gate id, pin) -> circuit input
-    n_muscles: dict[str, int] = {}
     for w in netlist.inputs:
         cons = consumers.get(("input", w.name), [])
         pins = [c for c in cons if c[0] == "pin"]
         if pins and (opt.muscle_per_lever or len(cons) == 1):
             for c in pins:
                 muscled[(c[1], c[2])] = w.name
-            n_muscles[w.name] = len(pins)
             consumers[("input", w.name)] = [c for c in cons if c[0] != "pin"]
     consumers_all = consumers
 
@@ -507,7 +505,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     direct = direct_nets(netlist, consumers, opt.direct_skip) if opt.direct else {}   # sink -> (driver, pin)
 
     # ---- placement -----------------------------------------------------------------
-    sources = [w for w in netlist.inputs if consumers.get(("input", w.name)) or w.name not in n_muscles]
+    sources = [w for w in netlist.inputs if consumers.get(("input", w.name)) or w.name not in muscled.values()]
     level = place_levels(netlist, sources, muscled=muscled)
     lvl = {g.id: level[("gate", g.id)] for g in netlist.gates}
     levels: dict[int, list] = {}
@@ -598,8 +596,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             if inp is not None:
                 ba, sa = m.a.split(".", 1)
                 bb, sb = m.b.split(".", 1)
-                name = f"muscle_{inp}" if n_muscles[inp] == 1 and inp not in {w.name for w in sources} else \
-                    f"muscle_{inp}_{g.id}_{m.input}"
+                # one muscle per input as before; with a muscle per lever each named for its lever
+                name = f"muscle_{inp}_{g.id}_{m.input}" if opt.muscle_per_lever else f"muscle_{inp}"
                 muscles.append(Muscle(name, inp, f"{g.id}_{ba}.{sa}", f"{g.id}_{bb}.{sb}", m.rest, m.actuated, m.k))
 
     # ---- sources of inputs that fan out (or reach an output) --------------------------
