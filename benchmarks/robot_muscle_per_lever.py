@@ -37,17 +37,32 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
 RESULTS = HERE / "results"
 BUILDS = {"default": [], "per_lever": ["--muscle-per-lever"],
-          "per_lever_k10": ["--muscle-per-lever", "--joint-k", "10"]}     # name: mlc compile flags
+          "per_lever_k10": ["--muscle-per-lever", "--joint-k", "10"],     # name: mlc compile flags
+          "per_lever_chain": ["--muscle-per-lever"]}
+# builds whose robot file sets some DOFs' coupling: per_lever_chain is session 46's per-lever robot,
+# u3_up (= y) carried by a chain from y's source instead of a muscle of its own (session 47)
+COUPLINGS = {"per_lever_chain": {"u3_up": "lever"}}
 GOAL_CPU_S = 120.0          # issue 10: 4 rows x 3 seeds in under 2 minutes on one core
 
 
-def compile_robot(flags: list[str], out: Path):
+def compile_robot(flags: list[str], out: Path, couplings: dict | None = None):
     """``mlc compile examples/tetris.tt --robot examples/tetris.robot.yaml`` (plus ``flags``)
-    into ``out``; the robot scene."""
+    into ``out``; the robot scene.  ``couplings`` ({dof name: coupling}): a copy of the robot
+    file with those DOFs' ``coupling`` set is compiled instead."""
+    import yaml
+
     from mlc.cli import main
     from mlc.scene.io import load_scene
-    rc = main(["compile", str(ROOT / "examples" / "tetris.tt"), "--robot", str(ROOT / "examples" / "tetris.robot.yaml"),
-               "-o", str(out), *flags])
+    robot = ROOT / "examples" / "tetris.robot.yaml"
+    if couplings:
+        data = yaml.safe_load(robot.read_text())
+        for d in data["dofs"]:
+            if f"u{d['unit']}_{d['side']}" in couplings:
+                d["coupling"] = couplings[f"u{d['unit']}_{d['side']}"]
+        out.mkdir(parents=True, exist_ok=True)
+        robot = out / "tetris.robot.yaml"
+        robot.write_text(yaml.safe_dump(data, sort_keys=False))
+    rc = main(["compile", str(ROOT / "examples" / "tetris.tt"), "--robot", str(robot), "-o", str(out), *flags])
     if rc != 0:
         raise SystemExit(f"mlc compile {' '.join(flags)} exited {rc}")
     return load_scene(out / "robot.yaml")
@@ -110,7 +125,7 @@ def plot(path: str) -> str:
     runs = data["runs"]
     rows = sorted({r["row"] for r in runs})
     names = list(data["summary"]["builds"])
-    colors = dict(zip(BUILDS, ("tab:gray", "tab:blue", "tab:orange")))
+    colors = dict(zip(BUILDS, ("tab:gray", "tab:blue", "tab:orange", "tab:green")))
     wid = 0.8 / len(names)
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))
     for i, name in enumerate(names):
@@ -157,7 +172,7 @@ def main(argv=None) -> int:
     data = json.loads(out.read_text()) if out.exists() else {"runs": []}
     done = {(r["build"], r["row"], r["seed"]) for r in data["runs"]}
     with tempfile.TemporaryDirectory() as tmp:
-        scenes = {name: compile_robot(BUILDS[name], Path(tmp) / name) for name in a.builds}
+        scenes = {name: compile_robot(BUILDS[name], Path(tmp) / name, COUPLINGS.get(name)) for name in a.builds}
     for row in a.rows:
         for seed in a.seeds:
             for name, sc in scenes.items():

@@ -4,6 +4,7 @@ every input lever a circuit input drives carries its own muscle of that input, n
 runs from the inputs to the gates, and the circuit still computes its table."""
 import copy
 import dataclasses
+from pathlib import Path
 
 import pytest
 
@@ -22,7 +23,7 @@ def _build(src, expr=None, **kw):
 
 @pytest.fixture(scope="module")
 def tetris():
-    return _build("examples/tetris.tt", muscle_per_lever=True)
+    return _build(str(Path(__file__).resolve().parents[1] / "examples" / "tetris.tt"), muscle_per_lever=True)
 
 
 def test_every_input_lever_carries_its_own_muscle_and_no_input_chain_is_built(tetris):
@@ -43,6 +44,9 @@ def test_every_input_lever_carries_its_own_muscle_and_no_input_chain_is_built(te
     # no wire from an input to a gate: only the stub that gives u3_up its parity
     assert {b.name.split("_")[3] for b in sc.bodies if b.name.startswith("w_")} <= {"stub"}
     assert sc.meta["connector"]["muscle_per_lever"] is True
+    # and it names that output, so that a robot drives u3_up's DOF by a muscle of y (mlc.robot.build)
+    assert sc.meta["connector"]["input_outputs"] == {o.name: o.src[1] for o in nl.outputs if o.kind == "input"} \
+        == {"u3_up": "y"}
     # against the default build: the same logic, 1623 bodies there (the inputs' wires)
     assert len(sc.bodies) < 40
 

@@ -207,20 +207,56 @@ def test_dynamic_verify_bar_moves_within_a_fold(robot, monkeypatch):
 
 
 def test_the_tetris_robot_with_a_muscle_per_lever_folds_every_shape(tmp_path, capsys):
-    """The paper's robot with a muscle on every input lever (docs/robot.md 3.4, session 46):
-    a third of the default build's bodies, and the static verifier reads I, L, S and O."""
+    """The paper's robot with a muscle on every input lever (docs/robot.md 3.4, sessions 46
+    and 47): under a quarter of the default build's bodies, u3_up (= y) driven by a muscle of
+    y across its own tips instead of a chain, and the static verifier reads I, L, S and O."""
     root = Path(__file__).resolve().parents[1] / "examples"
     out = tmp_path / "r"
     assert main(["compile", str(root / "tetris.tt"), "--robot", str(root / "tetris.robot.yaml"),
                  "--muscle-per-lever", "-o", str(out)]) == 0
     sc = load_scene(out / "robot.yaml")
     assert sc.meta["circuit"]["connector"]["muscle_per_lever"] is True
-    assert len(sc.bodies) < 800 and not any(b.name.startswith(("w_y_", "w_b_")) and "_stub" not in b.name
+    assert sc.meta["circuit"]["connector"]["input_outputs"] == {"u3_up": "y"}
+    assert len(sc.bodies) < 600 and not any(b.name.startswith(("w_y_", "w_b_")) and "_stub" not in b.name
                                             for b in sc.bodies)
-    assert sum(m.input == "y" for m in sc.muscles) == 4 and sum(m.input == "b" for m in sc.muscles) == 3
+    dofs = {d["name"]: d for d in sc.meta["robot"]["dofs"]}
+    assert dofs["u3_up"]["coupling"] == "muscle" and "chain" not in dofs["u3_up"]
+    assert not any(b.name.startswith("rc_u3_up") for b in sc.bodies)
+    dm = next(m for m in sc.muscles if m.name == "muscle_y_u3_up")
+    assert (dm.input, dm.a, dm.b) == ("y", "skel_u2.muscle_u3_up", "skel_j3.muscle_u3_up")
+    # the lever arms' gain d0/L0: the muscle's sites are L0/d0 times the tips' distance, in both states
+    by = {b.name: b for b in sc.bodies}
+    probe = next(p for p in sc.probes if p.name == "dof_u3_up")
+    gap = np.linalg.norm(by["skel_u2"].world("muscle_u3_up") - by["skel_j3"].world("muscle_u3_up"))
+    tips = np.linalg.norm(by["skel_u2"].world("tip_u3_up") - by["skel_j3"].world("tip_u3_up"))
+    assert tips == pytest.approx(probe.rest) and gap == pytest.approx(dm.rest)
+    assert dm.actuated / dm.rest == pytest.approx(probe.actuated / probe.rest)
+    src = next(m for m in sc.muscles if m.name == "muscle_y")          # the same material as y's source
+    assert (dm.rest, dm.actuated, dm.k) == (src.rest, src.actuated, src.k)
+    # three gate levers and y's source (it still carries the circuit's output u3_up) and the DOF
+    assert sum(m.input == "y" for m in sc.muscles) == 5 and sum(m.input == "b" for m in sc.muscles) == 3
     capsys.readouterr()
     assert main(["verify", str(out / "robot.yaml"), "--json"]) == 0
     rep = json.loads(capsys.readouterr().out)
     rows = {r["state"]: r for r in rep["rows"]}
     assert {s: r["shape_read"] for s, r in rows.items()} == {"00": "I", "01": "L", "10": "S", "11": "O"}
     assert all(r["max_dof_error_deg"] < 0.01 for r in rows.values())
+
+
+def test_a_muscle_coupling_needs_an_output_that_is_a_circuit_input(tmp_path, capsys):
+    """``coupling: muscle`` on a gate's output, or without --muscle-per-lever, is one clear
+    message naming the robot file's line (mlc.robot.build), and no robot is written."""
+    root = Path(__file__).resolve().parents[1] / "examples"
+    text = (root / "tetris.robot.yaml").read_text()
+    for line, flags in (("  - {unit: 2, side: up, output: u2_up}", ["--muscle-per-lever"]),
+                        ("  - {unit: 3, side: up, output: u3_up}", [])):
+        assert line + "\n" in text
+        bad = tmp_path / f"bad{len(flags)}.robot.yaml"
+        bad.write_text(text.replace(line + "\n", line[:-1] + ", coupling: muscle}\n"))
+        out = tmp_path / f"o{len(flags)}"
+        capsys.readouterr()
+        assert main(["compile", str(root / "tetris.tt"), "--robot", str(bad), "-o", str(out), *flags]) == 2
+        err = capsys.readouterr().err
+        lineno = bad.read_text().splitlines().index(line[:-1] + ", coupling: muscle}") + 1
+        assert f"{bad}:{lineno}" in err and "cannot carry a muscle" in err and "Traceback" not in err
+        assert not (out / "robot.yaml").exists()

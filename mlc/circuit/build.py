@@ -834,6 +834,11 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             scene.meta["connector"]["state_contacts"] = [[k.a, k.i, k.b, k.j, round(k.clearance, 4)] for k in touching]
         if opt.muscle_per_lever:
             scene.meta["connector"]["muscle_per_lever"] = True
+            # outputs that are a circuit input itself (no half unit): a robot gives the DOF such an
+            # output drives a muscle of that input instead of a chain (mlc.robot.build, "muscle")
+            wired = {o.name: o.src[1] for o in netlist.outputs if o.kind == "input" and not o.half_unit}
+            if wired:
+                scene.meta["connector"]["input_outputs"] = wired
         if opt.direct:
             scene.meta["connector"]["direct"] = [[d, s, p] for s, (d, p) in direct.items()]
         scene.check()

@@ -27,6 +27,12 @@ L1/L0 = d1/d0 (1.5 for the paper's numbers and expanding wires): the arms are le
 gain d0/L0 = 2.  The sites sit ``POST`` sigma below the skeleton plane, so the chain's
 last layer stays under the skeleton.  "lock": a constant output (its probe spans one
 rigid slab) holds its DOF with a plain bond between the tips at its constant length.
+"muscle": in a circuit compiled with a muscle per lever (``mlc compile --muscle-per-lever``),
+an output that is a circuit input itself (recorded in ``meta["connector"]["input_outputs"]``)
+drives its DOF by a muscle of that input between the two sites where a chain would end
+(in the skeleton's plane, not under it): the circuit's own muscle (L0 -> L1, k0) on the
+same levers of gain d0/L0, as the input's gate levers are driven, instead of a chain from
+the input's source (docs/robot.md 3.4).
 
 **Joint stops** (docs/robot.md section 2.3).  Every DOF hinge also gets two flat-bottom
 bonds (:func:`dof_stops`) that leave it free over [-15, 105] degrees of turn and close
@@ -80,7 +86,7 @@ from mlc.gates.connector import (POST_WIDTH, STOP_ARM, Pair, chain_parts, connec
 from mlc.gates.parts import axis_sites, hinge, segment_box, slab_body
 from mlc.geometry.rotation import matrix_to_quat
 from mlc.robot.spec import RobotSpec
-from mlc.scene.model import Body, Bond, Probe, Scene
+from mlc.scene.model import Body, Bond, Muscle, Probe, Scene
 
 JOINT_LENGTH = 2.0       # sigma: length of a unit's joint piece (between its up and down hinges)
 POST = 0.6               # sigma: the lever sites sit this far below the skeleton plane
@@ -391,6 +397,10 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
     probes: list[Probe] = []
     dofs_meta = []
     targets = []           # (dof spec, pair sites lo/hi, centre, axis) to route to
+    dof_muscles: list[Muscle] = []
+    # a circuit with a muscle per lever: an output that is a circuit input drives its DOF by a muscle
+    conn = meta.get("connector", {})
+    wired = dict(conn.get("input_outputs") or {}) if conn.get("muscle_per_lever") else {}
     posts = {k: [] for k in segs}
     for i in range(1, spec.units + 1):
         a = (i - 0.5) * l
@@ -428,10 +438,15 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
             if pr is None:
                 raise MlcError(f"dof {name}: the circuit has no probe for output {ds.output}", ds.loc)
             const = pr.a.split(".")[0] == pr.b.split(".")[0]
-            coupling = ds.coupling or ("lock" if const else "lever")
+            inp = wired.get(ds.output)
+            coupling = ds.coupling or ("lock" if const else "muscle" if inp else "lever")
             if coupling == "lock" and not const:
                 raise MlcError(f"dof {name}: output {ds.output} is not constant, so it cannot be a lock", ds.loc,
                                "use coupling: lever (or leave coupling out)")
+            if coupling == "muscle" and inp is None:
+                raise MlcError(f"dof {name}: output {ds.output} is not a circuit input in a circuit compiled with "
+                               "a muscle per lever, so it cannot carry a muscle", ds.loc,
+                               "compile with --muscle-per-lever, or use coupling: lever (or leave coupling out)")
             col = sorted({r[outs.index(ds.output)] for r in table.values()})
             dofs_meta[-1]["coupling"] = coupling
             probes.append(Probe(f"dof_{name}", ds.output, f"{b1}.tip_{name}", f"{b2}.tip_{name}", dg.d0, dg.d1))
@@ -440,6 +455,13 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
                 bonds.append(Bond(f"skel_lock_{name}", f"{b1}.tip_{name}", f"{b2}.tip_{name}", k_skel,
                                   dg.d1 if v else dg.d0, 0.0, "bond", None))
                 dofs_meta[-1]["value"] = v
+                continue
+            if coupling == "muscle":                # the DOF's own muscle of that input, on its lever arms
+                sites[b1][f"muscle_{name}"] = W(*(O + dg.p * dir1))
+                sites[b2][f"muscle_{name}"] = W(*(O + dg.q * dir2))
+                dof_muscles.append(Muscle(f"muscle_{inp}_{name}", inp, f"{b1}.muscle_{name}", f"{b2}.muscle_{name}",
+                                          geo.L0, geo.L1, next(m.k for m in circuit.muscles if m.input == inp)))
+                dofs_meta[-1]["input"] = inp
                 continue
             p1 = W(*(O + dg.p * dir1), -POST)
             p2 = W(*(O + dg.q * dir2), -POST)
@@ -647,7 +669,7 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
                   "dofs": dofs_meta, "chains": n_chains, "half_units": n_half,
                   "k": {"chains": geo.k, "skeleton": k_skel, "joint_k": joint_k}})
     scene = Scene(name=f"robot_{spec.name}", bodies=[by_body[b.name] for b in circuit.bodies] + bodies + parts_bodies,
-                  bonds=list(circuit.bonds) + bonds + parts_bonds, muscles=list(circuit.muscles),
+                  bonds=list(circuit.bonds) + bonds + parts_bonds, muscles=list(circuit.muscles) + dof_muscles,
                   probes=list(circuit.probes) + probes, inputs=list(circuit.inputs), outputs=list(circuit.outputs),
                   truth_table=dict(circuit.truth_table) if circuit.truth_table else None,
                   meta={"element": "robot", "robot": rmeta, "circuit": meta})

@@ -34,7 +34,7 @@ class DofSpec:
     unit: int
     side: str                  # "up" | "dn"
     output: str
-    coupling: str | None       # "lever" | "lock" | None (chosen by the builder)
+    coupling: str | None       # "lever" | "lock" | "muscle" | None (chosen by the builder)
     loc: Loc | None = None
 
     @property
