@@ -48,6 +48,25 @@ def test_sparse_and_dense_spectra_agree():
     assert sparse == pytest.approx(dense, rel=1e-6)
 
 
+def test_a_lanczos_that_does_not_converge_is_one_clear_error(monkeypatch):
+    """The shift-invert Lanczos of the sparse spectrum gave up on the 524-body Tetris robot
+    (session 47: more zero modes than eigenvalues asked for); that is an MlcError naming
+    --tau, not scipy's traceback.  Here the iteration is made to fail on a small chain."""
+    import scipy.sparse.linalg as sla
+
+    real = sla.eigsh
+
+    def eigsh(A, *a, **kw):
+        if kw.get("which") == "LM":          # the shift-invert call, not the largest-rate estimate
+            raise sla.ArpackNoConvergence("ARPACK error -1: No convergence", np.zeros(0), np.zeros((0, 0)))
+        return real(A, *a, **kw)
+
+    monkeypatch.setattr(sla, "eigsh", eigsh)
+    with pytest.raises(MlcError) as e:
+        relaxation_time(chain_scene(3, "contract"), dense_max=0)
+    assert e.value.where == "--tau" and "did not converge" in str(e.value)
+
+
 def test_relaxation_time_is_the_decay_time_of_the_dynamics():
     """Independent check by the integrator: at kT = 0 a 5-unit chain switched to 1 approaches
     its far-end length exponentially, at the rate the linearised spectrum predicts."""

@@ -224,7 +224,7 @@ def _smallest_nonzero_sparse(H) -> float:
     of zero modes (shift-invert Lanczos, asking for more eigenvalues until a non-zero
     one shows up)."""
     import scipy.sparse as sp
-    from scipy.sparse.linalg import LinearOperator, eigsh
+    from scipy.sparse.linalg import ArpackNoConvergence, LinearOperator, eigsh
 
     from mlc.verify.static import spd_lu
 
@@ -236,7 +236,16 @@ def _smallest_nonzero_sparse(H) -> float:
     k = 16
     while True:
         k = min(k, n - 2)
-        vals = eigsh(op, k=k, which="LM", return_eigenvectors=False)
+        try:
+            vals = eigsh(op, k=k, which="LM", return_eigenvectors=False)
+        except ArpackNoConvergence:
+            # more zero modes (floppy bends) than k: their cluster at 1/shift does not converge
+            # (the 524-body Tetris robot with a muscle per lever, session 47, after 31441 iterations)
+            raise MlcError(f"the slowest relaxation time could not be computed: the Lanczos iteration for the "
+                           f"smallest non-zero rate of this {n}-coordinate scene did not converge "
+                           f"(more than {k} zero modes, such as the floppy bends of its chains)", "--tau",
+                           "give the relaxation time in t0 (--tau T); for a robot leave --tau out: its default, "
+                           "mlc.robot.verify.ROBOT_TAU, is measured on the Tetris folds") from None
         ev = np.sort(1.0 / vals - shift)
         nz = ev[ev > ZERO * lam_max]
         if len(nz) or k >= n - 2:
