@@ -7,6 +7,10 @@ tau: from rest at kT = 1e-5, stiff scheme, until relaxed).  The two builds alter
 run in one process, so the machine's load falls on both alike; the cost ratio is of CPU
 seconds over the same (row, seed) runs.
 
+Other builds: ``per_lever_k10`` (``--joint-k 10``), ``per_lever_chain`` (session 46's per-lever
+robot: u3_up carried by a chain, ``COUPLINGS``) and ``per_lever_tau50`` (the per-lever robot
+verified with ``--tau 50``: runs of at least 150 t0, ``TAUS``).
+
 What it records, per build: bodies, every run's shape and relax time and CPU; per row and
 DOF the seed mean of the time-averaged angle, and the per-lever build's difference to the
 default with the error bar sqrt(sd^2/n + sd_ref^2/n) of the two seed spreads.
@@ -38,7 +42,11 @@ ROOT = HERE.parent
 RESULTS = HERE / "results"
 BUILDS = {"default": [], "per_lever": ["--muscle-per-lever"],
           "per_lever_k10": ["--muscle-per-lever", "--joint-k", "10"],     # name: mlc compile flags
-          "per_lever_chain": ["--muscle-per-lever"]}
+          "per_lever_chain": ["--muscle-per-lever"],
+          "per_lever_tau50": ["--muscle-per-lever"]}
+# builds verified with their own relaxation time tau (t0; the others: mlc.robot.verify.ROBOT_TAU),
+# as `mlc verify --dynamic --tau 50` would (the runs last at least 3 tau)
+TAUS = {"per_lever_tau50": 50.0}
 # builds whose robot file sets some DOFs' coupling: per_lever_chain is session 46's per-lever robot,
 # u3_up (= y) carried by a chain from y's source instead of a muscle of its own (session 47)
 COUPLINGS = {"per_lever_chain": {"u3_up": "lever"}}
@@ -125,7 +133,7 @@ def plot(path: str) -> str:
     runs = data["runs"]
     rows = sorted({r["row"] for r in runs})
     names = list(data["summary"]["builds"])
-    colors = dict(zip(BUILDS, ("tab:gray", "tab:blue", "tab:orange", "tab:green")))
+    colors = dict(zip(BUILDS, ("tab:gray", "tab:blue", "tab:orange", "tab:green", "tab:purple")))
     wid = 0.8 / len(names)
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))
     for i, name in enumerate(names):
@@ -178,9 +186,10 @@ def main(argv=None) -> int:
             for name, sc in scenes.items():
                 if (name, row, seed) in done:
                     continue
-                r = run_one(sc, row, seed, ROBOT_DT, ROBOT_TAU, 1800.0, a.kT, disp_acc=ROBOT_DISP_ACC)
+                tau = TAUS.get(name, ROBOT_TAU)
+                r = run_one(sc, row, seed, ROBOT_DT, tau, 1800.0, a.kT, disp_acc=ROBOT_DISP_ACC)
                 r.pop("history", None)
-                r.update(build=name, bodies=len(sc.bodies))
+                r.update(build=name, bodies=len(sc.bodies), tau=tau)
                 data["runs"].append(r)
                 data.update(commit=commit(), machine=platform.machine(), cpus=os.cpu_count(),
                             settings={"dt": ROBOT_DT, "disp_acc": ROBOT_DISP_ACC, "tau": ROBOT_TAU, "kT": a.kT},
