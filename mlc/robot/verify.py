@@ -306,12 +306,13 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
     read from each seed's final poses (see the module doc).
     ``dt`` (t0): the scheme's step (default ``ROBOT_DT``); ``tau`` (t0): the slowest
     relaxation time (default ``ROBOT_TAU``, measured on the robots' folds, docs/robot.md
-    section 3; ``"compute"`` runs :func:`mlc.verify.dynamic.relaxation_time`, which takes
-    more than 8 min for a 2000-body robot).  Seeds are ``first_seed``, ``first_seed + 1``, ..."""
+    section 3; ``"compute"`` runs :func:`mlc.verify.dynamic.relaxation_time` at the rest pose,
+    densely up to ``DENSE_ROBOT`` coordinates: seconds for the 524-body per-lever Tetris robot;
+    a larger one takes the sparse Lanczos, more than 8 min for a 2000-body robot).  Seeds are ``first_seed``, ``first_seed + 1``, ..."""
     from mlc.io.progress import Progress
     from mlc.sim.drive import Drive
     from mlc.sim.integrator import SimOptions, Simulation, check_kT
-    from mlc.verify.dynamic import TAU_FACTOR, relaxation_time
+    from mlc.verify.dynamic import DENSE_ROBOT, TAU_FACTOR, relaxation_time
 
     rm = robot_meta(scene)
     states = select_rows(scene, rows)
@@ -325,7 +326,7 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
     t0 = time.perf_counter()
     opt0 = SimOptions(scheme=scheme)
     if tau == "compute":
-        tau = relaxation_time(scene, gamma_r=opt0.gamma_r)
+        tau = relaxation_time(scene, gamma_r=opt0.gamma_r, dense_max=DENSE_ROBOT)
     tau = ROBOT_TAU if tau is None else float(tau)
     dt = ROBOT_DT if (dt is None and scheme == "stiff") else dt
     rep = Report(scene.name, "dynamic", params={"kT": kT, "seeds": int(seeds), "first_seed": int(first_seed),

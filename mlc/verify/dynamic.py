@@ -67,6 +67,8 @@ DT_LARGE = {"stiff": 0.2}  # t0: circuits (more than DENSE_MAX / 6 bodies); meas
 SLOW_STEPS = 1e8       # Euler steps a run beyond which the check warns before it starts
 DENSE_MAX = 1800       # degrees of freedom up to which the spectrum is computed densely
 ZERO = 1e-9            # eigenvalues below ZERO * lambda_max count as zero modes
+DENSE_ROBOT = 6000     # ... and for a robot's --tau compute (6000: 288 MB; a 524-body robot's 3144 took
+                       # 4.5 s, where the sparse Lanczos did not converge in 10 minutes, session 47)
 SIGNAL_MIN = 0.01      # probes answering less than this fraction of the largest answer are left out of signal_time
 
 
@@ -96,7 +98,16 @@ def relaxation_time(scene, pos=None, quat=None, gamma_r: float | None = None,
         nz = ev[ev > ZERO * max(ev[-1], 1e-300)]
         lam = float(nz[0]) if len(nz) else 0.0
     else:
-        lam = _smallest_nonzero_sparse(H)
+        from scipy.sparse.linalg import ArpackNoConvergence
+        try:
+            lam = _smallest_nonzero_sparse(H)
+        except ArpackNoConvergence:
+            # many zero modes (the floppy bends of chains) can keep the shift-invert Lanczos from
+            # converging: the 524-body Tetris robot with a muscle per lever has 150 against the 16
+            # eigenvalues first asked for (session 47, after 31441 iterations; its dense spectrum: 4.5 s)
+            raise MlcError(f"the slowest relaxation time could not be computed: the Lanczos iteration for the "
+                           f"smallest non-zero rate of this {prob.n}-coordinate scene did not converge", "--tau",
+                           "give the relaxation time in t0 (--tau T)") from None
     if lam <= 0.0:
         return 0.0
     t_unit = gamma / (1e-3 * k0)       # the integrator's time per t0
@@ -224,7 +235,7 @@ def _smallest_nonzero_sparse(H) -> float:
     of zero modes (shift-invert Lanczos, asking for more eigenvalues until a non-zero
     one shows up)."""
     import scipy.sparse as sp
-    from scipy.sparse.linalg import ArpackNoConvergence, LinearOperator, eigsh
+    from scipy.sparse.linalg import LinearOperator, eigsh
 
     from mlc.verify.static import spd_lu
 
@@ -236,16 +247,7 @@ def _smallest_nonzero_sparse(H) -> float:
     k = 16
     while True:
         k = min(k, n - 2)
-        try:
-            vals = eigsh(op, k=k, which="LM", return_eigenvectors=False)
-        except ArpackNoConvergence:
-            # more zero modes (floppy bends) than k: their cluster at 1/shift does not converge
-            # (the 524-body Tetris robot with a muscle per lever, session 47, after 31441 iterations)
-            raise MlcError(f"the slowest relaxation time could not be computed: the Lanczos iteration for the "
-                           f"smallest non-zero rate of this {n}-coordinate scene did not converge "
-                           f"(more than {k} zero modes, such as the floppy bends of its chains)", "--tau",
-                           "give the relaxation time in t0 (--tau T); for a robot leave --tau out: its default, "
-                           "mlc.robot.verify.ROBOT_TAU, is measured on the Tetris folds") from None
+        vals = eigsh(op, k=k, which="LM", return_eigenvectors=False)
         ev = np.sort(1.0 / vals - shift)
         nz = ev[ev > ZERO * lam_max]
         if len(nz) or k >= n - 2:
