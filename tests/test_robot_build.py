@@ -260,3 +260,23 @@ def test_a_muscle_coupling_needs_an_output_that_is_a_circuit_input(tmp_path, cap
         lineno = bad.read_text().splitlines().index(line[:-1] + ", coupling: muscle}") + 1
         assert f"{bad}:{lineno}" in err and "cannot carry a muscle" in err and "Traceback" not in err
         assert not (out / "robot.yaml").exists()
+
+
+def test_a_computed_tau_is_the_dense_spectrum_up_to_the_robot_limit(robot, monkeypatch):
+    """verify_robot_dynamic(tau="compute") runs with the scene's slowest relaxation time at
+    rest, from the dense spectrum up to DENSE_ROBOT coordinates: the sparse Lanczos did not
+    converge on the 524-body per-lever Tetris robot (session 47, docs/robot.md 3)."""
+    import mlc.verify.dynamic as D
+    from mlc.robot.verify import verify_robot_dynamic
+    sc = load_scene(robot / "out" / "robot.yaml")
+    asked = []
+    real = D.relaxation_time
+
+    def spy(scene, *a, **kw):
+        asked.append(kw.get("dense_max"))
+        return real(scene, *a, **kw)
+
+    monkeypatch.setattr(D, "relaxation_time", spy)
+    rep = verify_robot_dynamic(sc, rows=["0"], seeds=1, max_time=1.0, tau="compute")
+    assert asked == [D.DENSE_ROBOT] and 6 * len(sc.bodies) < D.DENSE_ROBOT
+    assert rep.params["tau"] == pytest.approx(real(sc), rel=1e-9) and rep.params["tau"] > 0
