@@ -93,6 +93,38 @@ def test_overlap_during_run_is_detected_not_ejected():
         assert "WCA" in msg and "bodies" in msg and " q" in msg and "t = " in msg
 
 
+def test_a_bond_pulled_past_its_bound_in_the_first_step_is_not_called_the_initial_scene(monkeypatch):
+    """A muscle that pulls a bond beyond the monitor's bound (0.25 sigma at equilibrium against
+    0.15 at kT = 0) fails in the first step, not in the scene at t = 0, which is fine: the
+    message says the run became unstable and what to check, not 'fix the poses' (before
+    session 47 a stiff failure in step 0 was reported as the initial scene's).  Euler looks
+    for a dt that gets past the failure once: its trial runs, which fail too, do not each
+    look again (before session 47 they did, recursively: 228 s for these two bodies)."""
+    from mlc.scene.model import Bond, Muscle
+
+    searches = []
+    real = Simulation._suggest_euler_dt
+
+    def counted(self, *a):
+        searches.append(self._trial)
+        return real(self, *a)
+
+    monkeypatch.setattr(Simulation, "_suggest_euler_dt", counted)
+
+    bodies = [Body(n, np.array(p, float), np.array([1.0, 0, 0, 0]), [Box(np.array([0.2, 0.2, 0.2]))],
+                   {"c": np.zeros(3)}) for n, p in (("p", [0, 0, 0]), ("q", [1.0, 0, 0]))]
+    sc = Scene("pulled", bodies, bonds=[Bond("tie", "p.c", "q.c", 1.0, 1.0)],
+               muscles=[Muscle("m", "a", "p.c", "q.c", 1.0, 1.5, 1.0)], inputs=["a"]).check()
+    simulate(sc, 0.05, {"a": 1}, SimOptions(kT=0, scheme="stiff", dt=0.05, stretch_joint=0.3))   # within 0.3
+    for scheme, dt in (("stiff", 0.05), ("euler", None)):
+        with pytest.raises(MlcError) as e:
+            simulate(sc, 0.05, {"a": 1}, SimOptions(kT=0, scheme=scheme, dt=dt))
+        msg = str(e.value)
+        assert "unstable at t =" in msg and "bond tie" in msg and "initial scene" not in msg, msg
+    assert searches == [False]                   # Euler's own failure only, none of its trials'
+    assert "no Euler step checked from the scene at rest gets past this point" in msg
+
+
 def test_dt_past_euler_limit_is_detected():
     sc = chain_scene(10)
     sim = Simulation(sc, None, SimOptions(scheme="euler", kT=1e-5))

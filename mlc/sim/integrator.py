@@ -138,6 +138,7 @@ class Simulation:
                            "quat", "normalise it")
         self.t = 0.0          # internal units
         self.step = 0
+        self._trial = False   # a trial run of _suggest_euler_dt: its failure is not reported in full
         # sites
         self.site_body = a.site_body.astype(np.int64)
         self.site_local = np.ascontiguousarray(a.site_local)
@@ -489,7 +490,7 @@ class Simulation:
         self._eval()
         self.status[:] = 0
         if K._failed(self.mon, float(self.opt.wca_min), self.status, 0):
-            self._fail()
+            self._fail(initial=True)
 
     def _suggest_euler_dt(self, t_fail: float, dt_failed: float):
         """A dt for Euler computed from the scene at rest (its initial state, drives at t = 0),
@@ -512,13 +513,19 @@ class Simulation:
             try:
                 trial = Simulation(self.scene, self._drive_arg, SimOptions(**{**trial_opt.__dict__, "dt": dt}),
                                    pos=self._pos0, quat=self._quat0)
+                # a trial that fails does not search for a dt of its own: before session 47 each did,
+                # recursively (a 2-body scene whose bond no dt keeps inside its bound took 228 s to say so)
+                trial._trial = True
                 trial.run(horizon, record_interval=horizon, quiet=True)
                 return dt, True, lim
             except MlcError:
                 dt = float(f"{dt / 4:.1g}")
         return None, False, lim
 
-    def _fail(self, dt_t0: float | None = None):
+    def _fail(self, dt_t0: float | None = None, initial: bool = False):
+        """Raise the monitors' failure as an MlcError.  ``initial``: found in the state at
+        t = 0 (:meth:`_check_initial`), which no step can fix; else in a step (a failure in
+        the first step also has step 0 in ``status``)."""
         st = self.status
         code, step = int(st[0]), int(st[1])
         dt_t0 = self.dt if dt_t0 is None else dt_t0
@@ -526,7 +533,8 @@ class Simulation:
         names = [b.name for b in self.scene.bodies]
         o = self.opt
         if o.scheme == "euler":
-            sug, checked, lim = (None, False, math.nan) if step == 0 else self._suggest_euler_dt(t, dt_t0)
+            sug, checked, lim = ((None, False, math.nan) if initial or self._trial
+                                 else self._suggest_euler_dt(t, dt_t0))
             if sug is not None:
                 fix = (f"use --dt {sug:g} or less (from the scene at rest, where Euler's limit is about "
                        f"{lim:.2g} t0" + ("; checked: it runs past this point)" if checked else ")"))
@@ -542,7 +550,7 @@ class Simulation:
         if code == K.STRETCH:
             m = int(st[2])
             bound = self.sp_bound[m]
-            if step == 0:
+            if initial:
                 raise MlcError(f"at t = 0: {self.spring_names[m]} is stretched beyond {bound:.3g} sigma in the "
                                "initial scene (with the drives' values at t = 0)", "scene",
                                "fix the poses or the rest lengths; no time step can fix this")
@@ -550,7 +558,7 @@ class Simulation:
                    f"{bound:.3g} sigma (thermal bound {o.stretch_thermal:g} sqrt(kT/k) + static allowance)")
         elif code == K.WCA_CLOSE:
             i, j = int(st[2]), int(st[3])
-            if step == 0:
+            if initial:
                 raise MlcError(f"at t = 0: bodies {names[i]} and {names[j]} have centres closer than "
                                f"{o.wca_min:g} sigma: their WCA cores overlap and would eject them",
                                "scene", "move the bodies apart (no time step can fix this)")
