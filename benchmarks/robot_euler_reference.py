@@ -17,7 +17,8 @@ from the reference (sigma), its largest DOF-angle difference (degrees) and its w
 CPU time.
 
     python benchmarks/robot_euler_reference.py OUT/robot.yaml [--row 01] [--time 2]
-        [--every 0.25] [--dts 0.2 0.05 0.01] [--euler-check 0.5] [--disp-acc 0.1] [-o OUT.json]
+        [--every 0.25] [--dts 0.2 0.05 0.01] [--euler-check 0.5] [--disp-acc 0.1] [--stretch-joint 0.25]
+        [-o OUT.json]
 
 ``--disp-acc`` gives the stiff runs that drift bound (sigma; mlc.robot.verify.ROBOT_DISP_ACC
 is the verifier's), else the integrator's default.  Writes benchmarks/results/robot_euler_reference.json
@@ -103,6 +104,10 @@ def main():
     ap.add_argument("--dts", nargs="*", type=float, default=[0.2, 0.05, 0.01])
     ap.add_argument("--euler-check", type=float, default=0.5)
     ap.add_argument("--disp-acc", type=float, default=None, help="the stiff runs' drift bound (sigma)")
+    ap.add_argument("--stretch-joint", type=float, default=None,
+                    help="every run's joint-bond bound c_0 (sigma; SimOptions.stretch_joint, default 0.15): at "
+                         "kT = 0 the bound is c_0 alone, and the per-lever robot's u3_up hinge peaks at 0.166 sigma "
+                         "as its muscle switches (session 47), inside the 0.197 of the verifier's kT = 1e-5")
     ap.add_argument("-o", "--out", type=Path, default=OUT)
     args = ap.parse_args()
     if args.plot:
@@ -113,15 +118,16 @@ def main():
     from mlc.scene.io import load_scene
     sc = load_scene(args.scene)
     runs = {}
-    ref = trajectory(sc, args.row, "euler", None, args.time, args.every)
+    mon = {} if args.stretch_joint is None else {"stretch_joint": args.stretch_joint}
+    ref = trajectory(sc, args.row, "euler", None, args.time, args.every, **mon)
     print(f"euler dt {ref['dt']:.3g} t0 (limit {ref['euler_limit']:.3g}): {ref['wall_s']:.0f} s wall, "
           f"{ref['cpu_s']:.0f} s CPU", flush=True)
-    half = trajectory(sc, args.row, "euler", ref["dt"] / 2, args.euler_check, args.every)
+    half = trajectory(sc, args.row, "euler", ref["dt"] / 2, args.euler_check, args.every, **mon)
     runs["euler_half_dt"] = {"dt": half["dt"], "wall_s": half["wall_s"], "cpu_s": half["cpu_s"],
                              "vs_reference": compare(half, ref)}
     print("euler dt/2:", runs["euler_half_dt"]["vs_reference"][-1], flush=True)
     for dt in args.dts:
-        r = trajectory(sc, args.row, "stiff", dt, args.time, args.every,
+        r = trajectory(sc, args.row, "stiff", dt, args.time, args.every, **mon,
                        **({} if args.disp_acc is None else {"disp_acc": args.disp_acc}))
         runs[f"stiff_dt_{dt:g}"] = {"dt": dt, "wall_s": r["wall_s"], "cpu_s": r["cpu_s"],
                                     "vs_reference": compare(r, ref)}
@@ -129,7 +135,7 @@ def main():
               runs[f"stiff_dt_{dt:g}"]["vs_reference"][-1], flush=True)
     motion = [float(np.max(np.linalg.norm(p - ref["pos"][0], axis=1))) for p in ref["pos"]]
     res = {"scene": str(args.scene), "bodies": len(sc.bodies), "row": args.row, "kT": 0.0, "time_t0": args.time,
-           "stiff_disp_acc": args.disp_acc,
+           "stiff_disp_acc": args.disp_acc, "stretch_joint": args.stretch_joint,
            "reference": {"scheme": "euler", "dt": ref["dt"], "euler_limit": ref["euler_limit"],
                          "wall_s": ref["wall_s"], "cpu_s": ref["cpu_s"], "t": ref["t"],
                          "max_body_motion_since_first_checkpoint_sigma": motion,
