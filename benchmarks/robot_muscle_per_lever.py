@@ -65,8 +65,9 @@ def compile_robot(flags: list[str], out: Path, couplings: dict | None = None):
     if couplings:
         data = yaml.safe_load(robot.read_text())
         for d in data["dofs"]:
-            if f"u{d['unit']}_{d['side']}" in couplings:
-                d["coupling"] = couplings[f"u{d['unit']}_{d['side']}"]
+            name = f"u{d['unit']}_{d['side']}"
+            if name in couplings:
+                d["coupling"] = couplings[name]
         out.mkdir(parents=True, exist_ok=True)
         robot = out / "tetris.robot.yaml"
         robot.write_text(yaml.safe_dump(data, sort_keys=False))
@@ -180,7 +181,12 @@ def main(argv=None) -> int:
     data = json.loads(out.read_text()) if out.exists() else {"runs": []}
     done = {(r["build"], r["row"], r["seed"]) for r in data["runs"]}
     with tempfile.TemporaryDirectory() as tmp:
-        scenes = {name: compile_robot(BUILDS[name], Path(tmp) / name, COUPLINGS.get(name)) for name in a.builds}
+        scenes, built = {}, {}        # builds that differ only in how they are verified share one compile
+        for name in a.builds:
+            key = (tuple(BUILDS[name]), tuple(sorted(COUPLINGS.get(name, {}).items())))
+            if key not in built:
+                built[key] = compile_robot(BUILDS[name], Path(tmp) / name, COUPLINGS.get(name))
+            scenes[name] = built[key]
     for row in a.rows:
         for seed in a.seeds:
             for name, sc in scenes.items():

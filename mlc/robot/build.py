@@ -344,10 +344,11 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
     t0 = time.perf_counter()
     meta = circuit.meta if isinstance(circuit.meta, dict) else {}
     signal = meta.get("signal", "expand")
-    design = connector_geometry(signal, gap=float(meta.get("connector", {}).get("gap", 0.5)))
+    conn = meta.get("connector", {})
+    design = connector_geometry(signal, gap=float(conn.get("gap", 0.5)))
     # the circuit's connector stiffness (mlc compile --joint-k): its meta records the joints' k
     # (design k times K); the coupling chains' bonds get the same, the skeleton keeps the design k
-    joint_k = float(meta.get("connector", {}).get("joint_k", design.k)) / design.k
+    joint_k = float(conn.get("joint_k", design.k)) / design.k
     if not (joint_k > 0 and math.isfinite(joint_k)):
         raise MlcError(f"the circuit scene records connector joint_k {joint_k * design.k}", "circuit meta",
                        "recompile the circuit (mlc compile --joint-k K, K > 0)")
@@ -399,7 +400,6 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
     targets = []           # (dof spec, pair sites lo/hi, centre, axis) to route to
     dof_muscles: list[Muscle] = []
     # a circuit with a muscle per lever: an output that is a circuit input drives its DOF by a muscle
-    conn = meta.get("connector", {})
     wired = dict(conn.get("input_outputs") or {}) if conn.get("muscle_per_lever") else {}
     posts = {k: [] for k in segs}
     for i in range(1, spec.units + 1):
