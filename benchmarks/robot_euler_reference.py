@@ -11,16 +11,18 @@ the only difference between runs is the integrator and its step) for ``--time`` 
   convergence (its error is first order in dt, so the difference of the two is about the
   reference's error);
 * the stiff scheme at each ``--dts`` step,
+* the linearly implicit scheme (``scheme="implicit"``, mlc/sim/implicit.py) at each
+  ``--implicit-dts`` step, with the same drift bound,
 
 and records, at every checkpoint (``--every`` t0), each run's largest body displacement
 from the reference (sigma), its largest DOF-angle difference (degrees) and its wall and
 CPU time.
 
     python benchmarks/robot_euler_reference.py OUT/robot.yaml [--row 01] [--time 2]
-        [--every 0.25] [--dts 0.2 0.05 0.01] [--euler-check 0.5] [--disp-acc 0.1] [--stretch-joint 0.25]
-        [-o OUT.json]
+        [--every 0.25] [--dts 0.2 0.05 0.01] [--implicit-dts 0.8] [--euler-check 0.5] [--disp-acc 0.1]
+        [--stretch-joint 0.25] [-o OUT.json]
 
-``--disp-acc`` gives the stiff runs that drift bound (sigma; mlc.robot.verify.ROBOT_DISP_ACC
+``--disp-acc`` gives the stiff and implicit runs that drift bound (sigma; mlc.robot.verify.ROBOT_DISP_ACC
 is the verifier's), else the integrator's default.  Writes benchmarks/results/robot_euler_reference.json
 (or ``-o``) and its .png (atomic).  Units: sigma,
 t0, degrees, seconds.  One process; Euler's steps dominate (about 0.3 ms of CPU a step for
@@ -88,7 +90,7 @@ def plot(res: dict, out: Path = OUT) -> None:
     for a in ax:
         a.set_xlabel("t (t0), from rest, kT = 0")
         a.legend(fontsize=8)
-    fig.suptitle(f"Tetris robot row {row}: stiff scheme against Euler at dt = {ref['dt']:.2g} t0")
+    fig.suptitle(f"Tetris robot row {row}: stiff and implicit schemes against Euler at dt = {ref['dt']:.2g} t0")
     fig.tight_layout()
     with atomic_path(out.with_suffix(".png")) as tmp:
         fig.savefig(tmp, dpi=110, format="png")
@@ -102,6 +104,8 @@ def main():
     ap.add_argument("--time", type=float, default=2.0)
     ap.add_argument("--every", type=float, default=0.25)
     ap.add_argument("--dts", nargs="*", type=float, default=[0.2, 0.05, 0.01])
+    ap.add_argument("--implicit-dts", nargs="*", type=float, default=[],
+                    help="steps (t0) of the linearly implicit scheme to run as well")
     ap.add_argument("--euler-check", type=float, default=0.5)
     ap.add_argument("--disp-acc", type=float, default=None, help="the stiff runs' drift bound (sigma)")
     ap.add_argument("--stretch-joint", type=float, default=None,
@@ -126,13 +130,14 @@ def main():
     runs["euler_half_dt"] = {"dt": half["dt"], "wall_s": half["wall_s"], "cpu_s": half["cpu_s"],
                              "vs_reference": compare(half, ref)}
     print("euler dt/2:", runs["euler_half_dt"]["vs_reference"][-1], flush=True)
-    for dt in args.dts:
-        r = trajectory(sc, args.row, "stiff", dt, args.time, args.every, **mon,
-                       **({} if args.disp_acc is None else {"disp_acc": args.disp_acc}))
-        runs[f"stiff_dt_{dt:g}"] = {"dt": dt, "wall_s": r["wall_s"], "cpu_s": r["cpu_s"],
-                                    "vs_reference": compare(r, ref)}
-        print(f"stiff dt {dt:g}: {r['wall_s']:.1f} s wall, {r['cpu_s']:.1f} s CPU, at {args.time:g} t0:",
-              runs[f"stiff_dt_{dt:g}"]["vs_reference"][-1], flush=True)
+    for scheme, dts in (("stiff", args.dts), ("implicit", args.implicit_dts)):
+        for dt in dts:
+            r = trajectory(sc, args.row, scheme, dt, args.time, args.every, **mon,
+                           **({} if args.disp_acc is None else {"disp_acc": args.disp_acc}))
+            runs[f"{scheme}_dt_{dt:g}"] = {"dt": dt, "wall_s": r["wall_s"], "cpu_s": r["cpu_s"],
+                                           "vs_reference": compare(r, ref)}
+            print(f"{scheme} dt {dt:g}: {r['wall_s']:.1f} s wall, {r['cpu_s']:.1f} s CPU, at {args.time:g} t0:",
+                  runs[f"{scheme}_dt_{dt:g}"]["vs_reference"][-1], flush=True)
     motion = [float(np.max(np.linalg.norm(p - ref["pos"][0], axis=1))) for p in ref["pos"]]
     res = {"scene": str(args.scene), "bodies": len(sc.bodies), "row": args.row, "kT": 0.0, "time_t0": args.time,
            "stiff_disp_acc": args.disp_acc, "stretch_joint": args.stretch_joint,

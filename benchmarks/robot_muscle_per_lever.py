@@ -9,7 +9,9 @@ seconds over the same (row, seed) runs.
 
 Other builds: ``per_lever_k10`` (``--joint-k 10``), ``per_lever_chain`` (session 46's per-lever
 robot: u3_up carried by a chain, ``COUPLINGS``) and ``per_lever_tau50`` (the per-lever robot
-verified with ``--tau 50``: runs of at least 150 t0, ``TAUS``).
+verified with ``--tau 50``: runs of at least 150 t0, ``TAUS``), ``per_lever_implicit`` and
+``default_implicit`` (those robots verified with the linearly implicit scheme, ``SCHEMES``;
+compare with ``--ref per_lever``).
 
 What it records, per build: bodies, every run's shape and relax time and CPU; per row and
 DOF the seed mean of the time-averaged angle, and the per-lever build's difference to the
@@ -43,10 +45,14 @@ RESULTS = HERE / "results"
 BUILDS = {"default": [], "per_lever": ["--muscle-per-lever"],
           "per_lever_k10": ["--muscle-per-lever", "--joint-k", "10"],     # name: mlc compile flags
           "per_lever_chain": ["--muscle-per-lever"],
-          "per_lever_tau50": ["--muscle-per-lever"]}
+          "per_lever_tau50": ["--muscle-per-lever"],
+          "per_lever_implicit": ["--muscle-per-lever"], "default_implicit": []}
 # builds verified with their own relaxation time tau (t0; the others: mlc.robot.verify.ROBOT_TAU),
 # as `mlc verify --dynamic --tau 50` would (the runs last at least 3 tau)
 TAUS = {"per_lever_tau50": 50.0}
+# builds verified with another integrator (the others: the stiff scheme, SK-ROCK, the verifier's default);
+# "implicit" is the linearly implicit scheme of mlc/sim/implicit.py (session 48), at the same dt and drift bound
+SCHEMES = {"per_lever_implicit": "implicit", "default_implicit": "implicit"}
 # builds whose robot file sets some DOFs' coupling: per_lever_chain is session 46's per-lever robot,
 # u3_up (= y) carried by a chain from y's source instead of a muscle of its own (session 47)
 COUPLINGS = {"per_lever_chain": {"u3_up": "lever"}}
@@ -134,7 +140,8 @@ def plot(path: str) -> str:
     runs = data["runs"]
     rows = sorted({r["row"] for r in runs})
     names = list(data["summary"]["builds"])
-    colors = dict(zip(BUILDS, ("tab:gray", "tab:blue", "tab:orange", "tab:green", "tab:purple")))
+    colors = dict(zip(BUILDS, ("tab:gray", "tab:blue", "tab:orange", "tab:green", "tab:purple", "tab:red",
+                               "tab:brown")))
     wid = 0.8 / len(names)
     fig, ax = plt.subplots(1, 2, figsize=(10, 4))
     for i, name in enumerate(names):
@@ -193,9 +200,10 @@ def main(argv=None) -> int:
                 if (name, row, seed) in done:
                     continue
                 tau = TAUS.get(name, ROBOT_TAU)
-                r = run_one(sc, row, seed, ROBOT_DT, tau, 1800.0, a.kT, disp_acc=ROBOT_DISP_ACC)
+                scheme = SCHEMES.get(name, "stiff")
+                r = run_one(sc, row, seed, ROBOT_DT, tau, 1800.0, a.kT, scheme=scheme, disp_acc=ROBOT_DISP_ACC)
                 r.pop("history", None)
-                r.update(build=name, bodies=len(sc.bodies), tau=tau)
+                r.update(build=name, bodies=len(sc.bodies), tau=tau, scheme=scheme)
                 data["runs"].append(r)
                 data.update(commit=commit(), machine=platform.machine(), cpus=os.cpu_count(),
                             settings={"dt": ROBOT_DT, "disp_acc": ROBOT_DISP_ACC, "tau": ROBOT_TAU, "kT": a.kT},

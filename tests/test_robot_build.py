@@ -85,6 +85,20 @@ def test_dynamic_verify_folds(robot, capsys):
     assert rep["params"]["dt"] == ROBOT_DT and rep["params"]["disp_acc"] == ROBOT_DISP_ACC
 
 
+def test_dynamic_verify_folds_with_the_implicit_scheme(robot, capsys):
+    # the linearly implicit scheme (mlc/sim/implicit.py) at the robot's step and drift bound
+    rc = main(["verify", str(robot / "out" / "robot.yaml"), "--dynamic", "--seeds", "1", "--rows", "1", "--json",
+               "--scheme", "implicit"])
+    rep = json.loads(capsys.readouterr().out)
+    assert rc == 0, rep["rows"]
+    r1 = rep["rows"][0]
+    assert r1["state"] == "1" and r1["relaxed"] and r1["shape_read"] == "hook"
+    assert r1["max_dof_mean_error_rad"] < 0.2 and r1["max_dof_error_rad"] < 0.3
+    from mlc.robot.verify import ROBOT_DISP_ACC, ROBOT_DT
+    assert rep["params"]["scheme"] == "implicit"
+    assert rep["params"]["dt"] == ROBOT_DT and rep["params"]["disp_acc"] == ROBOT_DISP_ACC
+
+
 def test_pictures_and_trajectory(robot, capsys):
     out = robot / "out"
     assert main(["robot", "shapes", str(out / "robot.yaml"), "-o", str(out / "shapes.png")]) == 0

@@ -15,9 +15,10 @@ def register(sub):
     p.add_argument("--time", type=float, required=True, help="simulated time (t0)")
     p.add_argument("--dt", type=float, default=None,
                    help="time step (t0); euler: default half the estimated stability limit; "
-                        "stiff: the largest step (default 0.05), split adaptively in transients")
-    p.add_argument("--scheme", choices=("euler", "stiff"), default="stiff",
-                   help="euler: Euler-Maruyama (the reference, HOOMD-blue's); stiff: SK-ROCK (default)")
+                        "stiff, implicit: the largest step (default 0.05), split adaptively in transients")
+    p.add_argument("--scheme", choices=("euler", "stiff", "implicit"), default="stiff",
+                   help="euler: Euler-Maruyama (the reference, HOOMD-blue's); stiff: SK-ROCK (default); "
+                        "implicit: linearly implicit, one sparse solve per step (large scenes of stiff joints)")
     p.add_argument("--kT", type=float, default=1e-5, help="thermal energy (k0 sigma^2), default 1e-5")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--set", action="append", default=[], metavar="INPUT=VALUE",

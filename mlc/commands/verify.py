@@ -24,7 +24,7 @@ def register(sub):
                    help="thermal energy (k0 sigma^2, default 1e-5): the Brownian dynamics' (--dynamic), or the one "
                         "the static check's thermal spread of every probe is computed at (0: skip that)")
     p.add_argument("--seeds", type=int, default=3, help="seeds per row for --dynamic (default 3)")
-    p.add_argument("--scheme", choices=("stiff", "euler"), default="stiff", help="integrator for --dynamic")
+    p.add_argument("--scheme", choices=("stiff", "euler", "implicit"), default="stiff", help="integrator for --dynamic")
     p.add_argument("--tau", type=float, metavar="T",
                    help="--dynamic: the slowest relaxation time (t0); a run lasts at least 3 T and ends at the first "
                         "plateau (robots: or the fold time). Default for a robot: mlc.robot.verify.ROBOT_TAU "

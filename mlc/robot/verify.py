@@ -328,10 +328,10 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
     if tau == "compute":
         tau = relaxation_time(scene, gamma_r=opt0.gamma_r, dense_max=DENSE_ROBOT)
     tau = ROBOT_TAU if tau is None else float(tau)
-    dt = ROBOT_DT if (dt is None and scheme == "stiff") else dt
+    dt = ROBOT_DT if (dt is None and scheme in ("stiff", "implicit")) else dt
     rep = Report(scene.name, "dynamic", params={"kT": kT, "seeds": int(seeds), "first_seed": int(first_seed),
                                                 "scheme": scheme, "tau": tau, "dt": dt, "robot": True,
-                                                "disp_acc": ROBOT_DISP_ACC if scheme == "stiff" else None})
+                                                "disp_acc": ROBOT_DISP_ACC if scheme in ("stiff", "implicit") else None})
     poses = {}
     total, done = len(states) * int(seeds), 0
     bar = Progress(f"dynamic check of {scene.name}", total=total, show=None if progress is None else False)

@@ -26,7 +26,7 @@ from mlc.sim import kernels as K
 from mlc.sim import check_kT
 from mlc.sim.drive import Drive, pack_drives
 
-SCHEMES = ("euler", "stiff")
+SCHEMES = ("euler", "stiff", "implicit")
 
 
 @dataclass
@@ -34,7 +34,8 @@ class SimOptions:
     """Integrator options (times in t0, lengths in sigma, energies in k0 sigma^2)."""
 
     dt: float | None = None          # None: a default from the stiffness estimate (see default_dt)
-    scheme: str = "stiff"            # "euler" (Euler-Maruyama, the reference) or "stiff" (SK-ROCK)
+    scheme: str = "stiff"            # "euler" (Euler-Maruyama, the reference), "stiff" (SK-ROCK) or
+                                     # "implicit" (linearly implicit, one sparse solve per step: mlc/sim/implicit.py)
     kT: float = 1e-5
     seed: int = 0
     gamma_r: float | None = None     # rotational drag; None = gamma (the paper)
@@ -105,7 +106,7 @@ class Simulation:
         self.scene = scene
         self.opt = o = options or SimOptions()
         if o.scheme not in SCHEMES:
-            raise MlcError(f"unknown scheme {o.scheme!r}", "--scheme", "use euler or stiff")
+            raise MlcError(f"unknown scheme {o.scheme!r}", "--scheme", "use euler, stiff or implicit")
         if o.fluct and o.scheme != "stiff":
             raise MlcError("the fluctuation mode is a variant of the stiff scheme", "--fluct",
                            "use --scheme stiff, or Euler well below its limit (see docs/simulation.md)")
@@ -231,6 +232,10 @@ class Simulation:
             numba.set_num_threads(self.threads)
         self._rho = None
         self.dt = self._choose_dt(o.dt)
+        self._imp = None
+        if o.scheme == "implicit":
+            from mlc.sim.implicit import Implicit
+            self._imp = Implicit(self)
 
     # -- set-up helpers -----------------------------------------------------------------
     def _drives(self, drives: dict) -> list[Drive]:
@@ -310,9 +315,10 @@ class Simulation:
             self._grow_nlist()
             self._eval_once()
 
-    def _eval_once(self):
+    def _eval_once(self, t: float | None = None):
+        """One evaluation at (pos, quat) and time ``t`` (internal units; default the simulation's)."""
         eps, s, rc = self._wca()
-        self._k["eval"](self.pos, self.quat, float(self.t), self.site_body, self.site_local, self.bsite0, self.sp_i,
+        self._k["eval"](self.pos, self.quat, float(self.t if t is None else t), self.site_body, self.site_local, self.bsite0, self.sp_i,
                         self.sp_j, self.sp_k, self.sp_rest0, self.sp_rest1, self.sp_tol, self.sp_inp, self.sp_bound,
                         self.end0, self.end_sp, self.end_sign, self.dkind, self.dpar, self.tab_t, self.tab_v,
                         eps, s, rc, self.ex0, self.ex_list, self.head, self.nxt, self.cell, self.nl0, self.nl,
@@ -336,7 +342,7 @@ class Simulation:
         map of a Gaussian rotation vector is accurate to ~0.08 sigma^2 in D_r); set before any
         noise is drawn, so it does not condition on the noise."""
         o = self.opt
-        if not (o.rot_noise and o.kT > 0 and o.scheme == "stiff"):
+        if not (o.rot_noise and o.kT > 0 and o.scheme in ("stiff", "implicit")):
             return 0
         var = 2.0 * o.kT * dt_int / self.gamma_r
         lev = max(0, math.ceil(math.log2(var / o.rot_var_max))) if var > o.rot_var_max else 0
@@ -388,6 +394,9 @@ class Simulation:
                     done = self._k["euler"](*common)
                     self.stages_out[0] += done
                     self.stages_out[1] = 1
+                elif o.scheme == "implicit":
+                    done = self._imp.advance(int(nsteps), float(dt), float(t_o), int(k_o), int(rec_every), int(rph),
+                                             rec, int(frame_every), int(fph), fpos, fquat)
                 else:
                     eta = 0.0 if o.fluct else float(o.eta)
                     m = self.fluct_stage_factor(dt / self.t_unit)
@@ -543,7 +552,7 @@ class Simulation:
                        "so the scene itself may be at fault")
         else:
             lim = self.euler_limit()
-            fix = ("no time step helps: the stiff scheme refined this step 2^30-fold; the scene itself drives "
+            fix = (f"no time step helps: the {o.scheme} scheme refined this step 2^30-fold; the scene itself drives "
                    "it (a muscle pulling a joint apart, bodies pushed together), check it"
                    + (f"; --scheme euler --dt {float(f'{0.5 * lim:.1g}'):g} shows the motion up to here"
                       if math.isfinite(lim) else ""))
@@ -590,6 +599,12 @@ class Simulation:
             v = 1.0 / (1.0 - 0.5 * hr) if hr < 2 else math.inf
             return {"scheme": "euler", "h_rho": hr, "ratio_min": 1.0, "ratio_max": v,
                     "note": "stiffest mode 1/(1 - h lambda/2); softer modes lie between"}
+        if self.opt.scheme == "implicit":
+            if self.opt.rot_noise:
+                return {"scheme": "implicit", "h_rho": hr, "ratio_min": 1.0, "ratio_max": 1.0,
+                        "note": "exact for every linear mode (noise covariance 2 kT (D/h + H+/2))"}
+            return {"scheme": "implicit", "h_rho": hr, "ratio_min": 1.0 / (1.0 + 0.5 * hr), "ratio_max": 1.0,
+                    "note": "stiffest mode 1/(1 + h lambda/2) (translational noise only: mlc/sim/implicit.py)"}
         if self.opt.fluct:
             out = {"scheme": "stiff-fluct", "h_rho": hr, "ratio_min": 1.0, "ratio_max": 1.0,
                    "stage_factor": self.fluct_stage_factor(dt),
