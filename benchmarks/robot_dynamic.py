@@ -2,8 +2,9 @@
 Brownian dynamics at kT = 1e-5 from rest until relaxed or the paper's 1800 t0.
 
 One (row, seed) at a time, one process (the machine is shared).  Each run is the same
-as ``mlc verify ROBOT --dynamic`` (:func:`mlc.robot.verify.verify_robot_dynamic`): the
-inputs switch to the row at t = 0 from the rest pose, the stiff scheme advances in
+as ``mlc verify ROBOT --dynamic`` (:func:`mlc.robot.verify.verify_robot_dynamic`; that
+is, with ``--scheme implicit --dt 0.8 --disp-acc 0.1``, the verifier's defaults since
+session 48): the inputs switch to the row at t = 0 from the rest pose, the scheme advances in
 windows of ``tau/20`` t0, and the run stops when
 
 * it has lasted at least ``3 tau`` (the time floor of :mod:`mlc.verify.dynamic`), the
@@ -18,7 +19,8 @@ turns are also read every ``--every`` t0, so the JSON holds each fold's history,
 final pose gets the slab-overlap test (``clearance_end``, sigma; negative: interpenetration).
 
     python benchmarks/robot_dynamic.py OUT/robot.yaml [--rows 11] [--seeds 0 1 2]
-        [--dt 0.2] [--tau 100] [--max-time 1800] [-o benchmarks/results/robot_dynamic.json]
+        [--dt 0.2] [--scheme stiff] [--disp-acc 0.1] [--tau 100] [--max-time 1800]
+        [-o benchmarks/results/robot_dynamic.json]
 
 A scene compiled with stiff joints (``mlc compile --joint-k K``) goes to its own file, e.g.
 ``-o benchmarks/results/robot_dynamic_jointk100.json``; every run records the scene's
@@ -87,7 +89,11 @@ def main(argv=None) -> int:
     ap.add_argument("scene")
     ap.add_argument("--rows", nargs="*")
     ap.add_argument("--seeds", nargs="*", type=int, default=[0, 1, 2])
-    ap.add_argument("--dt", type=float, default=0.2, help="t0, stiff scheme's step")
+    ap.add_argument("--dt", type=float, default=0.2, help="t0, the scheme's step")
+    ap.add_argument("--scheme", default="stiff", choices=("stiff", "implicit", "euler"),
+                    help="the integrator (mlc verify's default for a robot: mlc.robot.verify.ROBOT_SCHEME)")
+    ap.add_argument("--disp-acc", type=float, default=None,
+                    help="sigma: the step control's drift bound (mlc verify's for a robot: ROBOT_DISP_ACC)")
     ap.add_argument("--tau", type=float, default=100.0, help="t0, slowest relaxation time (time floor 3 tau)")
     ap.add_argument("--max-time", type=float, default=1800.0)
     ap.add_argument("--every", type=float, default=100.0)
@@ -108,8 +114,10 @@ def main(argv=None) -> int:
     runs = {(r["row"], r["seed"]): r for r in data.get("runs", [])}
     for state in rows:
         for seed in a.seeds:
-            r = run_one(sc, state, seed, a.dt, a.tau, a.max_time, a.kT, a.every, min_time=a.min_time)
-            r.update({"min_time": a.min_time if a.min_time is not None else 3 * a.tau, "dt": a.dt, "tau": a.tau, "kT": a.kT, "max_time": a.max_time, "scheme": "stiff",
+            r = run_one(sc, state, seed, a.dt, a.tau, a.max_time, a.kT, a.every, scheme=a.scheme,
+                        min_time=a.min_time, disp_acc=a.disp_acc)
+            r.update({"min_time": a.min_time if a.min_time is not None else 3 * a.tau, "dt": a.dt, "tau": a.tau,
+                      "kT": a.kT, "max_time": a.max_time, "scheme": a.scheme, "disp_acc": a.disp_acc,
                       "bodies": len(sc.bodies), "load_1min": round(os.getloadavg()[0], 2),
                       "joint_k": joint_k})
             runs[(state, seed)] = r

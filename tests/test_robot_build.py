@@ -81,21 +81,23 @@ def test_dynamic_verify_folds(robot, capsys):
     assert r1["state"] == "1" and r1["relaxed"] and r1["shape_read"] == "hook"
     assert r1["max_dof_mean_error_rad"] < 0.2 and r1["max_dof_error_rad"] < 0.3
     # at the robot defaults (docs/robot.md 3.4): the step and drift bound the report says it ran
-    from mlc.robot.verify import ROBOT_DISP_ACC, ROBOT_DT
+    from mlc.robot.verify import ROBOT_DISP_ACC, ROBOT_DT, ROBOT_SCHEME
     assert rep["params"]["dt"] == ROBOT_DT and rep["params"]["disp_acc"] == ROBOT_DISP_ACC
+    assert rep["params"]["scheme"] == ROBOT_SCHEME == "implicit"
 
 
-def test_dynamic_verify_folds_with_the_implicit_scheme(robot, capsys):
-    # the linearly implicit scheme (mlc/sim/implicit.py) at the robot's step and drift bound
+def test_dynamic_verify_folds_with_the_stiff_scheme_too(robot, capsys):
+    # the robot's default integrator is the linearly implicit scheme (ROBOT_SCHEME, above);
+    # SK-ROCK at the same step and drift bound folds it the same way
     rc = main(["verify", str(robot / "out" / "robot.yaml"), "--dynamic", "--seeds", "1", "--rows", "1", "--json",
-               "--scheme", "implicit"])
+               "--scheme", "stiff"])
     rep = json.loads(capsys.readouterr().out)
     assert rc == 0, rep["rows"]
     r1 = rep["rows"][0]
     assert r1["state"] == "1" and r1["relaxed"] and r1["shape_read"] == "hook"
     assert r1["max_dof_mean_error_rad"] < 0.2 and r1["max_dof_error_rad"] < 0.3
     from mlc.robot.verify import ROBOT_DISP_ACC, ROBOT_DT
-    assert rep["params"]["scheme"] == "implicit"
+    assert rep["params"]["scheme"] == "stiff"
     assert rep["params"]["dt"] == ROBOT_DT and rep["params"]["disp_acc"] == ROBOT_DISP_ACC
 
 

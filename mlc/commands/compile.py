@@ -96,7 +96,8 @@ def register(sub):
     p.add_argument("--dynamic", action="store_true", help="with --verify: Brownian dynamics from rest, until relaxed")
     p.add_argument("--kT", type=float, default=1e-5, help="thermal energy for --dynamic (k0 sigma^2, default 1e-5)")
     p.add_argument("--seeds", type=int, default=3, help="seeds per row for --dynamic (default 3)")
-    p.add_argument("--scheme", choices=("stiff", "euler", "implicit"), default="stiff", help="integrator for --dynamic")
+    p.add_argument("--scheme", choices=("stiff", "euler", "implicit"), default=None,
+                   help="integrator for --dynamic (default: stiff for a circuit, implicit for a robot)")
     add_jobs(p, compile_=True)
     p.add_argument("--stl", metavar="STL", help="printable mesh of the whole circuit (through mlc stl)")
     p.add_argument("--3mf", dest="threemf", metavar="3MF", help="3MF of the circuit with named parts (through mlc stl)")

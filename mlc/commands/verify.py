@@ -24,7 +24,8 @@ def register(sub):
                    help="thermal energy (k0 sigma^2, default 1e-5): the Brownian dynamics' (--dynamic), or the one "
                         "the static check's thermal spread of every probe is computed at (0: skip that)")
     p.add_argument("--seeds", type=int, default=3, help="seeds per row for --dynamic (default 3)")
-    p.add_argument("--scheme", choices=("stiff", "euler", "implicit"), default="stiff", help="integrator for --dynamic")
+    p.add_argument("--scheme", choices=("stiff", "euler", "implicit"), default=None,
+                   help="integrator for --dynamic (default: stiff for a circuit, implicit for a robot)")
     p.add_argument("--tau", type=float, metavar="T",
                    help="--dynamic: the slowest relaxation time (t0); a run lasts at least 3 T and ends at the first "
                         "plateau (robots: or the fold time). Default for a robot: mlc.robot.verify.ROBOT_TAU "
@@ -61,12 +62,12 @@ def check_jobs(jobs: int, dynamic: bool) -> None:
                        "integrator's threads (NUMBA_NUM_THREADS)", "--jobs", "drop --jobs or --dynamic")
 
 
-def verify_scene_file(scene, dynamic: bool = False, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
+def verify_scene_file(scene, dynamic: bool = False, kT: float = 1e-5, seeds: int = 3, scheme: str | None = None,
                       rows=None, require_clearance: bool = False, tau: float | None = None, dt: float | None = None,
                       jobs: int = 1):
     """The report for an already loaded scene (used by ``mlc compile --verify`` too).  ``tau``
     and ``dt`` (t0, dynamic only): the relaxation time a run lasts at least 3 times and the
-    integrator's step; None: the robot's or the verifier's defaults.  ``jobs``: rows of the
+    integrator's step; None (and ``scheme`` None): the robot's or the verifier's defaults.  ``jobs``: rows of the
     static check solved at once (:func:`mlc.verify.circuit.map_rows`)."""
     from mlc.io.progress import Progress
     from mlc.verify.circuit import select_rows, verify_dynamic, verify_static
@@ -76,7 +77,7 @@ def verify_scene_file(scene, dynamic: bool = False, kT: float = 1e-5, seeds: int
         return verify_robot(scene, dynamic, kT, seeds, scheme, rows, tau=tau, dt=dt, jobs=jobs)
     n = len(select_rows(scene, rows))
     if dynamic:
-        return verify_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme, tau=tau, dt=dt)
+        return verify_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme or "stiff", tau=tau, dt=dt)
     with Progress(f"static verification of {scene.name}", total=n) as bar:
         return verify_static(scene, rows, progress=lambda done, total: bar.update(done),
                              require_clearance=require_clearance, kT=kT, jobs=jobs)

@@ -17,7 +17,7 @@ def kernels_cached(scheme: str = "stiff", parallel: bool = False) -> bool | None
     compiled, None when that cannot be told."""
     try:
         from mlc.sim import kernels as k
-        d = k.kernels(parallel)["euler" if scheme == "euler" else "skrock"]
+        d = k.kernels(parallel)[{"euler": "euler", "implicit": "eval"}.get(scheme or "stiff", "skrock")]
         return bool(d._cache._cache_file._load_index())
     except Exception:
         return None

@@ -43,7 +43,10 @@ TOL_STRETCH = 1e-3        # sigma
 TOL_LENGTH = 0.05         # sigma: static probe lengths within this of the ideal
 FOLD_TIME = 1800.0        # t0: the paper's fold time, a dynamic run's default limit
 ROBOT_TAU = 100.0         # t0: a robot's slowest relaxation time, measured, not computed (docs/robot.md section 3)
-ROBOT_DT = 0.8            # t0: the stiff scheme's step for a robot's fold ...
+ROBOT_SCHEME = "implicit"  # a robot's integrator: the linearly implicit scheme (mlc/sim/implicit.py; session 48:
+                          # 3.5 times less CPU than the stiff scheme on the per-lever Tetris robot's 12 runs,
+                          # docs/robot.md 3.4); circuits keep the stiff scheme (mlc.verify.dynamic)
+ROBOT_DT = 0.8            # t0: the step for a robot's fold (the implicit and the stiff scheme) ...
 ROBOT_DISP_ACC = 0.1      # sigma: ... with this drift bound (SimOptions.disp_acc, default 0.01). Against dt 0.2 t0
                           # at 0.01 sigma: 1.67 times less CPU for the Tetris robot's 12 runs, all right, angles
                           # within 2.3 deg (docs/robot.md 3.4, benchmarks/results/robot_verify_speed.json);
@@ -297,14 +300,14 @@ def _static_row(scene: Scene, rm, state: str, steps: int, clearance: bool) -> tu
     return entries, row, (eq.pos, eq.quat)
 
 
-def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
+def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int = 3, scheme: str | None = None,
                          max_time: float | None = None, progress=None, keep_poses: bool = False,
                          tau: float | None = None, dt: float | None = None, first_seed: int = 0) -> Report:
     """Brownian dynamics from rest into each row, ``seeds`` seeds, until relaxed
     (:func:`run_fold`: at least 3 tau, circuit outputs on a plateau, joint angles within
     their thermal noise) or ``max_time`` t0 (default the paper's 1800 t0); the shape is
     read from each seed's final poses (see the module doc).
-    ``dt`` (t0): the scheme's step (default ``ROBOT_DT``); ``tau`` (t0): the slowest
+    ``scheme``: the integrator (default ``ROBOT_SCHEME``); ``dt`` (t0): its step (default ``ROBOT_DT``); ``tau`` (t0): the slowest
     relaxation time (default ``ROBOT_TAU``, measured on the robots' folds, docs/robot.md
     section 3; ``"compute"`` runs :func:`mlc.verify.dynamic.relaxation_time` at the rest pose,
     densely up to ``DENSE_ROBOT`` coordinates: seconds for the 524-body per-lever Tetris robot;
@@ -316,6 +319,7 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
 
     rm = robot_meta(scene)
     states = select_rows(scene, rows)
+    scheme = ROBOT_SCHEME if scheme is None else scheme
     if int(seeds) < 1:
         raise MlcError(f"need at least one seed, got {seeds}", "--seeds")
     check_kT(kT)
@@ -388,10 +392,11 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
     return rep
 
 
-def verify_robot(scene: Scene, dynamic: bool = False, kT: float = 1e-5, seeds: int = 3, scheme: str = "stiff",
+def verify_robot(scene: Scene, dynamic: bool = False, kT: float = 1e-5, seeds: int = 3, scheme: str | None = None,
                  rows=None, tau: float | None = None, dt: float | None = None, jobs: int = 1) -> Report:
     """``mlc verify`` of a robot scene: static (default; ``jobs`` rows at once) or by
-    Brownian dynamics (``tau`` and ``dt`` in t0, defaults ``ROBOT_TAU`` and ``ROBOT_DT``)."""
+    Brownian dynamics (``scheme`` default ``ROBOT_SCHEME``; ``tau`` and ``dt`` in t0, defaults
+    ``ROBOT_TAU`` and ``ROBOT_DT``)."""
     from mlc.io.progress import Progress
 
     robot_meta(scene)

@@ -244,7 +244,8 @@ class Implicit:
         """``nsteps`` macro steps of ``dt`` (internal units) from the simulation's state, step n
         at time t_o + (k_o + n) dt; records and frames as the compiled kernels do (before the
         step whose global index is due).  Returns the steps done; a failure leaves its code in
-        the simulation's ``status`` (as the kernels do)."""
+        the simulation's ``status`` (as the kernels do).  ``stages_out``: [0] force evaluations,
+        [3] rejected substeps, [4] the substep size to go on with (as the stiff scheme's)."""
         s = self.sim
         o = s.opt
         N = self.N
@@ -271,7 +272,11 @@ class Implicit:
                                   frame_every, fph, fpos, fquat, nfr, s.pos, s.quat)
             if K._failed(s.mon, wca_min, s.status, step):
                 return n
-            lev = max(getattr(self, "lev_last", lev_min) - 1, lev_min)
+            # the macro step starts at twice the last accepted substep (kept in stages_out[4], which
+            # advance() saves and restores, so the trajectory does not depend on the chunking)
+            h_last = s.stages_out[4]
+            lev = min(max(int(round(math.log2(dt / h_last))), 0), K.LMAX) if h_last > 0 else lev_min
+            lev = max(lev - 1, lev_min)
             u = 0
             fresh = True                  # F, T, arm, ws hold the state at the substep's start
             while u < full:
@@ -290,6 +295,7 @@ class Implicit:
                         s.status[0], s.status[1] = K.NONFINITE, step
                         return n
                     lev += 1
+                    s.stages_out[3] += 1
                     continue
                 dx = dd
                 if noisy:
@@ -313,14 +319,15 @@ class Implicit:
                     s.pos[:], s.quat[:] = saved
                     fresh = False
                     lev += 1
+                    s.stages_out[3] += 1
                     continue
                 u += full >> lev
                 if (dmax < 0.5 * o.disp_acc and amax < 0.5 * o.rot_acc and lev > lev_min
                         and ((u >> (K.LMAX - lev)) & 1) == 0):
                     lev -= 1
+                s.stages_out[4] = dt / (1 << lev)
                 if bad and K._failed(s.mon, wca_min, s.status, step):
                     return n + 1
-            self.lev_last = lev
             s.stages_out[1] = 1
         return nsteps
 
