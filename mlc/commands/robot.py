@@ -103,7 +103,7 @@ def run_fold(args) -> int:
     from mlc.errors import MlcError
     from mlc.io.outputs import Outputs
     from mlc.robot.draw import gif_bytes, render_frames
-    from mlc.robot.verify import ROBOT_DISP_ACC, ROBOT_DT, ROBOT_SCHEME, _shape_row, robot_meta
+    from mlc.robot.verify import ROBOT_DISP_ACC, ROBOT_DT, _shape_row, robot_meta
     from mlc.scene.io import load_scene
     from mlc.sim.drive import Drive
     from mlc.sim.integrator import SimOptions, Simulation
@@ -128,7 +128,9 @@ def run_fold(args) -> int:
     # default step: the verifier's, shortened to divide the frame interval (a frame ends a step)
     gap = args.time / (args.frames - 1)
     dt = gap / math.ceil(gap / ROBOT_DT - 1e-9) if args.dt is None else args.dt
-    sim = Simulation(scene, drives, SimOptions(scheme=ROBOT_SCHEME, kT=args.kT, seed=args.seed, dt=dt,
+    # the stiff scheme, not the verifier's implicit one: a fold's path and timing are what this shows, and
+    # the implicit scheme reaches the same end later (docs/robot.md 3.4, "Session 48")
+    sim = Simulation(scene, drives, SimOptions(scheme="stiff", kT=args.kT, seed=args.seed, dt=dt,
                                                disp_acc=ROBOT_DISP_ACC))
     res = sim.run(args.time, frames=args.frames)         # a progress bar on a terminal
     if res.interrupted:          # Ctrl-C: a fold cut short is not the row's shape; nothing is written
