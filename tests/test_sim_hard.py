@@ -18,7 +18,7 @@ def stiffer(scene: Scene, factor: float) -> Scene:
     return scene.check()
 
 
-@pytest.mark.parametrize("scheme", ["euler", "stiff"])
+@pytest.mark.parametrize("scheme", ["euler", "stiff", "implicit"])
 def test_bonds_100x_stiffer(scheme):
     soft = tongs_scene(3)
     hard = stiffer(tongs_scene(3), 100.0)
@@ -32,7 +32,7 @@ def test_bonds_100x_stiffer(scheme):
         assert res.stages >= 8               # the stage count follows sqrt(stiffness)
 
 
-@pytest.mark.parametrize("scheme", ["euler", "stiff"])
+@pytest.mark.parametrize("scheme", ["euler", "stiff", "implicit"])
 def test_high_temperature_no_false_alarm(scheme):
     from mlc.gates.library import gate_scene
 
