@@ -101,11 +101,9 @@ class Implicit:
         N = sim.N
         self.N = N
         self.sb = sim.site_body
-        nb = len(sim.arrays.bond_i)
-        self.zero = (sim.sp_rest0 == 0) & (sim.sp_rest1 == 0) & (sim.sp_tol == 0)
-        self.iz = np.nonzero(self.zero)[0]
-        self.isc = np.nonzero(~self.zero)[0]
-        self.nb = nb
+        zero = (sim.sp_rest0 == 0) & (sim.sp_rest1 == 0) & (sim.sp_tol == 0)     # zero-length bonds
+        self.iz = np.nonzero(zero)[0]
+        self.isc = np.nonzero(~zero)[0]
         self.D = np.empty(6 * N)
         self.D.reshape(N, 6)[:, :3] = sim.gamma
         self.D.reshape(N, 6)[:, 3:] = sim.gamma_r
@@ -113,7 +111,6 @@ class Implicit:
         self._a = np.zeros(6)
         self._b = np.zeros(6)
         self._z = np.zeros(6)
-        self.factorisations = 0
 
     # -- the positive part of the Hessian, as rows of G -------------------------------------
     def rows(self):
@@ -240,7 +237,6 @@ class Implicit:
         from mlc.verify.static import spd_lu
 
         A = (G.T @ G + sp.diags(self.D / h)).tocsc()
-        self.factorisations += 1
         return spd_lu(A)
 
     def advance(self, nsteps, dt, t_o, k_o, rec_every, rph, rec, frame_every, fph, fpos, fquat):
