@@ -13,7 +13,10 @@ are deterministic, so two integrators can be compared on one run each, to the en
   should reach.
 
     python benchmarks/robot_scheme_final.py OUT/robot.yaml [--rows 01 10 11] [--time 300]
-        [--every 25] [--dt 0.8] [--disp-acc 0.1] [--stretch-joint 0.25] [-o OUT.json]
+        [--every 25] [--dt 0.8] [--disp-acc 0.1] [--stretch-joint 0.25] [--no-fold-steps] [-o OUT.json]
+
+The implicit run takes the verifier's steps (:func:`mlc.robot.verify.fold_step`: ROBOT_FOLD_DT over
+the fold's first ROBOT_FOLD_TIME t0, session 49); ``--no-fold-steps``: ``--dt`` throughout, as before.
 
 ``--stretch-joint`` as in robot_euler_reference.py (at kT = 0 the joint bound is c_0 alone;
 the per-lever robot's u3_up hinge peaks at 0.166 sigma when its muscle switches).
@@ -57,7 +60,9 @@ def plot(res: dict, out: Path) -> None:
     for a in ax:
         a.set_xlabel("t (t0), from rest, kT = 0")
         a.legend(fontsize=7)
-    fig.suptitle(f"{res['bodies']}-body robot: folds at kT = 0, dt {res['dt']} t0, drift bound {res['disp_acc']} sigma")
+    fs = res.get("implicit_fold_steps")
+    fold = f" (implicit: {fs['dt']:g} over the first {fs['time_t0']:g} t0)" if fs else ""
+    fig.suptitle(f"{res['bodies']}-body robot: folds at kT = 0, dt {res['dt']} t0{fold}, drift bound {res['disp_acc']} sigma")
     fig.tight_layout()
     with atomic_path(out.with_suffix(".png")) as tmp:
         fig.savefig(tmp, dpi=110, format="png")
@@ -68,7 +73,7 @@ def main(argv=None) -> int:
     from gitstate import commit
     from robot_euler_reference import trajectory
 
-    from mlc.robot.verify import dof_angles, verify_robot_static
+    from mlc.robot.verify import ROBOT_FOLD_DT, ROBOT_FOLD_TIME, dof_angles, verify_robot_static
     from mlc.scene.io import load_scene
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("scene", nargs="?")
@@ -78,6 +83,9 @@ def main(argv=None) -> int:
     ap.add_argument("--dt", type=float, default=0.8)
     ap.add_argument("--disp-acc", type=float, default=0.1)
     ap.add_argument("--stretch-joint", type=float, default=0.25)
+    ap.add_argument("--no-fold-steps", action="store_true",
+                    help="the implicit run at --dt throughout, not the verifier's short steps over the fold's "
+                         "first ROBOT_FOLD_TIME t0 (mlc.robot.verify.fold_step; before session 49)")
     ap.add_argument("--plot", action="store_true", help="only redraw the PNG from the JSON")
     ap.add_argument("-o", "--out", type=Path, default=OUT)
     a = ap.parse_args(argv)
@@ -88,7 +96,9 @@ def main(argv=None) -> int:
         ap.error("give the robot scene (mlc compile ... --robot ... -o OUT: OUT/robot.yaml)")
     sc = load_scene(a.scene)
     res = {"scene": str(a.scene), "bodies": len(sc.bodies), "kT": 0.0, "time_t0": a.time, "dt": a.dt,
-           "disp_acc": a.disp_acc, "stretch_joint": a.stretch_joint, "rows": {}, "commit": commit(),
+           "disp_acc": a.disp_acc, "stretch_joint": a.stretch_joint,
+           "implicit_fold_steps": None if a.no_fold_steps else {"dt": ROBOT_FOLD_DT, "time_t0": ROBOT_FOLD_TIME},
+           "rows": {}, "commit": commit(),
            "machine": {"platform": platform.platform(), "cpus": os.cpu_count()}}
     for row in a.rows:
         c0 = time.process_time()
@@ -99,7 +109,8 @@ def main(argv=None) -> int:
                             "ok": bool(st.rows[0]["ok"]), "cpu_s": round(time.process_time() - c0, 1)}}
         runs = {}
         for scheme in ("stiff", "implicit"):
-            r = trajectory(sc, row, scheme, a.dt, a.time, a.every, disp_acc=a.disp_acc, stretch_joint=a.stretch_joint)
+            r = trajectory(sc, row, scheme, a.dt, a.time, a.every, not a.no_fold_steps, disp_acc=a.disp_acc,
+                           stretch_joint=a.stretch_joint)
             ang = np.asarray(r["ang"])
             runs[scheme] = ang
             entry[scheme] = {"cpu_s": round(r["cpu_s"], 1), "dof_angles_deg": np.round(ang, 4).tolist(),

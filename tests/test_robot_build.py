@@ -101,6 +101,47 @@ def test_dynamic_verify_folds_with_the_stiff_scheme_too(robot, capsys):
     assert rep["params"]["dt"] == ROBOT_DT and rep["params"]["disp_acc"] == ROBOT_DISP_ACC
 
 
+def test_the_implicit_scheme_takes_short_steps_while_a_fold_is_fast(robot, monkeypatch):
+    """run_fold steps the implicit scheme at ROBOT_FOLD_DT over a fold's first ROBOT_FOLD_TIME
+    t0 and at the run's dt after (and leaves that dt set); the stiff scheme at its dt throughout.
+    It pays: at kT = 0 the tiny robot's fold at 20 t0, against the stiff scheme's (which the
+    Euler reference confirms, benchmarks/robot_euler_reference.py), lags by tens of degrees at
+    ROBOT_DT throughout (26 deg, session 49, docs/robot.md 3.4) and by less than half of that
+    with the short steps."""
+    import mlc.robot.verify as V
+    from mlc.sim.drive import Drive
+    from mlc.sim.integrator import SimOptions, Simulation
+    sc = load_scene(robot / "out" / "robot.yaml")
+
+    def fold(scheme, t_end, kT=0.0):
+        # stretch_joint 0.25 as benchmarks/robot_euler_reference.py: at kT = 0 a joint's bound is c_0 alone
+        sim = Simulation(sc, {"a": Drive.constant(1)}, SimOptions(scheme=scheme, kT=kT, seed=0, dt=V.ROBOT_DT,
+                                                                   disp_acc=V.ROBOT_DISP_ACC, stretch_joint=0.25))
+        steps, run = [], sim.run
+
+        def spy(time, **kw):
+            steps.append((round(sim.t / sim.t_unit, 6), sim.dt))
+            return run(time, **kw)
+        sim.run = spy
+        V.run_fold(sim, sc, "1", kT, 100.0, t_end)          # tau 100 t0: windows of 5 t0, no relaxation before 300
+        assert sim.dt == V.ROBOT_DT
+        return np.array(V.dof_angles(sc, sim.pos, sim.quat)), steps
+
+    ref, steps = fold("stiff", 20.0)
+    assert [d for _, d in steps] == [V.ROBOT_DT] * 4
+    fine, steps = fold("implicit", 20.0)
+    assert V.ROBOT_FOLD_TIME >= 20.0 and [d for _, d in steps] == [V.ROBOT_FOLD_DT] * 4
+    monkeypatch.setattr(V, "ROBOT_FOLD_TIME", 0.0)
+    coarse, steps = fold("implicit", 20.0)
+    assert [d for _, d in steps] == [V.ROBOT_DT] * 4
+    lag_fine, lag_coarse = np.max(np.abs(fine - ref)), np.max(np.abs(coarse - ref))
+    assert lag_coarse > 10.0 and lag_fine < 0.5 * lag_coarse, (lag_fine, lag_coarse)
+    # the switch: short steps in the windows that start before ROBOT_FOLD_TIME, dt from there on
+    monkeypatch.setattr(V, "ROBOT_FOLD_TIME", 5.0)
+    _, steps = fold("implicit", 15.0, kT=1e-5)
+    assert steps == [(0.0, V.ROBOT_FOLD_DT), (5.0, V.ROBOT_DT), (10.0, V.ROBOT_DT)]
+
+
 def test_pictures_and_trajectory(robot, capsys):
     out = robot / "out"
     assert main(["robot", "shapes", str(out / "robot.yaml"), "-o", str(out / "shapes.png")]) == 0

@@ -47,6 +47,8 @@ ROBOT_SCHEME = "implicit"  # a robot's integrator: the linearly implicit scheme 
                           # 3.5 times less CPU than the stiff scheme on the per-lever Tetris robot's 12 runs,
                           # docs/robot.md 3.4); circuits keep the stiff scheme (mlc.verify.dynamic)
 ROBOT_DT = 0.8            # t0: the step for a robot's fold (the implicit and the stiff scheme) ...
+ROBOT_FOLD_DT = 0.2       # t0: the implicit scheme's step over a fold's first ROBOT_FOLD_TIME t0, its fast phase, where
+ROBOT_FOLD_TIME = 50.0    # a first-order step at ROBOT_DT lags (docs/robot.md 3.4, "Session 49"); ROBOT_DT after
 ROBOT_DISP_ACC = 0.1      # sigma: ... with this drift bound (SimOptions.disp_acc, default 0.01). Against dt 0.2 t0
                           # at 0.01 sigma: 1.67 times less CPU for the Tetris robot's 12 runs, all right, angles
                           # within 2.3 deg (docs/robot.md 3.4, benchmarks/results/robot_verify_speed.json);
@@ -146,6 +148,17 @@ def angles_relaxed(angles, block: float, tau: float, z: float = 3.0) -> tuple[bo
     return bool(np.all(drift <= tol)), {"drift_deg": drift.tolist(), "tol_deg": tol.tolist(), "noise_deg": s.tolist()}
 
 
+def fold_step(scheme: str, dt: float, t: float) -> float:
+    """The step (t0) a robot's fold takes at time ``t`` (t0) after its inputs switched, for a run at
+    step ``dt``: the implicit scheme takes at most ``ROBOT_FOLD_DT`` over the first ``ROBOT_FOLD_TIME``
+    (its first-order steps slow the modes about as fast as a step: at ROBOT_DT throughout, the
+    per-lever Tetris robot's row 11 lags the stiff scheme by 34 deg at 25 t0 and 5 deg at 100 t0;
+    docs/robot.md 3.4, "Session 49"); the other schemes, and later times, take ``dt``."""
+    if scheme == "implicit" and t < ROBOT_FOLD_TIME - 1e-9:
+        return min(dt, ROBOT_FOLD_DT)
+    return dt
+
+
 def run_fold(sim, scene: Scene, state: str, kT: float, tau: float, max_time: float, every: float | None = None,
              min_time: float | None = None, on_window=None):
     """Advance ``sim`` (inputs already set to row ``state``) in windows of max(0.05, tau/20)
@@ -154,6 +167,7 @@ def run_fold(sim, scene: Scene, state: str, kT: float, tau: float, max_time: flo
     :func:`mlc.verify.dynamic.plateau_tol`, and the DOF angles' block means within their
     own thermal noise (:func:`angles_relaxed`).  The DOF probes are not plateau-tested:
     the skeleton's soft joints fluctuate far more than the circuit's stiff pairs.
+    The step is :func:`fold_step`'s for the simulation's scheme and dt (restored at the end).
     ``min_time`` (t0): run at least this long (default ``TAU_FACTOR`` tau; the rest row 0).
     Returns (probe means over the plateau {name: sigma}, time t0, relaxed, test details,
     history of turns every ``every`` t0 or []).  ``on_window(t)``, if given, is called after
@@ -170,7 +184,9 @@ def run_fold(sim, scene: Scene, state: str, kT: float, tau: float, max_time: flo
     ends, means, hist, angs = [], {p: [] for p in names}, [], []
     t, relaxed, detail, first = 0.0, False, {}, 0
     next_rec = every if every else float("inf")
+    dt_run = sim.dt
     while True:
+        sim.dt = fold_step(sim.opt.scheme, dt_run, t)
         res = sim.run(window, record_interval=window / 10, quiet=True)
         t = res.time
         ends.append(t)
@@ -198,6 +214,7 @@ def run_fold(sim, scene: Scene, state: str, kT: float, tau: float, max_time: flo
                 break
         if t >= max_time - 1e-9:
             break
+    sim.dt = dt_run
     k = max(first, 0) if relaxed else max(len(ends) - MIN_WINDOWS, 0)
     return {p: float(np.mean(means[p][k:])) for p in names}, t, relaxed, detail, hist
 
@@ -335,7 +352,9 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
     dt = ROBOT_DT if (dt is None and scheme in ("stiff", "implicit")) else dt
     rep = Report(scene.name, "dynamic", params={"kT": kT, "seeds": int(seeds), "first_seed": int(first_seed),
                                                 "scheme": scheme, "tau": tau, "dt": dt, "robot": True,
-                                                "disp_acc": ROBOT_DISP_ACC if scheme in ("stiff", "implicit") else None})
+                                                "disp_acc": ROBOT_DISP_ACC if scheme in ("stiff", "implicit") else None,
+                                                "fold_dt": fold_step(scheme, dt, 0.0) if dt is not None else None,
+                                                "fold_time": ROBOT_FOLD_TIME if scheme == "implicit" else 0.0})
     poses = {}
     total, done = len(states) * int(seeds), 0
     bar = Progress(f"dynamic check of {scene.name}", total=total, show=None if progress is None else False)
@@ -407,6 +426,18 @@ def verify_robot(scene: Scene, dynamic: bool = False, kT: float = 1e-5, seeds: i
         return verify_robot_static(scene, rows, progress=lambda done, total: bar.update(done), jobs=jobs)
 
 
+def _steps_text(p: dict) -> str:
+    """', implicit scheme, dt 0.8 t0 (0.2 over the first 50 t0)' from a dynamic report's params."""
+    if not p.get("scheme"):
+        return ""
+    out = f", {p['scheme']} scheme"
+    if p.get("dt") is not None:
+        out += f", dt {p['dt']:g} t0"
+        if p.get("fold_time") and p.get("fold_dt") is not None and p["fold_dt"] < p["dt"]:
+            out += f" ({p['fold_dt']:g} over the first {p['fold_time']:g} t0)"
+    return out
+
+
 def format_robot_report(rep: Report) -> str:
     """The probe table of :func:`mlc.verify.circuit.format_report` (circuit outputs and DOF
     lengths), then one line per row: shape read vs expected, turns (deg) and the largest
@@ -415,7 +446,8 @@ def format_robot_report(rep: Report) -> str:
 
     table = [ln for ln in format_report(rep).splitlines() if not ln.startswith(("all ", "WRONG", "WARNING: row"))]
     lines = table + [f"{rep.scene}: {rep.mode} verification of the skeleton, {len(rep.rows)} rows"
-             + (f", {rep.params.get('seeds')} seeds, kT = {rep.params.get('kT')}" if rep.mode == "dynamic" else "")]
+             + (f", {rep.params.get('seeds')} seeds, kT = {rep.params.get('kT')}" + _steps_text(rep.params)
+                if rep.mode == "dynamic" else "")]
     for r in rep.rows:
         turns = " ".join(f"{t:+7.2f}" for t in r["turns_read"])
         tail = (f"stretch {r['joint_stretch']:.1e}" if rep.mode == "static"
@@ -462,4 +494,4 @@ def format_any(rep: Report) -> str:
     return format_report(rep)
 
 
-__all__ = ["FOLD_TIME", "ROBOT_DISP_ACC", "ROBOT_DT", "ROBOT_TAU", "angles_relaxed", "dof_angles", "format_any", "run_fold", "format_robot_report", "read_shape", "robot_meta", "verify_robot_dynamic", "verify_robot_static"]
+__all__ = ["FOLD_TIME", "ROBOT_DISP_ACC", "ROBOT_DT", "ROBOT_FOLD_DT", "ROBOT_FOLD_TIME", "fold_step", "ROBOT_TAU", "angles_relaxed", "dof_angles", "format_any", "run_fold", "format_robot_report", "read_shape", "robot_meta", "verify_robot_dynamic", "verify_robot_static"]
