@@ -21,7 +21,9 @@ default with the error bar sqrt(sd^2/n + sd_ref^2/n) of the two seed spreads.
         [--builds default per_lever] [--ref default]
     python benchmarks/robot_muscle_per_lever.py --plot benchmarks/results/robot_muscle_per_lever.json
 
-Writes benchmarks/results/robot_muscle_per_lever.json (merged run by run, so it resumes) and .png.
+Writes benchmarks/results/robot_muscle_per_lever.json (merged run by run, so it resumes; each run
+records the commit it ran at) and .png.  The implicit builds take the verifier's steps
+(:func:`mlc.robot.verify.fold_step`: short ones over the fold's first ROBOT_FOLD_TIME t0, session 49).
 Units: t0 (times), degrees (angles), CPU seconds.
 """
 from __future__ import annotations
@@ -171,7 +173,7 @@ def main(argv=None) -> int:
     from gitstate import commit
     from robot_dynamic import run_one
 
-    from mlc.robot.verify import ROBOT_DISP_ACC, ROBOT_DT, ROBOT_TAU
+    from mlc.robot.verify import ROBOT_DISP_ACC, ROBOT_DT, ROBOT_FOLD_DT, ROBOT_FOLD_TIME, ROBOT_TAU
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--rows", nargs="*", default=["00", "01", "10", "11"])
     ap.add_argument("--seeds", nargs="*", type=int, default=[0, 1, 2])
@@ -203,10 +205,11 @@ def main(argv=None) -> int:
                 scheme = SCHEMES.get(name, "stiff")
                 r = run_one(sc, row, seed, ROBOT_DT, tau, 1800.0, a.kT, scheme=scheme, disp_acc=ROBOT_DISP_ACC)
                 r.pop("history", None)
-                r.update(build=name, bodies=len(sc.bodies), tau=tau, scheme=scheme)
+                r.update(build=name, bodies=len(sc.bodies), tau=tau, scheme=scheme, commit=commit())
                 data["runs"].append(r)
                 data.update(commit=commit(), machine=platform.machine(), cpus=os.cpu_count(),
-                            settings={"dt": ROBOT_DT, "disp_acc": ROBOT_DISP_ACC, "tau": ROBOT_TAU, "kT": a.kT},
+                            settings={"dt": ROBOT_DT, "disp_acc": ROBOT_DISP_ACC, "tau": ROBOT_TAU, "kT": a.kT,
+                                      "implicit_fold_dt": ROBOT_FOLD_DT, "implicit_fold_time": ROBOT_FOLD_TIME},
                             summary=compare(data["runs"], a.ref))
                 with atomic_path(out) as tmpf:
                     Path(tmpf).write_text(json.dumps(data, indent=1))
