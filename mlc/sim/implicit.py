@@ -22,15 +22,26 @@ short calculation: ``A V A = (D/h) V (D/h) + C`` with ``A = D/h + H``, ``V = kT 
 ``C = kT (2 D/h + H)``); ``xi_1`` is the Brownian increment that the stiff scheme uses (the
 same path for the same seed), ``xi_2`` fresh normals, one per row of ``G``.
 
-Without rotational noise (the default: rotations are deterministic) there is no such
-correction: ``b`` is the translational Brownian term alone, and a harmonic mode's stationary
-variance is kT/lambda / (1 + h lambda/(2 gamma)), exact for the slow modes and smaller for
-the stiff ones (a joint's thermal stretch; the Euler scheme's errs the other way, 1/(1 -
-h lambda/2)).  The correction cannot be kept for the translations alone: ``G``'s rows couple
-a body's translation and rotation (a bond at an arm), and their translational part has a
-component of order sqrt(k) along the soft modes (the body turning about the bonded site),
-which such a term would shake with a force sqrt(kT k) per step (tried: the per-lever Tetris
-robot's stops were torn open within 170 t0).
+Without rotational noise (the default, the paper's model: a body turns only as the bonds at
+its sites turn it) the continuous dynamics' stationary state is not Boltzmann's: a mode whose
+mobility is part rotational gets noise only through its translational part.  For one row ``g``
+of ``G`` taken as a mode of its own (a bond at arms ``a``: ``g = (u, a x u)`` on each body) the
+continuous variance is ``f kT/k``, ``f = g_t^T D_t^-1 g_t / g^T D^-1 g`` its share of
+translational mobility, and the same calculation asks for ``C = H V H = f kT g g^T`` on top of
+the translational Brownian term.  So each row's fresh normal is scaled by ``sqrt(f)``:
+
+    b = sqrt(2 kT) D_t^1/2 h^-1/2 xi_1 + sqrt(kT) G^T (f^1/2 * xi_2),
+
+exact for a row that is a mode by itself (a bond between centres, f = 1, gets kT/k; one at
+arms of 0.5 sigma, f = 0.8, gets 0.8 kT/k, as Euler at a small step does:
+``tests/test_sim_implicit.py``), an approximation where rows couple.  Its covariance is
+below ``kT H+``, the rotational-noise case's, so it does not shake the soft modes.  Without
+it (before session 49) a mode's variance was kT/lambda / (1 + h lambda/2): the locked joints
+of the per-lever Tetris robot fluctuated 3-5 times less than with Euler (in std; docs/robot.md
+3.4, "Session 49").  Keeping the correction for the translations alone, ``G``'s translational
+columns, is wrong: they have a component of order sqrt(k) along the soft modes (the body
+turning about the bonded site), which such a term shakes with a force sqrt(kT k) per step
+(tried in session 48: the per-lever Tetris robot's stops were torn open within 170 t0).
 
 ``H+`` is built as ``G^T G`` from rows of ``G`` (one sparse row per row):
 
@@ -107,6 +118,9 @@ class Implicit:
         self.D = np.empty(6 * N)
         self.D.reshape(N, 6)[:, :3] = sim.gamma
         self.D.reshape(N, 6)[:, 3:] = sim.gamma_r
+        self.inv_D = 1.0 / self.D
+        self.inv_Dt = self.inv_D.copy()          # translational mobilities only
+        self.inv_Dt.reshape(N, 6)[:, 3:] = 0.0
         self.incr = np.zeros((N, 6))
         self._a = np.zeros(6)
         self._b = np.zeros(6)
@@ -306,12 +320,18 @@ class Implicit:
                     k = u >> (K.LMAX - lev)
                     brownian_increments(seed, step, k, lev, N, rot, self.incr, self._a, self._b, self._z)
                     b = (self.D.reshape(N, 6) / hs) * amp[None, :] * self.incr
-                    if rot and G.shape[0]:
+                    if G.shape[0]:
                         if len(xi2) < G.shape[0]:
                             xi2 = np.zeros(G.shape[0])
                         normals(seed2, np.uint64(step) * np.uint64(2147483648) + np.uint64((1 << lev) + k),
                                 G.shape[0], xi2)
-                        b = b + (math.sqrt(kT) * (G.T @ xi2[:G.shape[0]])).reshape(N, 6)
+                        x2 = xi2[:G.shape[0]]
+                        if not rot:
+                            # each row's share of translational mobility (module doc: the noise of a
+                            # row's mode is translational only, so its exact variance is that share)
+                            G2 = G.multiply(G)
+                            x2 = x2 * np.sqrt((G2 @ self.inv_Dt) / np.maximum(G2 @ self.inv_D, 1e-300))
+                        b = b + (math.sqrt(kT) * (G.T @ x2)).reshape(N, 6)
                     dx = dd + lu.solve(b.ravel()).reshape(N, 6)
                 saved = (s.pos.copy(), s.quat.copy())
                 _apply(s.pos, s.quat, dx)

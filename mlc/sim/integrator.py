@@ -603,8 +603,10 @@ class Simulation:
             if self.opt.rot_noise:
                 return {"scheme": "implicit", "h_rho": hr, "ratio_min": 1.0, "ratio_max": 1.0,
                         "note": "exact for every linear mode (noise covariance 2 kT (D/h + H+/2))"}
-            return {"scheme": "implicit", "h_rho": hr, "ratio_min": 1.0 / (1.0 + 0.5 * hr), "ratio_max": 1.0,
-                    "note": "stiffest mode 1/(1 + h lambda/2) (translational noise only: mlc/sim/implicit.py)"}
+            return {"scheme": "implicit", "h_rho": hr, "ratio_min": 1.0, "ratio_max": 1.0,
+                    "note": "exact for a bond that is a mode by itself (translational noise only: each row's "
+                            "correction scaled by its translational share, mlc/sim/implicit.py); approximate "
+                            "where bonds couple"}
         if self.opt.fluct:
             out = {"scheme": "stiff-fluct", "h_rho": hr, "ratio_min": 1.0, "ratio_max": 1.0,
                    "stage_factor": self.fluct_stage_factor(dt),
