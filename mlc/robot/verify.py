@@ -185,36 +185,38 @@ def run_fold(sim, scene: Scene, state: str, kT: float, tau: float, max_time: flo
     t, relaxed, detail, first = 0.0, False, {}, 0
     next_rec = every if every else float("inf")
     dt_run = sim.dt
-    while True:
-        sim.dt = fold_step(sim.opt.scheme, dt_run, t)
-        res = sim.run(window, record_interval=window / 10, quiet=True)
-        t = res.time
-        ends.append(t)
-        if on_window is not None:
-            on_window(t)
-        angs.append(dof_angles(scene, sim.pos, sim.quat))
-        for p in names:
-            v = res.probes[p]
-            means[p].append(float(np.mean(v[1:] if len(v) > 1 else v)))
-        if t >= next_rec - 1e-9:
-            sh = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy())
-            hist.append({"t": round(t, 3), "turns": sh["turns_read"], "shape": sh["shape_read"]})
-            next_rec += every
-        first = len(ends) - MIN_WINDOWS
-        cut = (1.0 - PLATEAU) * t
-        while first > 0 and ends[first - 1] - window >= cut - 1e-12:
-            first -= 1
-        if first >= 0 and t >= t_min - 1e-12:
-            block = (len(ends) - first) * window / MIN_WINDOWS
-            circ_ok = all(np.ptp([np.mean(b) for b in np.array_split(means[p][first:], MIN_WINDOWS)])
-                          < plateau_tol(kT, sim.k0, 0.0, tau, block) for p in circ)
-            ang_ok, detail = angles_relaxed(angs[first:], block, tau)
-            if circ_ok and ang_ok:
-                relaxed = True
+    try:
+        while True:
+            sim.dt = fold_step(sim.opt.scheme, dt_run, t)
+            res = sim.run(window, record_interval=window / 10, quiet=True)
+            t = res.time
+            ends.append(t)
+            if on_window is not None:
+                on_window(t)
+            angs.append(dof_angles(scene, sim.pos, sim.quat))
+            for p in names:
+                v = res.probes[p]
+                means[p].append(float(np.mean(v[1:] if len(v) > 1 else v)))
+            if t >= next_rec - 1e-9:
+                sh = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy())
+                hist.append({"t": round(t, 3), "turns": sh["turns_read"], "shape": sh["shape_read"]})
+                next_rec += every
+            first = len(ends) - MIN_WINDOWS
+            cut = (1.0 - PLATEAU) * t
+            while first > 0 and ends[first - 1] - window >= cut - 1e-12:
+                first -= 1
+            if first >= 0 and t >= t_min - 1e-12:
+                block = (len(ends) - first) * window / MIN_WINDOWS
+                circ_ok = all(np.ptp([np.mean(b) for b in np.array_split(means[p][first:], MIN_WINDOWS)])
+                              < plateau_tol(kT, sim.k0, 0.0, tau, block) for p in circ)
+                ang_ok, detail = angles_relaxed(angs[first:], block, tau)
+                if circ_ok and ang_ok:
+                    relaxed = True
+                    break
+            if t >= max_time - 1e-9:
                 break
-        if t >= max_time - 1e-9:
-            break
-    sim.dt = dt_run
+    finally:
+        sim.dt = dt_run
     k = max(first, 0) if relaxed else max(len(ends) - MIN_WINDOWS, 0)
     return {p: float(np.mean(means[p][k:])) for p in names}, t, relaxed, detail, hist
 
