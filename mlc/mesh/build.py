@@ -68,6 +68,11 @@ _TOL = 1e-3  # sigma: tolerance for "same point / same line"
 REUSE_MIN_PARTS = 64
 APART_GAP = True      # large assemblies: min_gap of pairs proven farther apart than the search skips manifold3d
 GUARD_PAD = 0.005  # mm: protected material grown by this much for the final trims of large assemblies
+#: branch junction: a page counts as stacked on the source's hinge line (the compound junction's
+#: fin up that line into its own end knuckle) only when its hinge is within this cosine of the line;
+#: a chain's next layer, bent at the junction, keeps 0.5 (_compound's o_cos)
+O_COS = 0.95
+SPLIT_TWIST = True    # compound junctions: the joint part posed with the twist shared by its pins (_split_twist)
 
 
 # --------------------------------------------------------------------------- primitives
@@ -306,7 +311,11 @@ class Assembly:
             To = out[u.bodies[1]]
             uu = Tc[:3, :3] @ u.axes[0]
             vv = To[:3, :3] @ u.axes[1]
-            F1 = _ortho(uu, vv)
+            if SPLIT_TWIST and u.host is not None:
+                # compound junction (circuit chains): the twist is shared by the two pins
+                F1 = _split_twist(uu, vv, max(abs(x) for x in u.layouts[0].pin), max(abs(x) for x in u.layouts[1].pin))
+            else:
+                F1 = _ortho(uu, vv)
             F0 = _ortho(u.axes[0], u.axes[1])
             # the hub sits where the two bodies' copies of the joint point are (their mean)
             c = 0.5 * (Tc[:3, :3] @ u.center + Tc[:3, 3] + To[:3, :3] @ u.center + To[:3, 3])
@@ -321,6 +330,32 @@ def _ortho(u, v) -> np.ndarray:
     u = u / np.linalg.norm(u)
     v = v - np.dot(v, u) * u
     v = v / np.linalg.norm(v)
+    return np.column_stack([u, v, np.cross(u, v)])
+
+
+def _split_twist(uu, vv, Lu, Lv) -> np.ndarray:
+    """The posed frame (u, v, u x v) of a universal joint part whose two bodies hold its pins
+    along ``uu`` and ``vv`` (unit), when these are not square: the scene's universal joint is
+    a ball joint, and a circuit chain's statics twist its junctions by up to about 13 degrees
+    (session 49), which a printed cardan cannot follow.  The part floats in the clearance of its
+    holes, so it is posed where both pins fit best: the twist (90 degrees less the angle between
+    ``uu`` and ``vv``) is shared between the two pins in inverse proportion to their reach into
+    their bodies' holes (``Lu``, ``Lv``, mm from the joint point), so that both pin ends move
+    sideways in their holes by the same distance.  :func:`_ortho` kept ``uu`` and turned the
+    other pin by the whole twist: its ends met the walls of their holes from 4.8 degrees on
+    (0.2 mm of clearance over 2.4 mm of pin), where sharing takes 7.6 degrees."""
+    uu = uu / np.linalg.norm(uu)
+    e2 = vv - np.dot(vv, uu) * uu
+    n2 = float(np.linalg.norm(e2))
+    if n2 < 1e-12:
+        return _ortho(uu, vv)
+    e2 /= n2
+    alpha = float(np.arctan2(n2, np.dot(vv, uu)))       # the angle between the pins
+    tw = 0.5 * np.pi - alpha
+    du = tw * Lv / (Lu + Lv) if Lu + Lv > 0 else 0.5 * tw
+    dv = tw - du
+    u = np.cos(du) * uu - np.sin(du) * e2
+    v = np.cos(alpha + dv) * uu + np.sin(alpha + dv) * e2
     return np.column_stack([u, v, np.cross(u, v)])
 
 
@@ -710,6 +745,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
     soft: dict[str, mf.Manifold] = {}
     fat_guard: dict[str, tuple] = {}     # reuse only: (hard, soft or None) guards grown by GUARD_PAD
     cone_cores: dict[str, mf.Manifold] = {}  # pin: cone: what the trims never touch (knuckles, cones, rings)
+    pages = {uj.bodies[1] for uj in ujoints if uj.layouts[1].holes is not None}   # branch junctions' pages
     for b in scene.bodies:
         bn = b.name
         # large assemblies: every primitive and boolean of the body in its own frame (its first
@@ -717,8 +753,10 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         # moved (the same triangles wherever they are) and share every cached exact result
         Fb = _frame(slabs[bn][0].center, slabs[bn][0].R) if reuse and LOCAL_BUILD and slabs.get(bn) else None
         _LOCAL[0] = None if Fb is None else np.linalg.inv(Fb)
-        solid = union([box(sb.center, sb.R, sb.size) for sb in shapes[bn]] + _bend_fills(slabs[bn]))
         my_axes = [ax for ax in axes if bn in ax.bodies]
+        # a branch page's arm, which ends on the face of its own end knuckle, is carried into it
+        links = _rod_links(shapes[bn], my_axes, bn, t, s) if bn in pages else []
+        solid = union([box(sb.center, sb.R, sb.size) for sb in shapes[bn] + links] + _bend_fills(slabs[bn]))
         my_uj = [(uj, 0 if uj.bodies[0] == bn else 1) for uj in ujoints if bn in uj.bodies]
         # 1. clear the other bodies' knuckles
         # (a mechanism of its own: a cut that ends at the span's end runs on past what is left of
@@ -1595,7 +1633,7 @@ def _host_axis(bn, axes, center, s, g):
     return None
 
 
-def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, kmin, others=None):
+def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, kmin, others=None, o_cos=0.5):
     """A compound junction on hinge axis ``ax``: the universal joint part holds the pin of the
     whole knuckle stack and has one knuckle in it (next to the end knuckle of the pin owner,
     on the joint's side, so the stack is captive), a ball hub at the joint point with a collar
@@ -1606,7 +1644,10 @@ def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, 
     Relative to the bodies of ``ax`` the joint turns about the axis only (collar and stack
     stay coaxial); relative to ``other`` it turns about the second pin only, and the ball is
     the same in every such turn, so it keeps its distance (>= clearance) from ``other``'s own
-    knuckles on the same line (the next layer's hinge).  Returns None when the ball would be
+    knuckles on the same line (the next layer's hinge: a hinge of ``other``, or of one of
+    ``others``, through the joint point within ``o_cos`` (cosine) of the axis; a branch page
+    whose hinge leaves the joint point 30 degrees off the axis is not one, session 49).
+    Returns None when the ball would be
     thinner than the pin plus a minimum wall."""
     c, g = prof.clearance, prof.knuckle_gap
     a = float(np.dot(center - ax.origin, ax.direction))
@@ -1630,7 +1671,7 @@ def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, 
     o_axis = None
     o_body = None
     for bx in axes:
-        if any(o in bx.bodies for o in (others or [other])) and abs(float(np.dot(bx.direction, ax.direction))) > 0.5:
+        if any(o in bx.bodies for o in (others or [other])) and abs(float(np.dot(bx.direction, ax.direction))) > o_cos:
             rel = center - bx.origin
             b = float(np.dot(rel, bx.direction))
             if np.linalg.norm(rel - b * bx.direction) < _TOL * s and abs(b) > bx.span / 2:
@@ -1702,7 +1743,7 @@ def _branch(members, S, joints, scene, bodies, axes, slabs, s, prof, R, r_pin, r
     hx = _host_axis(S, axes, center, s, g)
     if hx is None or len(set(pages)) != len(pages):
         return None
-    comp = _compound(hx, center, S, pages[0], axes, s, prof, R, r_pin, kmin, others=pages)
+    comp = _compound(hx, center, S, pages[0], axes, s, prof, R, r_pin, kmin, others=pages, o_cos=O_COS)
     if comp is None:
         return None
     u = comp["u"]
@@ -2942,6 +2983,51 @@ def _is_rod(sb: SlabBox, t) -> bool:
     """A slab box with two thin sides (at most ``2 t`` mm), a rod rather than a plate: a page's
     arm, or the post that carries a circuit chain's end joint under a gate's input lever."""
     return sorted(sb.size)[1] <= 2 * t
+
+
+def _rod_links(sbs, my_axes, bn, t, s) -> list:
+    """Boxes that carry a rod (:func:`_is_rod`: a branch page's arm) lying on the line of one of
+    body ``bn``'s hinges on into the knuckle of ``bn`` whose end face it ends on, half the
+    knuckle's length deep (inside the knuckle: no material is added outside it).
+
+    A page's arm runs along its own hinge's line from the joint point to the hinge's end
+    knuckle (:func:`_own_lines`) and stops exactly on that knuckle's end face, where the slab
+    and the pin stop too: the arm met the rest of its body face to face only.  Built in the
+    world the coincident faces merged; built in the body's own frame (a large assembly, session
+    9) their placements differ by rounding (3.5e-13 mm), and the union left the arm, its yoke
+    knuckle and plate a separate piece (session 49: the Tetris circuit's page ``w_y_p1``'s
+    slabs ``AB`` and ``CD`` in 2 pieces each, ``part_count``)."""
+    out = []
+    tol = _TOL * s
+    for sb in sbs:
+        if not _is_rod(sb, t):
+            continue
+        ia = int(np.argmax(sb.size))
+        d = sb.R[:, ia]
+        others = [i for i in range(3) if i != ia]
+        for ax in my_axes:
+            if abs(abs(float(np.dot(d, ax.direction))) - 1) > 1e-6:
+                continue
+            rel = sb.center - ax.origin
+            a = float(np.dot(rel, ax.direction))
+            if np.linalg.norm(rel - a * ax.direction) > tol:
+                continue
+            if float(np.hypot(*(0.5 * sb.size[others]))) >= ax.R:
+                continue          # not inside the knuckle: a link would add material outside it
+            lo, hi = a - 0.5 * sb.size[ia], a + 0.5 * sb.size[ia]
+            for a0, a1 in ax.intervals.get(bn, []):
+                k = a1 - a0
+                if lo < a0 and abs(hi - a0) <= tol:          # ends on the knuckle's lower face
+                    e0, e1 = max(lo, hi - t), a0 + k / 2
+                elif hi > a1 and abs(lo - a1) <= tol:        # ... on its upper face
+                    e0, e1 = a1 - k / 2, min(hi, lo + t)
+                else:
+                    continue
+                size = sb.size.copy()
+                size[ia] = e1 - e0
+                out.append(SlabBox(ax.origin + ax.direction * (0.5 * (e0 + e1)) + (rel - a * ax.direction), sb.R,
+                                   size, sb.normal_axis, sb.offset))
+    return out
 
 
 def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False, rod_reach=None, fin_min=None):
