@@ -17,7 +17,7 @@ def tetris_y_branch():
     # the Tetris circuit's branch of input y: its source half unit and the 4 pages on it (two
     # leave along the joint's second pin, two diagonally), at rest, without muscles
     from mlc import pipeline
-    from tests.helpers import ROOT
+    from helpers import ROOT
     sc = pipeline.build(pipeline.compile_spec(pipeline.load(str(ROOT / "examples" / "tetris.tt"), None))).circuit.scene
     keep = {b.name for b in sc.bodies if b.name.startswith(("src_y_", "w_y_p"))}
     assert len(keep) == 20
