@@ -172,7 +172,7 @@ def run_fold(sim, scene: Scene, state: str, kT: float, tau: float, max_time: flo
     Returns (probe means over the plateau {name: sigma}, time t0, relaxed, test details,
     history of turns every ``every`` t0 or []).  ``on_window(t)``, if given, is called after
     every window with the time run so far (t0)."""
-    from mlc.verify.dynamic import MIN_WINDOWS, PLATEAU, TAU_FACTOR, plateau_tol
+    from mlc.verify.dynamic import MIN_WINDOWS, TAU_FACTOR, plateau_start, plateau_tol
 
     rm = robot_meta(scene)
     names = [p.name for p in scene.probes]
@@ -201,10 +201,7 @@ def run_fold(sim, scene: Scene, state: str, kT: float, tau: float, max_time: flo
                 sh = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy())
                 hist.append({"t": round(t, 3), "turns": sh["turns_read"], "shape": sh["shape_read"]})
                 next_rec += every
-            first = len(ends) - MIN_WINDOWS
-            cut = (1.0 - PLATEAU) * t
-            while first > 0 and ends[first - 1] - window >= cut - 1e-12:
-                first -= 1
+            first = plateau_start(ends, window, t)
             if first >= 0 and t >= t_min - 1e-12:
                 block = (len(ends) - first) * window / MIN_WINDOWS
                 circ_ok = all(np.ptp([np.mean(b) for b in np.array_split(means[p][first:], MIN_WINDOWS)])

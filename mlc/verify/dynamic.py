@@ -279,6 +279,17 @@ def plateau_tol(kT: float, k0: float = 1.0, sd: float = 0.0, tau: float = 0.0, b
     return base + 3.0 * math.sqrt(2.0) * sd * math.sqrt(min(1.0, 2.0 * tau / max(block, 1e-300)))
 
 
+def plateau_start(ends: list, window: float, t: float) -> int:
+    """The index of the first window on the plateau of a run at time ``t`` (t0) whose windows of
+    ``window`` t0 ended at ``ends``: the windows that started in the last ``PLATEAU`` of the run,
+    at least ``MIN_WINDOWS`` of them (negative while fewer windows have run)."""
+    first = len(ends) - MIN_WINDOWS
+    cut = (1.0 - PLATEAU) * t
+    while first > 0 and ends[first - 1] - window >= cut - 1e-12:
+        first -= 1
+    return first
+
+
 def relax_all(sim: Simulation, probes: list[str], kT: float, t_min: float = 0.0, window: float = WINDOW,
               max_time: float = MAX_TIME, sd: dict | None = None, tau: float = 0.0, on_window=None):
     """Run ``sim`` until every probe in ``probes`` has relaxed: time >= ``t_min`` t0, and the
@@ -302,11 +313,7 @@ def relax_all(sim: Simulation, probes: list[str], kT: float, t_min: float = 0.0,
         for p in probes:
             v = res.probes[p]
             means[p].append(float(np.mean(v[1:] if len(v) > 1 else v)))
-        # the plateau: windows that started in the last third of the run
-        first = len(ends) - MIN_WINDOWS
-        cut = (1.0 - PLATEAU) * t
-        while first > 0 and ends[first - 1] - window >= cut - 1e-12:
-            first -= 1
+        first = plateau_start(ends, window, t)          # the plateau: the last third of the run
         if first >= 0 and t >= t_min - 1e-12:
             block = (len(ends) - first) * window / MIN_WINDOWS
             flat = all(np.ptp([np.mean(b) for b in np.array_split(means[p][first:], MIN_WINDOWS)])
