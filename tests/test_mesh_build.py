@@ -185,3 +185,125 @@ def test_split_twist_shares_the_twist_in_inverse_proportion_to_the_pins_reach():
     # square pins: the frame of before
     uu, vv = np.array([0.0, 0, 1]), np.array([0.0, 1, 0])
     assert np.allclose(_split_twist(uu, vv, 4.0, 2.4), _ortho(uu, vv))
+
+
+# -- trim radii that split a body (session 50) ------------------------------------------------
+# The Tetris robot's coupling chains: where the skeleton bends a half unit, the other bodies'
+# slabs pass close to a slab far from its joints, and the sampled trim radii of its hinge (3.5 mm)
+# and universal joint (4.9 mm) reached across its whole length (4.5 mm): only its knuckles were
+# left, 4 or 5 pieces (``part_count``).  Here the smallest such case: a slab Y between two hinges,
+# owning the first (C) and not the second (D), with its neighbours folded back onto it about
+# each hinge (178 degrees): both trim radii are capped at 3.8 mm, and Y's slab (4.5 mm) is cut
+# through between its own knuckles at C and at D.
+
+def _three_slabs():
+    from mlc.scene.model import Body, Bond, Box
+    L, W, T = 0.9, 0.5, 0.01
+    bodies = [Body(n, np.array([x, 0.0, 0.0]), np.array([1.0, 0, 0, 0]), [Box(np.array([L, W, T]))],
+                   {s: np.array([sx, sy, 0.0]) for s, sx, sy in sites})
+              for n, x, sites in (("X", L, [("c0", -L / 2, -W / 2), ("c1", -L / 2, W / 2)]),
+                                  ("Y", 0.0, [("c0", L / 2, -W / 2), ("c1", L / 2, W / 2),
+                                              ("d0", -L / 2, -W / 2), ("d1", -L / 2, W / 2)]),
+                                  ("Z", -L, [("d0", L / 2, -W / 2), ("d1", L / 2, W / 2)]))]
+    bonds = [Bond("hc0", "Y.c0", "X.c0", kind="hinge", joint="hC"),
+             Bond("hc1", "Y.c1", "X.c1", kind="hinge", joint="hC"),
+             Bond("hd0", "Z.d0", "Y.d0", kind="hinge", joint="hD"),
+             Bond("hd1", "Z.d1", "Y.d1", kind="hinge", joint="hD")]
+    sc = Scene(name="three_slabs", bodies=bodies, bonds=bonds)
+    pos = np.array([b.position for b in bodies], float)
+    quat = np.array([b.orientation for b in bodies], float)
+    for i, c, deg in ((0, L / 2, 178.0), (2, -L / 2, -178.0)):
+        th = np.radians(deg)
+        Ry = np.array([[np.cos(th), 0, np.sin(th)], [0, 1, 0], [-np.sin(th), 0, np.cos(th)]])
+        ctr = np.array([c, 0.0, 0.0])
+        pos[i] = ctr + Ry @ (pos[i] - ctr)
+        quat[i] = [np.cos(th / 2), 0.0, np.sin(th / 2), 0.0]
+    return sc, {"folded": (pos, quat)}
+
+
+def test_a_slab_whose_trim_radii_would_cut_it_through_prints_in_one_piece():
+    sc, poses = _three_slabs()
+    asm = build_assembly(sc, load_profile("mjp"), poses, reuse=True)
+    # the sampled radii reach across the slab (capped at R + clearance + sigma / 2)
+    assert [(ax.pin_owner, round(ax.rho, 3)) for ax in asm.axes] == [("Y", 3.8), ("Z", 3.8)]
+    pieces = {p.name: len(p.solid.decompose()) for p in asm.parts}
+    assert pieces == {"X": 1, "Y": 1, "Z": 1}
+    assert any(n.startswith("Y: trim radii of its joints shrunk") for n in asm.notes)
+    # Y keeps its knuckles (all three) and more slab than the two pieces had (7.689 mm^3)
+    Y = asm.part("Y").solid
+    for ax in asm.axes:
+        for a0, a1 in ax.intervals["Y"]:
+            k = (cylinder(ax.origin, ax.direction, a0 + 0.01, a1 - 0.01, ax.R - 0.01, 32)
+                 - cylinder(ax.origin, ax.direction, a0, a1, ax.r_hole + 0.01, 32))     # its ring
+            assert (k - Y).volume() < 1e-3 * k.volume(), ax.name
+    assert Y.volume() > 7.7
+
+
+def test_trim_radii_are_shrunk_by_bisection_only_for_a_body_that_splits():
+    from mlc.mesh.build import UNSPLIT_STEPS, _toward, _Unsplit
+    assert _toward(1.3, 3.8, 1.0) == 3.8 and _toward(1.3, 3.8, 0.0) == 1.3 and _toward(1.3, 1.0, 0.5) == 1.0
+    whole = _Unsplit(True)
+    assert whole.done(1) and whole.f == 1.0                 # whole at the sampled radii: as before
+    off = _Unsplit(False)
+    assert off.done(3) and off.f == 1.0                     # a mechanism of its own: as before
+    never = _Unsplit(True)                                  # split even at the least radii: as before
+    assert not never.done(2) and never.f == 0.0
+    assert not never.done(2) and never.f == 1.0 and never.done(2)
+    cut = _Unsplit(True)                                    # whole up to f = 0.3: the largest f found
+    fs = []
+    while not cut.done(1 if cut.f <= 0.3 else 2):
+        fs.append(cut.f)
+    assert len(fs) <= UNSPLIT_STEPS + 2 and 0.3 - 1.0 / 2 ** (UNSPLIT_STEPS - 1) <= cut.f <= 0.3
+
+
+# -- a hinge across its plates (session 50) ---------------------------------------------------
+# The Tetris robot's skeleton: unit plates (0.2 sigma thick) joined at a corner by a hinge normal
+# to them, 0.5 sigma long.  The pin owner's end knuckles lie 0.05 mm above and below its 1 mm
+# plate, and its plate is cut back around the other body's knuckle over the plate's whole
+# thickness: its knuckle stack and pin printed as a piece of their own (and a final trim took the
+# other plate's knuckle off it).  A fin across the owner's plate now carries its end knuckles.
+
+def _corner_hinge():
+    from mlc.scene.model import Body, Bond, Box
+    sites = {"h0": [1.0, 1.0, -0.25], "h1": [1.0, 1.0, 0.25]}
+    u = Body("u", np.array([0.0, 0.0, 0.0]), np.array([1.0, 0, 0, 0]), [Box(np.array([2.0, 2.0, 0.2]))],
+             {k: np.array(v) for k, v in sites.items()})
+    j = Body("j", np.array([2.0, 0.0, 0.0]), np.array([1.0, 0, 0, 0]), [Box(np.array([2.0, 2.0, 0.2]))],
+             {k: np.array(v) - [2.0, 0.0, 0.0] for k, v in sites.items()})
+    bonds = [Bond("b0", "u.h0", "j.h0", kind="hinge", joint="h"), Bond("b1", "u.h1", "j.h1", kind="hinge", joint="h")]
+    sc = Scene(name="corner_hinge", bodies=[u, j], bonds=bonds)
+    pos = np.array([u.position, j.position], float)
+    quat = np.array([u.orientation, j.orientation], float)
+    poses = {"rest": (pos.copy(), quat.copy())}
+    th = np.radians(90.0)             # j folded in the plane about the hinge (the L of the robot)
+    Rz = np.array([[np.cos(th), -np.sin(th), 0], [np.sin(th), np.cos(th), 0], [0, 0, 1]])
+    ctr = np.array([1.0, 1.0, 0.0])
+    pos[1] = ctr + Rz @ (pos[1] - ctr)
+    quat[1] = [np.cos(th / 2), 0.0, 0.0, np.sin(th / 2)]
+    poses["folded"] = (pos, quat)
+    return sc, poses
+
+
+def test_a_hinge_across_its_plates_prints_each_plate_in_one_piece():
+    from mlc.mesh.checks import check_assembly
+    sc, poses = _corner_hinge()
+    asm = build_assembly(sc, load_profile("mjp"), poses, reuse=True)
+    ax = asm.axes[0]
+    assert ax.pin_owner == "u" and abs(abs(ax.direction[2]) - 1) < 1e-9 and ax.span == pytest.approx(2.5)
+    pieces = {p.name: len(p.solid.decompose()) for p in asm.parts}
+    assert pieces == {"u": 1, "j": 1}
+    assert any(n.startswith("hinge h: u's knuckles lie off its slab") for n in asm.notes)
+    rep = {c.name: c for c in check_assembly(asm).checks}
+    for name in ("watertight", "part_count", "min_gap", "states", "retention", "features"):
+        assert rep[name].ok, (name, rep[name].detail, rep[name].failures[:3])
+
+
+def test_a_final_trim_that_splits_a_part_is_not_kept(monkeypatch):
+    # without the fin, u's knuckle stack is cut off, and a final trim of j against it took j's
+    # own knuckle off j's plate: large assemblies no longer keep such a trim
+    import mlc.mesh.build as B
+    monkeypatch.setattr(B, "OFF_SLAB_FINS", False)
+    sc, poses = _corner_hinge()
+    assert len(build_assembly(sc, load_profile("mjp"), poses, reuse=True).part("j").solid.decompose()) == 1
+    monkeypatch.setattr(B, "KEEP_WHOLE", False)
+    assert len(build_assembly(sc, load_profile("mjp"), poses, reuse=True).part("j").solid.decompose()) == 2

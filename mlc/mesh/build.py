@@ -72,6 +72,11 @@ GUARD_PAD = 0.005  # mm: protected material grown by this much for the final tri
 #: fin up that line into its own end knuckle) only when its hinge is within this cosine of the line;
 #: a chain's next layer, bent at the junction, keeps 0.5 (_compound's o_cos)
 O_COS = 0.95
+#: large assemblies: a body whose own knuckles lie off its slab along a hinge crossing the slab
+#: gets a fin across the slab that carries them (:func:`_knuckles_off_slab`; session 50)
+OFF_SLAB_FINS = True
+#: large assemblies: the final trims (:func:`_resolve`) never keep a trim that splits a part (session 50)
+KEEP_WHOLE = True
 SPLIT_TWIST = True    # compound junctions: the joint part posed with the twist shared by its pins (_split_twist)
 
 
@@ -697,6 +702,16 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
             for bn in ax.bodies:
                 plates[bn] += _yoke_plates(slabs[bn], ax.origin, ax.direction, [(-ax.span / 2, ax.span / 2)],
                                            reach, t)
+        elif reuse and OFF_SLAB_FINS:
+            # an axis across a body's slab, longer than the slab is thick (the robot's skeleton: a
+            # hinge normal to the unit plates, 2.5 mm of knuckles on a 1 mm plate): the body's own
+            # knuckles that lie wholly off its slab get a fin across it (session 50)
+            for bn in ax.bodies:
+                if _knuckles_off_slab(slabs[bn], ax, bn, t):
+                    plates[bn] += _yoke_plates(slabs[bn], ax.origin, ax.direction, [(-ax.span / 2, ax.span / 2)],
+                                               reach, t)
+                    notes.append(f"hinge {ax.name}: {bn}'s knuckles lie off its slab: a fin across the slab "
+                                 "carries them")
     for uj in ujoints:
         for side, bn in enumerate(uj.bodies):
             plates[bn] += _uj_plates(uj, side, slabs[bn], uj.rho[side] + reach, t)
@@ -754,162 +769,177 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         Fb = _frame(slabs[bn][0].center, slabs[bn][0].R) if reuse and LOCAL_BUILD and slabs.get(bn) else None
         _LOCAL[0] = None if Fb is None else np.linalg.inv(Fb)
         my_axes = [ax for ax in axes if bn in ax.bodies]
-        # a branch page's arm, which ends on the face of its own end knuckle, is carried into it
-        links = _rod_links(shapes[bn], my_axes, bn, t, s) if bn in pages else []
-        solid = union([box(sb.center, sb.R, sb.size) for sb in shapes[bn] + links] + _bend_fills(slabs[bn]))
-        my_uj = [(uj, 0 if uj.bodies[0] == bn else 1) for uj in ujoints if bn in uj.bodies]
-        # 1. clear the other bodies' knuckles
-        # (a mechanism of its own: a cut that ends at the span's end runs on past what is left of
-        # the body along the axis when that would be thinner than the minimum wall; issue 13:
-        # out_hi's yoke plate, 0.19 mm past the pivot's cut at sla)
-        sheet = {ax.name: (None if reuse else _ext_ivs(shapes[bn], ax), prof.min_wall) for ax in my_axes}
+        # trims that would leave the body in several pieces (a connector half unit whose slab
+        # the trim radii of its hinge and universal joint eat, issue 13, session 50): rebuilt
+        # with those radii shrunk towards the least that keeps the knuckles clear (_Unsplit)
+        n_notes, shrink = len(notes), _Unsplit(reuse)
+        while True:
+            del notes[n_notes:]
+            f = shrink.f
+            # a branch page's arm, which ends on the face of its own end knuckle, is carried into it
+            links = _rod_links(shapes[bn], my_axes, bn, t, s) if bn in pages else []
+            solid = union([box(sb.center, sb.R, sb.size) for sb in shapes[bn] + links] + _bend_fills(slabs[bn]))
+            my_uj = [(uj, 0 if uj.bodies[0] == bn else 1) for uj in ujoints if bn in uj.bodies]
+            # 1. clear the other bodies' knuckles
+            # (a mechanism of its own: a cut that ends at the span's end runs on past what is left of
+            # the body along the axis when that would be thinner than the minimum wall; issue 13:
+            # out_hi's yoke plate, 0.19 mm past the pivot's cut at sla)
+            sheet = {ax.name: (None if reuse else _ext_ivs(shapes[bn], ax), prof.min_wall) for ax in my_axes}
 
-        def axis_cuts(ax, grow=0.0):
-            return [cylinder(ax.origin, ax.direction, a0, a1, ax.rho + grow, n, cutter=True)
-                    for a0, a1 in _ext(_complement(ax.intervals[bn], -ax.span / 2, ax.span / 2), ax.span, t,
-                                       *sheet[ax.name])]
-        other_cuts, avoid, avoid_sweep = [], [], []
-        for uj, side in my_uj:
-            lay = uj.layouts[side]
-            # the radius the joint's hub and the other body's yoke knuckles sweep about this axis:
-            # the rest of uj.rho is for the other body's slabs in the logic states (_ujoint_trim)
-            sweep = float(np.hypot(uj.layouts[1 - side].extent, uj.R)) + c
-            for a0, a1 in _complement(lay.own, *lay.cut):
-                other_cuts.append(cylinder(uj.center, uj.axes[side], a0, a1, uj.rho[side], n, cutter=True))
-                avoid.append((uj.center, uj.axes[side], a0, a1, uj.rho[side]))
-                avoid_sweep.append((uj.center, uj.axes[side], a0, a1, min(sweep, uj.rho[side])))
-        for uj in ujoints:      # compound junction: the other bodies of its hinge clear the yoke too
-            if uj.host is not None and bn in uj.host.bodies and bn not in uj.bodies:
-                other_cuts.append(cylinder(uj.center, uj.axes[0], *uj.layouts[0].cut, uj.rho[0], n, cutter=True))
-                avoid.append((uj.center, uj.axes[0], *uj.layouts[0].cut, uj.rho[0]))
-        cuts = [x for ax in my_axes for x in axis_cuts(ax)] + other_cuts
-        cut_solid = _clean(subtract(solid, cuts))
-        base_n = len(_clean(solid).decompose())
-        cut_n = len(cut_solid.decompose())
-        # a slab running along an axis is severed by the clearance around another body's
-        # knuckle: bridge around it on the side no other body ever swings through.  For a
-        # mechanism of its own (not reuse), also where that clearance and another trim leave
-        # only a web thinner than the minimum wall (the cut grown by the minimum wall severs it:
-        # core_cd between hinge c and its universal joint, 0.22 mm at mjp, issue 13)
-        # The split alone misses a web that is not the body's only link (issue 13, session 37:
-        # core_cd of the expanding OR at mjp, a 0.547 mm web between hinge c's trim and the
-        # joint's, the body held on by its other slabs as well): the web is also measured, on
-        # sections of the cut body across the other knuckles (:func:`_web_thinner`)
-        def thin_at(ax):
-            if len(_clean(subtract(
-                    solid, [x for a in my_axes for x in axis_cuts(a, prof.min_wall if a is ax else 0.0)]
-                    + other_cuts)).decompose()) > cut_n:
-                return True
-            return _web_thinner(_clean(subtract(solid, cuts)), ax, bn, prof.min_wall)
-        need = {}
-        for ax in my_axes:
-            if cut_n > base_n and len(_clean(subtract(solid, axis_cuts(ax))).decompose()) > base_n:
-                need[ax.name] = "severed"
-            elif not reuse and thin_at(ax):
-                # first the plates at the axis, carried along it as far as the body's slabs go
-                # (a slab beside the knuckle stack joins it there, clear of the other knuckles)
-                ext = _axis_extension(slabs[bn], ax, reach, t)
-                if ext:
-                    solid = _clean(union([solid] + [box(sb.center, sb.R, sb.size) for sb in ext]))
-                    base_n = len(solid.decompose())
-                    cut_solid = _clean(subtract(solid, cuts))
-                    cut_n = len(cut_solid.decompose())
-                    notes.append(f"hinge {ax.name}: {bn}'s plate at the axis carried along it past the knuckles "
-                                 f"({', '.join(f'{a0:.2f} to {a1:.2f}' for a0, a1 in _ext_ivs(slabs[bn], ax))} mm), "
-                                 "where only a web thinner than the minimum wall was left")
-                if not ext or thin_at(ax):     # (without plates added, as just measured)
-                    need[ax.name] = "thin"
-        bridges, fins, through = [], [], []
-        for ax in my_axes:
-            if ax.name not in need:
-                continue
-            own = ax.intervals[bn]
-            mine = []
-            for a0, a1 in _complement(own, -ax.span / 2, ax.span / 2):
-                if any(o1 <= a0 + 1e-9 for _, o1 in own) and any(o0 >= a1 - 1e-9 for o0, _ in own):
-                    # (compiled circuits, reuse: as before, meshes unchanged); a bridge over a
-                    # thin web must keep clear of the other bodies in the dense paths too
-                    if need[ax.name] == "thin":
-                        # the web's bridge may run into the universal joint's trim of this body
-                        # (core_cd towards d: its trim radius is set by out_hi's slab in the logic
-                        # states, and the bridge itself is kept clear of every other slab in every
-                        # state and dense pose), not into what the hub and yoke knuckles sweep; the
-                        # gap: the other slab's half thickness, the clearance, and half the diagonal
-                        # of the sample grid (a point between samples is at most that much nearer)
-                        br = _bridge(ax, bn, a0, a1, samples, state_T, t, prof, avoid_sweep,
-                                     (bridge_T, t / 2 + c + h / np.sqrt(2)))
-                    else:
-                        br = _bridge(ax, bn, a0, a1, samples, state_T, t, prof, () if reuse else avoid)
-                    if br is None:
-                        continue
-                    mine.append(br)
-                    if need[ax.name] == "thin":
-                        through.append(br[0])
-                    notes.append(f"hinge {ax.name}: {bn} bridges around the other knuckles "
-                                 f"({np.degrees(br[1]):.0f} degrees from them)"
-                                 + (", where only a web thinner than the minimum wall was left" if need[ax.name] == "thin" else ""))
-            if mine and need[ax.name] == "thin":
-                # the bridge carries the load now: the web around the other knuckles, thinner
-                # than the minimum wall, goes (the trim grown by the minimum wall, less the bridge)
-                fins.append(subtract(union(axis_cuts(ax, prof.min_wall)), [x for x, _ in mine]))
-            bridges += mine
-        if through and other_cuts:      # the joint's trims spare a thin web's bridge (checked clear above)
-            cuts = [x for ax in my_axes for x in axis_cuts(ax)] + [subtract(union(other_cuts), through)]
-        solid = _clean(subtract(union([solid] + [x for x, _ in bridges]), cuts + fins)) if bridges else cut_solid
-        # 2. own knuckles, attachment rings
-        keep = []
-        for ax in my_axes:
-            for a0, a1 in ax.intervals[bn]:
-                keep.append(cylinder(ax.origin, ax.direction, a0, a1, R, n))
-        for uj, side in my_uj:
-            for a0, a1 in uj.layouts[side].own:
-                keep.append(cylinder(uj.center, uj.axes[side], a0, a1, uj.layouts[side].r_own or R, n))
-        # rings where the slab is too narrow for a hole; holes inside slabs are drilled last,
-        # where the slab has room for them after trimming
-        rings = [cylinder(x[0], x[1], -t / 2, t / 2, lug_out, n) for x in lugs[bn] if x[2]]
-        male, recess = [], []
-        if cones:
-            cr = r_cone + c * np.sqrt(2)
+            def axis_cuts(ax, grow=0.0):
+                return [cylinder(ax.origin, ax.direction, a0, a1, _toward(ax.R + c, ax.rho, f) + grow, n, cutter=True)
+                        for a0, a1 in _ext(_complement(ax.intervals[bn], -ax.span / 2, ax.span / 2), ax.span, t,
+                                           *sheet[ax.name])]
+            other_cuts, avoid, avoid_sweep = [], [], []
+            for uj, side in my_uj:
+                lay = uj.layouts[side]
+                # the radius the joint's hub and the other body's yoke knuckles sweep about this axis:
+                # the rest of uj.rho is for the other body's slabs in the logic states (_ujoint_trim)
+                sweep = float(np.hypot(uj.layouts[1 - side].extent, uj.R)) + c
+                rho_s = _toward(sweep, uj.rho[side], f)
+                for a0, a1 in _complement(lay.own, *lay.cut):
+                    other_cuts.append(cylinder(uj.center, uj.axes[side], a0, a1, rho_s, n, cutter=True))
+                    avoid.append((uj.center, uj.axes[side], a0, a1, rho_s))
+                    avoid_sweep.append((uj.center, uj.axes[side], a0, a1, min(sweep, rho_s)))
+            for uj in ujoints:      # compound junction: the other bodies of its hinge clear the yoke too
+                if uj.host is not None and bn in uj.host.bodies and bn not in uj.bodies:
+                    rho_h = _toward(float(np.hypot(uj.layouts[1].extent, uj.R)) + c, uj.rho[0], f)
+                    other_cuts.append(cylinder(uj.center, uj.axes[0], *uj.layouts[0].cut, rho_h, n, cutter=True))
+                    avoid.append((uj.center, uj.axes[0], *uj.layouts[0].cut, rho_h))
+            cuts = [x for ax in my_axes for x in axis_cuts(ax)] + other_cuts
+            cut_solid = _clean(subtract(solid, cuts))
+            base_n = len(_clean(solid).decompose())
+            cut_n = len(cut_solid.decompose())
+            # a slab running along an axis is severed by the clearance around another body's
+            # knuckle: bridge around it on the side no other body ever swings through.  For a
+            # mechanism of its own (not reuse), also where that clearance and another trim leave
+            # only a web thinner than the minimum wall (the cut grown by the minimum wall severs it:
+            # core_cd between hinge c and its universal joint, 0.22 mm at mjp, issue 13)
+            # The split alone misses a web that is not the body's only link (issue 13, session 37:
+            # core_cd of the expanding OR at mjp, a 0.547 mm web between hinge c's trim and the
+            # joint's, the body held on by its other slabs as well): the web is also measured, on
+            # sections of the cut body across the other knuckles (:func:`_web_thinner`)
+            def thin_at(ax):
+                if len(_clean(subtract(
+                        solid, [x for a in my_axes for x in axis_cuts(a, prof.min_wall if a is ax else 0.0)]
+                        + other_cuts)).decompose()) > cut_n:
+                    return True
+                return _web_thinner(_clean(subtract(solid, cuts)), ax, bn, prof.min_wall)
+            need = {}
             for ax in my_axes:
-                if ax.joint is not None:     # a compound junction's stack keeps the joint's straight pin
+                if cut_n > base_n and len(_clean(subtract(solid, axis_cuts(ax))).decompose()) > base_n:
+                    need[ax.name] = "severed"
+                elif not reuse and thin_at(ax):
+                    # first the plates at the axis, carried along it as far as the body's slabs go
+                    # (a slab beside the knuckle stack joins it there, clear of the other knuckles)
+                    ext = _axis_extension(slabs[bn], ax, reach, t)
+                    if ext:
+                        solid = _clean(union([solid] + [box(sb.center, sb.R, sb.size) for sb in ext]))
+                        base_n = len(solid.decompose())
+                        cut_solid = _clean(subtract(solid, cuts))
+                        cut_n = len(cut_solid.decompose())
+                        notes.append(f"hinge {ax.name}: {bn}'s plate at the axis carried along it past the knuckles "
+                                     f"({', '.join(f'{a0:.2f} to {a1:.2f}' for a0, a1 in _ext_ivs(slabs[bn], ax))} mm), "
+                                     "where only a web thinner than the minimum wall was left")
+                    if not ext or thin_at(ax):     # (without plates added, as just measured)
+                        need[ax.name] = "thin"
+            bridges, fins, through = [], [], []
+            for ax in my_axes:
+                if ax.name not in need:
                     continue
-                seq = sorted((iv, b2) for b2, ivs in ax.intervals.items() for iv in ivs)
-                for (iv0, b0), (iv1, b1) in zip(seq, seq[1:]):
-                    face = iv0[1]          # the cone grows from the end face of the lower knuckle
-                    if b0 == bn:
-                        male.append(cone(ax.origin, ax.direction, face - 1e-3, face + h_cone, r_cone + 1e-3,
-                                         r_cone - h_cone, n))
-                    if b1 == bn:      # the truncated cone offset by c: flat top c higher, side c out
-                        recess.append(cone(ax.origin, ax.direction, face - 1e-3, face + h_cone + c, cr + 1e-3,
-                                           cr - h_cone - c, n, cutter=True))
-        keep += male
-        solid = union([solid] + keep + rings)
-        # 3. holes: non-owner knuckles, yoke knuckles, attachment holes
-        holes = []
-        holes += recess
-        for ax in my_axes:
-            if ax.pin_owner != bn and (not cones or ax.joint is not None):
+                own = ax.intervals[bn]
+                mine = []
+                for a0, a1 in _complement(own, -ax.span / 2, ax.span / 2):
+                    if any(o1 <= a0 + 1e-9 for _, o1 in own) and any(o0 >= a1 - 1e-9 for o0, _ in own):
+                        # (compiled circuits, reuse: as before, meshes unchanged); a bridge over a
+                        # thin web must keep clear of the other bodies in the dense paths too
+                        if need[ax.name] == "thin":
+                            # the web's bridge may run into the universal joint's trim of this body
+                            # (core_cd towards d: its trim radius is set by out_hi's slab in the logic
+                            # states, and the bridge itself is kept clear of every other slab in every
+                            # state and dense pose), not into what the hub and yoke knuckles sweep; the
+                            # gap: the other slab's half thickness, the clearance, and half the diagonal
+                            # of the sample grid (a point between samples is at most that much nearer)
+                            br = _bridge(ax, bn, a0, a1, samples, state_T, t, prof, avoid_sweep,
+                                         (bridge_T, t / 2 + c + h / np.sqrt(2)))
+                        else:
+                            br = _bridge(ax, bn, a0, a1, samples, state_T, t, prof, () if reuse else avoid)
+                        if br is None:
+                            continue
+                        mine.append(br)
+                        if need[ax.name] == "thin":
+                            through.append(br[0])
+                        notes.append(f"hinge {ax.name}: {bn} bridges around the other knuckles "
+                                     f"({np.degrees(br[1]):.0f} degrees from them)"
+                                     + (", where only a web thinner than the minimum wall was left" if need[ax.name] == "thin" else ""))
+                if mine and need[ax.name] == "thin":
+                    # the bridge carries the load now: the web around the other knuckles, thinner
+                    # than the minimum wall, goes (the trim grown by the minimum wall, less the bridge)
+                    fins.append(subtract(union(axis_cuts(ax, prof.min_wall)), [x for x, _ in mine]))
+                bridges += mine
+            if through and other_cuts:      # the joint's trims spare a thin web's bridge (checked clear above)
+                cuts = [x for ax in my_axes for x in axis_cuts(ax)] + [subtract(union(other_cuts), through)]
+            solid = _clean(subtract(union([solid] + [x for x, _ in bridges]), cuts + fins)) if bridges else cut_solid
+            # 2. own knuckles, attachment rings
+            keep = []
+            for ax in my_axes:
                 for a0, a1 in ax.intervals[bn]:
-                    holes.append(cylinder(ax.origin, ax.direction, a0 - g / 2, a1 + g / 2, r_hole, n, cutter=True))
-        for uj, side in my_uj:
-            lay = uj.layouts[side]
-            for a0, a1, rh in (lay.holes if lay.holes is not None else [(a0 - g / 2, a1 + g / 2, r_hole)
-                                                                        for a0, a1 in lay.own]):
-                holes.append(cylinder(uj.center, uj.axes[side], a0, a1, rh, n, cutter=True))
-        for x in lugs[bn]:
-            if x[2]:
-                holes.append(cylinder(x[0], x[1], -t - 1, t + 1, lug_hole, n, cutter=True))
-        solid = subtract(solid, holes)
-        # 4. the owner's pin
-        pins = [cylinder(ax.origin, ax.direction, -ax.span / 2, ax.span / 2, r_pin, n)
-                for ax in my_axes if ax.pin_owner == bn and not cones]
-        solid = _clean(union([solid] + pins))
-        protected[bn] = union(keep + pins + rings)
-        if reuse:
-            cores[bn] = union([subtract(union(keep + rings), holes)] + pins)
-        if cones:
-            cone_cores[bn] = subtract(union(keep + rings), holes)
-        solid = _drop_scraps(solid, protected[bn], bn, notes)
+                    keep.append(cylinder(ax.origin, ax.direction, a0, a1, R, n))
+            for uj, side in my_uj:
+                for a0, a1 in uj.layouts[side].own:
+                    keep.append(cylinder(uj.center, uj.axes[side], a0, a1, uj.layouts[side].r_own or R, n))
+            # rings where the slab is too narrow for a hole; holes inside slabs are drilled last,
+            # where the slab has room for them after trimming
+            rings = [cylinder(x[0], x[1], -t / 2, t / 2, lug_out, n) for x in lugs[bn] if x[2]]
+            male, recess = [], []
+            if cones:
+                cr = r_cone + c * np.sqrt(2)
+                for ax in my_axes:
+                    if ax.joint is not None:     # a compound junction's stack keeps the joint's straight pin
+                        continue
+                    seq = sorted((iv, b2) for b2, ivs in ax.intervals.items() for iv in ivs)
+                    for (iv0, b0), (iv1, b1) in zip(seq, seq[1:]):
+                        face = iv0[1]          # the cone grows from the end face of the lower knuckle
+                        if b0 == bn:
+                            male.append(cone(ax.origin, ax.direction, face - 1e-3, face + h_cone, r_cone + 1e-3,
+                                             r_cone - h_cone, n))
+                        if b1 == bn:      # the truncated cone offset by c: flat top c higher, side c out
+                            recess.append(cone(ax.origin, ax.direction, face - 1e-3, face + h_cone + c, cr + 1e-3,
+                                               cr - h_cone - c, n, cutter=True))
+            keep += male
+            solid = union([solid] + keep + rings)
+            # 3. holes: non-owner knuckles, yoke knuckles, attachment holes
+            holes = []
+            holes += recess
+            for ax in my_axes:
+                if ax.pin_owner != bn and (not cones or ax.joint is not None):
+                    for a0, a1 in ax.intervals[bn]:
+                        holes.append(cylinder(ax.origin, ax.direction, a0 - g / 2, a1 + g / 2, r_hole, n, cutter=True))
+            for uj, side in my_uj:
+                lay = uj.layouts[side]
+                for a0, a1, rh in (lay.holes if lay.holes is not None else [(a0 - g / 2, a1 + g / 2, r_hole)
+                                                                            for a0, a1 in lay.own]):
+                    holes.append(cylinder(uj.center, uj.axes[side], a0, a1, rh, n, cutter=True))
+            for x in lugs[bn]:
+                if x[2]:
+                    holes.append(cylinder(x[0], x[1], -t - 1, t + 1, lug_hole, n, cutter=True))
+            solid = subtract(solid, holes)
+            # 4. the owner's pin
+            pins = [cylinder(ax.origin, ax.direction, -ax.span / 2, ax.span / 2, r_pin, n)
+                    for ax in my_axes if ax.pin_owner == bn and not cones]
+            solid = _clean(union([solid] + pins))
+            protected[bn] = union(keep + pins + rings)
+            if reuse:
+                cores[bn] = union([subtract(union(keep + rings), holes)] + pins)
+            if cones:
+                cone_cores[bn] = subtract(union(keep + rings), holes)
+            solid = _drop_scraps(solid, protected[bn], bn, notes)
+            if shrink.done(len(solid.decompose())):
+                break
+        if shrink.f < 1.0:
+            notes.append(f"{bn}: trim radii of its joints shrunk to {shrink.f:.3g} of the way from the least "
+                         "that clears their knuckles to the sampled ones: at the full radii the body "
+                         "was in several pieces")
         # the spot where the attachment hole would go (0.85 mm in from the site), kept if possible
         spots = [cylinder(_spot(x[4], x[0], lug_out), x[1], -t, t, lug_out + c, n) for x in lugs[bn] if not x[2]]
         soft[bn] = union([protected[bn]] + spots)
@@ -1595,6 +1625,60 @@ def _ujoint_trim_memo(memo, uj: UJoint, samples, state_T, t, c, h):
     if key not in memo:
         memo[key] = _ujoint_trim(uj, samples, state_T, t, c, h)
     return memo[key]
+
+
+#: large assemblies (reuse): a body that the trims of its joints leave in several pieces is rebuilt
+#: with their radii shrunk; this many bisection steps between the least radii and the sampled ones
+UNSPLIT_STEPS = 5
+
+
+def _toward(least: float, rho: float, f: float) -> float:
+    """A trim radius ``f`` of the way from ``least`` (what keeps the knuckles, hub and yokes of the
+    joint clear) to the sampled ``rho`` (``f`` = 1: ``rho`` itself, as before session 50)."""
+    return rho if f >= 1.0 or rho <= least else least + f * (rho - least)
+
+
+class _Unsplit:
+    """The trim-radius fraction ``f`` a body is built with (session 50, issue 13).
+
+    The sampled trim radii of a hinge or universal joint clear the other bodies' slabs in every
+    logic state; where those slabs pass close far from the joint (the robot's coupling chains,
+    whose half units the skeleton bends), the radii reach across the whole slab (4.9 mm on a slab
+    4.5 mm long) and leave only the knuckles, each a piece of its own.  A body of a large
+    assembly (reuse) that comes out in several pieces is rebuilt with every trim radius of its
+    own joints ``f`` of the way from the least one that keeps the knuckles clear to the sampled
+    one: ``f`` = 0, then a bisection (:data:`UNSPLIT_STEPS`) for the largest ``f`` that keeps it in
+    one piece; if even ``f`` = 0 splits it, it is built as before.  What the smaller radii leave
+    close is left to the final trims (:func:`_resolve`, which never keep a split) and the
+    ``states`` check.  A body whole at the sampled radii is built exactly as before; so is
+    every body of a mechanism of its own (the library gates)."""
+
+    def __init__(self, reuse):
+        self.on = bool(reuse) and UNSPLIT_STEPS > 0
+        self.f, self.lo, self.hi, self.tries, self.final = 1.0, None, 1.0, 0, False
+
+    def done(self, pieces: int) -> bool:
+        """Whether the body just built (``pieces``, built at ``self.f``) is kept; else ``self.f``
+        is the next fraction to try."""
+        split = pieces > 1
+        if not self.on or self.final or (self.f == 1.0 and not split):
+            return True
+        self.tries += 1
+        if split:
+            self.hi = self.f
+        else:
+            self.lo = self.f
+        if self.lo is None:
+            # f = 1 splits: try the least radii; if they split it too, build it as before
+            self.f, self.final = (0.0, False) if self.f == 1.0 else (1.0, True)
+            return False
+        if self.tries > UNSPLIT_STEPS:
+            if self.f == self.lo:
+                return True
+            self.f, self.final = self.lo, True
+            return False
+        self.f = 0.5 * (self.lo + self.hi)
+        return False
 
 
 def _drop_scraps(solid: mf.Manifold, keep: mf.Manifold, bn: str, notes: list) -> mf.Manifold:
@@ -2445,7 +2529,13 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
                         removed = X.solid.volume() - trimmed.volume()
                         if removed <= 1e-9:
                             continue
-                        cands.append((not ok, len(trimmed.decompose()) != 1, lost, removed, X, trimmed, Y))
+                        split = len(trimmed.decompose()) != 1
+                        if split and cong is not None and KEEP_WHOLE:
+                            # large assemblies: a trim that splits the part is never kept (it was
+                            # when no other settled: the robot's skeleton units lost a knuckle or a
+                            # lever post to a coupling's slab, session 50); the checks report the pair
+                            continue
+                        cands.append((not ok, split, lost, removed, X, trimmed, Y))
                         _log("  decomposed")
                         if ok:
                             break
@@ -2977,6 +3067,30 @@ def _uj_plates(uj: UJoint, side: int, sbs, reach, t):
     return _yoke_plates(sbs, uj.center, uj.axes[side], [lay.plate], reach, t,
                         rod_reach=max(uj.R, uj.hub_r) + 2 * t if side == 1 and uj.free_pin else None,
                         fin_min=uj.R + t)
+
+
+def _knuckles_off_slab(sbs, ax: HingeAxis, bn: str, t) -> bool:
+    """Whether a knuckle of body ``bn`` on hinge ``ax`` lies wholly beside (along the axis) every
+    slab of ``bn`` that reaches the axis: a hinge whose axis crosses the slab, with a span longer
+    than the slab is thick (the Tetris robot's skeleton: hinges normal to the unit plates, the
+    owner's end knuckles 0.05 mm above and below its 1 mm plate, each stack a piece of its own,
+    issue 13, session 50)."""
+    ivs = ax.intervals.get(bn, [])
+    if not ivs:
+        return False
+    ext = []
+    for sb in sbs:
+        rel = sb.center - ax.origin
+        mid = float(np.dot(rel, ax.direction))
+        perp = rel - mid * ax.direction
+        w = perp - np.dot(perp, sb.R[:, sb.normal_axis]) * sb.R[:, sb.normal_axis]
+        if np.linalg.norm(w) > 1e-6:
+            w = w / np.linalg.norm(w)
+            if np.linalg.norm(perp) - 0.5 * np.sum(np.abs(sb.R.T @ w) * sb.size) > t:
+                continue        # this slab does not reach the axis
+        half = 0.5 * float(np.sum(np.abs(sb.R.T @ ax.direction) * sb.size))
+        ext.append((mid - half, mid + half))
+    return any(not any(e0 < a1 and e1 > a0 for e0, e1 in ext) for a0, a1 in ivs)
 
 
 def _is_rod(sb: SlabBox, t) -> bool:
