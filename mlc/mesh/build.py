@@ -78,6 +78,7 @@ OFF_SLAB_FINS = True
 #: large assemblies: the final trims (:func:`_resolve`) never keep a trim that splits a part (session 50)
 KEEP_WHOLE = True
 SPLIT_TWIST = True    # compound junctions: the joint part posed with the twist shared by its pins (_split_twist)
+PIN_TWIST = True      # compound junctions: the second pin turned about the first to the least twist (least_twist)
 
 
 # --------------------------------------------------------------------------- primitives
@@ -619,9 +620,13 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         radii = (compound["hub_v"] if compound is not None else hub) / 2 + g + ky * np.array([0.0, 0.5, 1.0])
         if free_v:      # no hinge of its own gives the second pin: the one whose yoke stays clear
             v = pin_clear.choose(center, u, v, cb, ob, radii)
+        # the yoke's span from the body's extent along the pin chosen so far: a compound
+        # junction's second pin turned below keeps its knuckles where they were along it
+        W = (_extent_along(slabs[cb], center, u), _extent_along(slabs[ob], center, v))
+        if compound is not None and PIN_TWIST:
+            v = pin_clear.least_twist(center, u, v, cb, ob, radii)
         pin_clear.add(ob, center, v, radii)
         cap = max(kmin, prof.min_wall)
-        W = (_extent_along(slabs[cb], center, u), _extent_along(slabs[ob], center, v))
         best = None
         mode_list = (("both", "both"), ("+", "both"), ("-", "both"), ("both", "+"), ("both", "-"))
         if compound is not None:
@@ -1048,6 +1053,7 @@ _CONE_PROBE = [False]      # building to find the smallest sigma at which cones 
 #: the slab, kept on it (:func:`_yoke_plates`)
 FIN_SIN = 0.05
 SECOND_PIN_TRIES = 12      # second-pin directions tried, every 15 degrees about the first pin
+TWIST_PIN_STEP = 1.0       # degrees: the second pins of a compound junction tried (_PinClearance.least_twist)
 
 
 class _PinClearance:
@@ -1103,6 +1109,46 @@ class _PinClearance:
                 q = P @ Tb[:3, :3].T + Tb[:3, 3]
                 worst = min(worst, float(np.linalg.norm(q[:, None, :] - k[None, :, :], axis=2).min()) - need)
         return worst
+
+    def least_twist(self, center, u, v, cb: str, ob: str, radii) -> np.ndarray:
+        """The second pin of a compound junction (circuit chains): of the directions about the
+        first pin ``u`` every ``TWIST_PIN_STEP`` degrees from ``v``, the one whose largest
+        *twist* over the posed states is least, among those whose yoke knuckles stay as clear
+        of the other parts as ``v``'s (:meth:`_score`, or clear of all of them).
+
+        The twist is 90 degrees less the angle between the pins, ``u`` fixed in ``cb`` and the
+        second pin in ``ob``: the scene's universal joint is a ball joint, and the statics of a
+        circuit chain turn its two layers relative to each other about all three axes, where a
+        printed cardan keeps its pins square.  Its joint part floats in its holes' clearance up
+        to about 7.6 degrees (:func:`_split_twist`); past that its pin ends cut into the yokes.
+        The pin laid across the next layer's slab (``v``: ``u`` x the way to that body's slabs,
+        as before session 50) is twisted by up to 12.8 degrees in the Tetris circuit's 22 poses
+        (``g3`` with the last two half units of both chains into it, 24 bodies).  The twist is
+        linear in the pin's direction (sin twist = (R_C u).(R_O v), over the poses), and one
+        direction per joint keeps it small in every pose: there at most 1.42 degrees at the
+        chains' own junctions; the chains' end joints on ``g3``'s input levers, whose knuckles
+        the levers' neighbours bound, 12.34 -> 10.88 and 7.94 -> 6.62 degrees (states check:
+        34 -> 9 intersections, 0.31 -> 0.10 mm^3; benchmarks/results/tetris_circuit_pins_s50.json)."""
+        if not self.state_T:
+            return v
+        w = np.cross(u, v)
+        a = np.radians(np.arange(0.0, 180.0, TWIST_PIN_STEP))
+        cand = np.outer(np.cos(a), v) + np.outer(np.sin(a), w)         # (n, 3), cand[0] = v
+        worst = np.zeros(len(a))
+        for _, Ts in self.state_T:
+            U = Ts[cb][:3, :3] @ u
+            worst = np.maximum(worst, np.abs(cand @ (Ts[ob][:3, :3].T @ U)))
+        order = np.argsort(worst, kind="stable")
+        if order[0] == 0 or worst[order[0]] >= worst[0] - 1e-12:
+            return v
+        near = self._near(center, cb, ob)
+        floor = min(0.0, self._score(center, v, ob, radii, near)) if near else 0.0
+        for i in order:
+            if i == 0 or worst[i] >= worst[0] - 1e-12:
+                return v
+            if not near or self._score(center, cand[i], ob, radii, near) >= floor - 1e-9:
+                return cand[i] / np.linalg.norm(cand[i])
+        return v
 
     def choose(self, center, u, v, cb: str, ob: str, radii) -> np.ndarray:
         if not self.state_T:
