@@ -552,6 +552,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
     groups = _branch_groups(joints, scene)
     done: set = set()
     pin_clear = _PinClearance(base_samples, state_T, R, c, t, reach)
+    pin_clear.joint_points = [0.5 * (scene.site_world(b[0].a) + scene.site_world(b[0].b)) * s
+                              for b in joints.values() if b[0].kind == "universal"]
     for jname, bonds in joints.items():
         if bonds[0].kind != "universal" or jname in done:
             continue
@@ -1074,6 +1076,7 @@ class _PinClearance:
         self.slab_need, self.knuckle_need = R + c + 0.5 * t, 2 * R + c
         self.names, self.base = names, base_samples
         self.knuckles: list = []        # (body, knuckle axis points)
+        self.joint_points: list = []    # every universal joint's point (mm, rest): least_twist
         self._tree = None
 
     def add(self, body: str, center, v, radii) -> None:
@@ -1099,16 +1102,21 @@ class _PinClearance:
         return out
 
     def _score(self, center, v, ob: str, radii, near) -> float:
+        return float(np.min(self._clearances(center, v, ob, radii, near), initial=np.inf))
+
+    def _clearances(self, center, v, ob: str, radii, near) -> np.ndarray:
+        """The smallest distance, past what it needs, of the yoke knuckles along ``v`` from
+        each of ``near`` over the posed states (mm, one entry per item of ``near``)."""
         kn = center + np.outer(np.r_[radii, -radii], v)
-        worst = np.inf
+        out = np.full(len(near), np.inf)
         for _, Ts in self.state_T:
             To = Ts[ob]
             k = kn @ To[:3, :3].T + To[:3, 3]
-            for bn, P, need in near:
+            for i, (bn, P, need) in enumerate(near):
                 Tb = Ts[bn]
                 q = P @ Tb[:3, :3].T + Tb[:3, 3]
-                worst = min(worst, float(np.linalg.norm(q[:, None, :] - k[None, :, :], axis=2).min()) - need)
-        return worst
+                out[i] = min(out[i], float(np.linalg.norm(q[:, None, :] - k[None, :, :], axis=2).min()) - need)
+        return out
 
     def least_twist(self, center, u, v, cb: str, ob: str, radii) -> np.ndarray:
         """The second pin of a compound junction (circuit chains): of the directions about the
@@ -1142,11 +1150,23 @@ class _PinClearance:
         if order[0] == 0 or worst[order[0]] >= worst[0] - 1e-12:
             return v
         near = self._near(center, cb, ob)
-        floor = min(0.0, self._score(center, v, ob, radii, near)) if near else 0.0
+        # each slab and knuckle near: as clear as from v's knuckles, or clear (a slab on the
+        # same hinge as ob is always within reach of the knuckles, whatever their turn)
+        floor = np.minimum(0.0, self._clearances(center, v, ob, radii, near)) - 1e-9
+        # ... and each knuckle within its own half of the way to every other joint point near
+        # (the junction's other joint, whose yoke is laid out after this one: the two yokes of
+        # a pair turned towards each other met as printed, min_gap 0 in the Tetris circuit)
+        P = np.array([p for p in self.joint_points if 0 < np.linalg.norm(p - center) < self.crop])
+        half = 0.5 * np.linalg.norm(P - center, axis=1) if len(P) else np.zeros(0)
+        n = (P - center) / half[:, None] / 2 if len(P) else np.zeros((0, 3))
+
+        def room(p):
+            return half - float(np.max(radii)) * np.abs(n @ p) - self.knuckle_need / 2
+        floor_p = np.minimum(0.0, room(v)) - 1e-9
         for i in order:
             if i == 0 or worst[i] >= worst[0] - 1e-12:
                 return v
-            if not near or self._score(center, cand[i], ob, radii, near) >= floor - 1e-9:
+            if np.all(room(cand[i]) >= floor_p) and np.all(self._clearances(center, cand[i], ob, radii, near) >= floor):
                 return cand[i] / np.linalg.norm(cand[i])
         return v
 
