@@ -1135,8 +1135,11 @@ class _PinClearance:
         linear in the pin's direction (sin twist = (R_C u).(R_O v), over the poses), and one
         direction per joint keeps it small in every pose: there at most 1.42 degrees at the
         chains' own junctions; the chains' end joints on ``g3``'s input levers, whose knuckles
-        the levers' neighbours bound, 12.34 -> 10.88 and 7.94 -> 6.62 degrees (states check:
-        34 -> 9 intersections, 0.31 -> 0.10 mm^3; benchmarks/results/tetris_circuit_pins_s50.json)."""
+        the levers' neighbours bound, 12.34 -> 10.88 and 8.41 -> 6.62 degrees (states check:
+        34 -> 9 intersections, 0.31 -> 0.10 mm^3; benchmarks/results/tetris_circuit_pins_s50.json).
+        A first try that bounded the knuckles by their worst clearance only turned the two yokes
+        of a pair towards each other (the pin along the pair's axis is the least twisted where
+        the next layer turns about that axis), and they met as printed: hence the half-way rule."""
         if not self.state_T:
             return v
         w = np.cross(u, v)
