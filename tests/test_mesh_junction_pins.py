@@ -117,3 +117,37 @@ def test_the_least_twisted_pin_keeps_its_yoke_clear_of_other_bodies():
     assert pc._score(center, p, "O", radii, near) >= 0                       # the pin chosen is
     assert abs(float(p @ u)) < 1e-12 and abs(np.linalg.norm(p) - 1) < 1e-12
     assert 0 < twist(p) < twist(v) - 1.0, (twist(p), twist(v))
+
+
+def test_the_least_twisted_pin_keeps_clear_of_a_yoke_laid_out_after_it():
+    # Session 51: the half-way rule alone let one yoke of a junction's pair turn into the line
+    # of the other's, laid out after it (0.155 mm as printed in the Tetris circuit).  A joint
+    # not laid out yet counts with its untwisted yoke (``pending``); the joint's own entry not.
+    from mlc.geometry.rotation import expmap
+    R, c, t = 1.0, 0.2, 0.8
+    center = np.zeros(3)
+    u, v, x = np.array([0.0, 0, 1]), np.array([0.0, 1, 0]), np.array([1.0, 0, 0])
+    radii = np.array([2.0, 2.5, 3.0])
+    To = np.eye(4)
+    To[:3, :3] = expmap(x * np.radians(10.0))
+    far = np.array([[0.0, 0.0, -40.0]])
+    base = {"C": far, "O": far + 1.0, "Y": far - 1.0}
+    state_T = [("0", {"C": np.eye(4), "O": np.eye(4), "Y": np.eye(4)}),
+               ("1", {"C": np.eye(4), "O": To, "Y": np.eye(4)})]
+    pc = B._PinClearance(base, state_T, R, c, t, 10.0)
+    # the joint's own untwisted yoke, and another joint's 1 mm above it along x (on body Y)
+    pc.pending = {"J1": ("Y", center, v), "J2": ("Y", np.array([0.0, 0, 1.0]), x)}
+    p = pc.least_twist(center, u, v, "C", "O", radii, "J1")
+    kn = np.r_[radii, -radii]
+    theirs = np.array([0.0, 0, 1.0]) + np.outer(kn, x)
+    gap = np.linalg.norm((np.outer(kn, p))[:, None] - theirs[None], axis=2).min()
+    assert gap >= pc.knuckle_need - 1e-9, gap               # clear of J2's yoke (x: 1 mm)
+    assert abs(float(p @ u)) < 1e-12 and abs(float(p @ x)) < 0.99
+    assert np.degrees(np.arcsin(abs(float(u @ (To[:3, :3] @ p))))) < 10.0 - 1.0     # still turned
+    # without J2 pending: the pin along x, the untwisted one
+    pc.pending = {"J1": ("Y", center, v)}
+    p = pc.least_twist(center, u, v, "C", "O", radii, "J1")
+    assert abs(abs(float(p @ x)) - 1) < 1e-9
+    # laid out: a joint leaves pending
+    pc.add("O", center, p, radii, "J1")
+    assert pc.pending == {}

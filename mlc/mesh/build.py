@@ -554,6 +554,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
     pin_clear = _PinClearance(base_samples, state_T, R, c, t, reach)
     pin_clear.joint_points = [0.5 * (scene.site_world(b[0].a) + scene.site_world(b[0].b)) * s
                               for b in joints.values() if b[0].kind == "universal"]
+    if PIN_TWIST:
+        pin_clear.pending = _pending_yokes(joints, groups, scene, axes, slabs, s, g)
     for jname, bonds in joints.items():
         if bonds[0].kind != "universal" or jname in done:
             continue
@@ -605,18 +607,10 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
                     break
                 notes.append(f"universal joint {jname}: no room for a compound junction on hinge {hx.name}")
         u = _hinge_dir(cb, axes, slabs, center) if compound is None else compound["u"]
-        v = _hinge_dir(ob, axes, slabs, center)
-        parallel = abs(np.dot(u, v)) > 0.95
+        v, parallel = _second_pin(u, ob, axes, slabs, center)
         # ... and the joint hangs on a post, farther than ``reach`` from every hinge of O's (a
         # chain's junction is nearer its next half unit's hinges, whose trims settle it)
         free_v = parallel and all(_axis_distance(center, ax) > reach for ax in axes if ob in ax.bodies)
-        if parallel:
-            w = np.mean([sb.center for sb in slabs[ob]], axis=0) - center
-            v = np.cross(u, w)
-            if np.linalg.norm(v) < 1e-9:
-                v = _perp_frame(u)[:, 0]
-        v = v - np.dot(v, u) * u
-        v /= np.linalg.norm(v)
         hub = 2 * (R + c)
         ky = max(kmin, R)
         radii = (compound["hub_v"] if compound is not None else hub) / 2 + g + ky * np.array([0.0, 0.5, 1.0])
@@ -626,8 +620,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         # junction's second pin turned below keeps its knuckles where they were along it
         W = (_extent_along(slabs[cb], center, u), _extent_along(slabs[ob], center, v))
         if compound is not None and PIN_TWIST:
-            v = pin_clear.least_twist(center, u, v, cb, ob, radii)
-        pin_clear.add(ob, center, v, radii)
+            v = pin_clear.least_twist(center, u, v, cb, ob, radii, jname)
+        pin_clear.add(ob, center, v, radii, jname)
         cap = max(kmin, prof.min_wall)
         best = None
         mode_list = (("both", "both"), ("+", "both"), ("-", "both"), ("both", "+"), ("both", "-"))
@@ -1077,11 +1071,14 @@ class _PinClearance:
         self.names, self.base = names, base_samples
         self.knuckles: list = []        # (body, knuckle axis points)
         self.joint_points: list = []    # every universal joint's point (mm, rest): least_twist
+        self.pending: dict = {}         # joint -> (body, point, untwisted second pin), mm,
+                                        # until it is laid out: least_twist
         self._tree = None
 
-    def add(self, body: str, center, v, radii) -> None:
+    def add(self, body: str, center, v, radii, joint: str | None = None) -> None:
         """Knuckle axis points of a laid-out yoke (on ``body``), for the joints after it."""
         self.knuckles.append((body, center + np.outer(np.r_[radii, -radii], v)))
+        self.pending.pop(joint, None)
 
     def _near(self, center, cb: str, ob: str) -> list:
         """[(body, points, need)] of the other bodies' slab samples and knuckles within the crop."""
@@ -1118,7 +1115,29 @@ class _PinClearance:
                 out[i] = min(out[i], float(np.linalg.norm(q[:, None, :] - k[None, :, :], axis=2).min()) - need)
         return out
 
-    def least_twist(self, center, u, v, cb: str, ob: str, radii) -> np.ndarray:
+    def _clearances_many(self, center, V, ob: str, radii, near) -> np.ndarray:
+        """:meth:`_clearances` of the yokes along each row of ``V`` at once: (len(V), len(near)),
+        mm, where they are negative (a positive clearance may read as inf: the points farther
+        than the knuckles' reach plus the need are left out).  In ``ob``'s rest frame,
+        |q - k|^2 = |q - center|^2 - 2 r (q - center).v + r^2."""
+        r = np.r_[radii, -radii]
+        rmax = float(np.max(np.abs(r)))
+        out = np.full((len(V), len(near)), np.inf)
+        for _, Ts in self.state_T:
+            To = Ts[ob]
+            for i, (bn, P, need) in enumerate(near):
+                Tb = Ts[bn]
+                rel = ((P @ Tb[:3, :3].T + Tb[:3, 3]) - To[:3, 3]) @ To[:3, :3] - center   # (m, 3)
+                rel = rel[np.einsum("ij,ij->i", rel, rel) <= (rmax + need) ** 2]
+                if not len(rel):
+                    continue
+                A = rel @ V.T                                                                 # (m, n)
+                d2 = np.einsum("ij,ij->i", rel, rel)[:, None, None] - 2 * A[:, :, None] * r + r * r
+                d = np.sqrt(np.maximum(d2.min(axis=(0, 2)), 0.0)) - need
+                out[:, i] = np.minimum(out[:, i], d)
+        return out
+
+    def least_twist(self, center, u, v, cb: str, ob: str, radii, joint: str | None = None) -> np.ndarray:
         """The second pin of a compound junction (circuit chains): of the directions about the
         first pin ``u`` every ``TWIST_PIN_STEP`` degrees from ``v``, the one whose largest
         *twist* over the posed states is least, among those whose yoke knuckles stay as clear
@@ -1139,7 +1158,11 @@ class _PinClearance:
         34 -> 9 intersections, 0.31 -> 0.10 mm^3; benchmarks/results/tetris_circuit_pins_s50.json).
         A first try that bounded the knuckles by their worst clearance only turned the two yokes
         of a pair towards each other (the pin along the pair's axis is the least twisted where
-        the next layer turns about that axis), and they met as printed: hence the half-way rule."""
+        the next layer turns about that axis), and they met as printed: hence the half-way rule.
+        The half-way rule alone let one yoke of a pair turn into the line of the other's, laid
+        out after it (``w_b_2_58_AB``-``w_b_2_58_CD``, 0.155 mm as printed in the Tetris
+        circuit): the joints not yet laid out count with their untwisted yokes (``pending``,
+        :func:`_pending_yokes`), which they keep unless a turn stays as clear of this one."""
         if not self.state_T:
             return v
         w = np.cross(u, v)
@@ -1152,24 +1175,30 @@ class _PinClearance:
         order = np.argsort(worst, kind="stable")
         if order[0] == 0 or worst[order[0]] >= worst[0] - 1e-12:
             return v
-        near = self._near(center, cb, ob)
+        # (the joints not laid out yet: their untwisted yokes, at this one's radii)
+        near = self._near(center, cb, ob) + [
+            (bn, p + np.outer(np.r_[radii, -radii], pv), self.knuckle_need) for jn, (bn, p, pv) in self.pending.items()
+            if jn != joint and bn not in (cb, ob) and np.linalg.norm(p - center) < self.crop]
         # each slab and knuckle near: as clear as from v's knuckles, or clear (a slab on the
         # same hinge as ob is always within reach of the knuckles, whatever their turn)
-        floor = np.minimum(0.0, self._clearances(center, v, ob, radii, near)) - 1e-9
+        floor = np.minimum(0.0, self._clearances_many(center, v[None], ob, radii, near)[0]) - 1e-9
         # ... and each knuckle within its own half of the way to every other joint point near
         # (the junction's other joint, whose yoke is laid out after this one: the two yokes of
         # a pair turned towards each other met as printed, min_gap 0 in the Tetris circuit)
         P = np.array([p for p in self.joint_points if 0 < np.linalg.norm(p - center) < self.crop])
         half = 0.5 * np.linalg.norm(P - center, axis=1) if len(P) else np.zeros(0)
-        n = (P - center) / half[:, None] / 2 if len(P) else np.zeros((0, 3))
+        n = (P - center) / (2 * half[:, None]) if len(P) else np.zeros((0, 3))
 
         def room(p):
             return half - float(np.max(radii)) * np.abs(n @ p) - self.knuckle_need / 2
         floor_p = np.minimum(0.0, room(v)) - 1e-9
-        for i in order:
-            if i == 0 or worst[i] >= worst[0] - 1e-12:
-                return v
-            if np.all(room(cand[i]) >= floor_p) and np.all(self._clearances(center, cand[i], ob, radii, near) >= floor):
+        better = [i for i in order if i != 0 and worst[i] < worst[0] - 1e-12]   # least twist first
+        for b in range(0, len(better), 24):       # in batches: the first few usually settle it
+            ix = np.array(better[b:b + 24])
+            ok = np.all(np.abs(cand[ix] @ n.T) * float(np.max(radii)) <= (half - self.knuckle_need / 2 - floor_p), axis=1)
+            ok &= np.all(self._clearances_many(center, cand[ix], ob, radii, near) >= floor, axis=1)
+            if ok.any():
+                i = ix[np.argmax(ok)]
                 return cand[i] / np.linalg.norm(cand[i])
         return v
 
@@ -3077,6 +3106,42 @@ def _trim_by(X, Y, sts, grow, dirs, keep, state_grow, merged=False):
 
 def _bb_near(a, b, margin) -> bool:
     return bool(np.all(a[:3] <= b[3:] + margin) and np.all(b[:3] <= a[3:] + margin))
+
+
+def _second_pin(u, ob, axes, slabs, center) -> tuple:
+    """A universal joint's second pin (unit, square to the first pin ``u``) fixed in body
+    ``ob``: along its hinge, or across its slabs when that hinge runs along ``u``; and whether
+    it did (``parallel``)."""
+    v = _hinge_dir(ob, axes, slabs, center)
+    parallel = abs(np.dot(u, v)) > 0.95
+    if parallel:
+        w = np.mean([sb.center for sb in slabs[ob]], axis=0) - center
+        v = np.cross(u, w)
+        if np.linalg.norm(v) < 1e-9:
+            v = _perp_frame(u)[:, 0]
+    v = v - np.dot(v, u) * u
+    return v / np.linalg.norm(v), parallel
+
+
+def _pending_yokes(joints, groups, scene, axes, slabs, s, g) -> dict:
+    """Every compound junction's yoke before any is laid out: joint -> (its yoke's body, the
+    joint point in mm, its untwisted second pin :func:`_second_pin`).
+    ``_PinClearance.least_twist`` keeps a joint's turned yoke clear of these for the joints
+    after it; each is dropped when its joint is laid out."""
+    out = {}
+    for jname, bonds in joints.items():
+        if bonds[0].kind != "universal" or jname in groups:
+            continue
+        bd = bonds[0]
+        cb, ob = bd.a.split(".")[0], bd.b.split(".")[0]
+        center = 0.5 * (scene.site_world(bd.a) + scene.site_world(bd.b)) * s
+        for side_b, other_b in ((cb, ob), (ob, cb)):
+            hx = _host_axis(side_b, axes, center, s, g)
+            if hx is not None:
+                v, _ = _second_pin(hx.direction, other_b, axes, slabs, center)
+                out[jname] = (other_b, center, v)
+                break
+    return out
 
 
 def _hinge_dir(bn, axes, slabs, center) -> np.ndarray:
