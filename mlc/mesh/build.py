@@ -774,18 +774,19 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         # the trim radii of its hinge and universal joint eat, issue 13, session 50): rebuilt
         # with those radii shrunk towards the least that keeps the knuckles clear (_Unsplit)
         n_notes, shrink = len(notes), _Unsplit(reuse)
-        while True:
+        # a branch page's arm, which ends on the face of its own end knuckle, is carried into it
+        links = _rod_links(shapes[bn], my_axes, bn, t, s) if bn in pages else []
+        solid0 = union([box(sb.center, sb.R, sb.size) for sb in shapes[bn] + links] + _bend_fills(slabs[bn]))
+        my_uj = [(uj, 0 if uj.bodies[0] == bn else 1) for uj in ujoints if bn in uj.bodies]
+        # (a mechanism of its own: a cut that ends at the span's end runs on past what is left of
+        # the body along the axis when that would be thinner than the minimum wall; issue 13:
+        # out_hi's yoke plate, 0.19 mm past the pivot's cut at sla)
+        sheet = {ax.name: (None if reuse else _ext_ivs(shapes[bn], ax), prof.min_wall) for ax in my_axes}
+        while True:     # once, or again at the next trim-radius fraction (_Unsplit)
             del notes[n_notes:]
             f = shrink.f
-            # a branch page's arm, which ends on the face of its own end knuckle, is carried into it
-            links = _rod_links(shapes[bn], my_axes, bn, t, s) if bn in pages else []
-            solid = union([box(sb.center, sb.R, sb.size) for sb in shapes[bn] + links] + _bend_fills(slabs[bn]))
-            my_uj = [(uj, 0 if uj.bodies[0] == bn else 1) for uj in ujoints if bn in uj.bodies]
+            solid = solid0
             # 1. clear the other bodies' knuckles
-            # (a mechanism of its own: a cut that ends at the span's end runs on past what is left of
-            # the body along the axis when that would be thinner than the minimum wall; issue 13:
-            # out_hi's yoke plate, 0.19 mm past the pivot's cut at sla)
-            sheet = {ax.name: (None if reuse else _ext_ivs(shapes[bn], ax), prof.min_wall) for ax in my_axes}
 
             def axis_cuts(ax, grow=0.0):
                 return [cylinder(ax.origin, ax.direction, a0, a1, _toward(ax.R + c, ax.rho, f) + grow, n, cutter=True)
