@@ -151,3 +151,40 @@ def test_the_least_twisted_pin_keeps_clear_of_a_yoke_laid_out_after_it():
     # laid out: a joint leaves pending
     pc.add("O", center, p, radii, "J1")
     assert pc.pending == {}
+
+
+def test_a_one_sided_yoke_takes_the_least_twisted_pin_when_only_its_side_is_clear():
+    # Session 51: the pin along x is not twisted (O turns 10 degrees about x), but a third
+    # body's slab stands across the x axis on its -x side only.  A yoke on both sides of the
+    # hub must turn away from x (twisted by about 8 degrees); a one-sided yoke on +x, its pin
+    # capped, keeps the untwisted pin.  Without the cap's reach (cap_r) only the first is tried.
+    from mlc.geometry.rotation import expmap
+    R, c, t = 1.0, 0.2, 0.8
+    center = np.zeros(3)
+    u, v, x = np.array([0.0, 0, 1]), np.array([0.0, 1, 0]), np.array([1.0, 0, 0])
+    radii = np.array([2.0, 2.5, 3.0])
+    To = np.eye(4)
+    To[:3, :3] = expmap(x * np.radians(10.0))
+    far = np.array([[0.0, 0.0, -40.0]])
+    s = np.linspace(-1.0, 1.0, 9)
+    X = np.array([[-2.5, y, z] for y in s for z in s])
+    state_T = [("0", {"C": np.eye(4), "O": np.eye(4), "X": np.eye(4)}),
+               ("1", {"C": np.eye(4), "O": To, "X": np.eye(4)})]
+
+    def twist(p):
+        return np.degrees(np.arcsin(abs(float(u @ (To[:3, :3] @ p)))))
+    pc = B._PinClearance({"C": far, "O": far + 1.0, "X": X}, state_T, R, c, t, 10.0)
+    p_both = pc.least_twist(center, u, v, "C", "O", radii)
+    assert twist(p_both) > B.ONE_SIDED_ABOVE + B.ONE_SIDED_GAIN, twist(p_both)
+    p, mode = pc.least_twist(center, u, v, "C", "O", radii, cap_r=3.8)
+    side = {"+": 1.0, "-": -1.0}[mode]                      # the knuckles lie along side * p: +x
+    assert abs(side * float(p @ x) - 1) < 1e-9 and twist(p) < 1e-6, (p, mode)
+    # its knuckles and cap are clear of X; the other side's would not be
+    near = pc._near(center, "C", "O")
+    assert pc._clearances_many(center, p[None], "O", radii, near, side * np.r_[radii, 3.8]).min() >= 0
+    assert pc._clearances_many(center, p[None], "O", radii, near).min() < 0
+    # a slab on both sides of x: no one-sided yoke either, the pin with both sides as before
+    X2 = np.concatenate([X, X * [-1, 1, 1]])
+    pc = B._PinClearance({"C": far, "O": far + 1.0, "X": X2}, state_T, R, c, t, 10.0)
+    p, mode = pc.least_twist(center, u, v, "C", "O", radii, cap_r=3.8)
+    assert mode == "both" and abs(float(p @ x)) < 0.99

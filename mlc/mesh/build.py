@@ -48,6 +48,7 @@ clearance.
 from __future__ import annotations
 
 import itertools
+import math
 import os
 import sys
 import time
@@ -79,6 +80,9 @@ OFF_SLAB_FINS = True
 KEEP_WHOLE = True
 SPLIT_TWIST = True    # compound junctions: the joint part posed with the twist shared by its pins (_split_twist)
 PIN_TWIST = True      # compound junctions: the second pin turned about the first to the least twist (least_twist)
+ONE_SIDED_TWIST = True   # ... with a one-sided yoke where both sides would not be clear (session 51)
+ONE_SIDED_ABOVE = 4.0    # degrees: ... only when the least twist with both sides is more than this
+ONE_SIDED_GAIN = 1.0     # degrees: ... and the one-sided yoke's twist less by at least this
 
 
 # --------------------------------------------------------------------------- primitives
@@ -619,18 +623,30 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         # the yoke's span from the body's extent along the pin chosen so far: a compound
         # junction's second pin turned below keeps its knuckles where they were along it
         W = (_extent_along(slabs[cb], center, u), _extent_along(slabs[ob], center, v))
-        if compound is not None and PIN_TWIST:
-            v = pin_clear.least_twist(center, u, v, cb, ob, radii, jname)
-        pin_clear.add(ob, center, v, radii, jname)
         cap = max(kmin, prof.min_wall)
+        o_mode, cap_r = "both", radii[-1] + g + cap      # cap_r: a one-sided yoke's cap end (mm)
+        if compound is not None and PIN_TWIST and ONE_SIDED_TWIST:
+            # or a one-sided yoke on the turned pin, its pin capped, where a yoke on both sides
+            # would meet the pair's other joint or a slab
+            v, o_mode = pin_clear.least_twist(center, u, v, cb, ob, radii, jname, cap_r=cap_r)
+        elif compound is not None and PIN_TWIST:
+            v = pin_clear.least_twist(center, u, v, cb, ob, radii, jname)
+        pin_clear.add(ob, center, v, radii, jname,
+                      r=None if o_mode == "both" else (1 if o_mode == "+" else -1) * np.r_[radii, cap_r])
         best = None
         mode_list = (("both", "both"), ("+", "both"), ("-", "both"), ("both", "+"), ("both", "-"))
         if compound is not None:
-            mode_list = (("host", "both"),)
+            mode_list = (("host", o_mode),)
             hub = compound["hub_v"]
         for modes in mode_list:
             if compound is not None:
-                lays = (compound["layout_c"], _yoke_layout(modes[1], hub, g, ky, cap, W[1], s))
+                ly = _yoke_layout(modes[1], hub, g, ky, cap, W[1], s)
+                if ly.mode != "both":
+                    # one-sided on a compound junction: trimmed where the joint part is (ball
+                    # hub to cap), not along the whole line, which may run through O's slab
+                    # (w_y_3_56_CD cut in two, session 51)
+                    ly.cut = (-(hub / 2 + g), ly.caps[0][1]) if ly.mode == "+" else (ly.caps[0][0], hub / 2 + g)
+                lays = (compound["layout_c"], ly)
             else:
                 lays = tuple(_yoke_layout(m, hub, g, ky, cap, W[i], s) for i, m in enumerate(modes))
             part_name = jname if jname not in bodies else f"joint_{jname}"
@@ -1076,9 +1092,10 @@ class _PinClearance:
                                         # until it is laid out: least_twist
         self._tree = None
 
-    def add(self, body: str, center, v, radii, joint: str | None = None) -> None:
-        """Knuckle axis points of a laid-out yoke (on ``body``), for the joints after it."""
-        self.knuckles.append((body, center + np.outer(np.r_[radii, -radii], v)))
+    def add(self, body: str, center, v, radii, joint: str | None = None, r=None) -> None:
+        """Knuckle axis points of a laid-out yoke (on ``body``), for the joints after it
+        (``r``: their signed distances along ``v``, mm; both sides at ``radii`` by default)."""
+        self.knuckles.append((body, center + np.outer(np.r_[radii, -radii] if r is None else r, v)))
         self.pending.pop(joint, None)
 
     def _near(self, center, cb: str, ob: str) -> list:
@@ -1116,29 +1133,42 @@ class _PinClearance:
                 out[i] = min(out[i], float(np.linalg.norm(q[:, None, :] - k[None, :, :], axis=2).min()) - need)
         return out
 
-    def _clearances_many(self, center, V, ob: str, radii, near) -> np.ndarray:
+    def _clearances_many(self, center, V, ob: str, radii, near, r=None) -> np.ndarray:
         """:meth:`_clearances` of the yokes along each row of ``V`` at once: (len(V), len(near)),
         mm, where they are negative (a positive clearance may read as inf: the points farther
-        than the knuckles' reach plus the need are left out).  In ``ob``'s rest frame,
-        |q - k|^2 = |q - center|^2 - 2 r (q - center).v + r^2."""
-        r = np.r_[radii, -radii]
-        rmax = float(np.max(np.abs(r)))
-        out = np.full((len(V), len(near)), np.inf)
+        than the knuckles' reach plus the need are left out); ``r``: the knuckle points' signed
+        distances along v (both sides at ``radii`` by default)."""
+        r = np.r_[radii, -radii] if r is None else np.asarray(r, float)
+        return self._clear_r(V, self._posed_near(center, ob, near, float(np.max(np.abs(r)))), len(near), r).min(axis=2)
+
+    def _posed_near(self, center, ob: str, near, rmax: float) -> list:
+        """[(item, points, need)]: the points of each of ``near`` in every posed state, in
+        ``ob``'s rest frame from the joint point (mm), those within ``rmax`` plus the need."""
+        out = []
         for _, Ts in self.state_T:
             To = Ts[ob]
             for i, (bn, P, need) in enumerate(near):
                 Tb = Ts[bn]
                 rel = ((P @ Tb[:3, :3].T + Tb[:3, 3]) - To[:3, 3]) @ To[:3, :3] - center   # (m, 3)
                 rel = rel[np.einsum("ij,ij->i", rel, rel) <= (rmax + need) ** 2]
-                if not len(rel):
-                    continue
-                A = rel @ V.T                                                                 # (m, n)
-                d2 = np.einsum("ij,ij->i", rel, rel)[:, None, None] - 2 * A[:, :, None] * r + r * r
-                d = np.sqrt(np.maximum(d2.min(axis=(0, 2)), 0.0)) - need
-                out[:, i] = np.minimum(out[:, i], d)
+                if len(rel):
+                    out.append((i, rel, need))
         return out
 
-    def least_twist(self, center, u, v, cb: str, ob: str, radii, joint: str | None = None) -> np.ndarray:
+    @staticmethod
+    def _clear_r(V, posed: list, n: int, r) -> np.ndarray:
+        """(len(V), n, len(r)): the least distance, past the need, of each item's posed points
+        (:meth:`_posed_near`) from the knuckle point at ``r`` along each row of ``V`` (mm; inf
+        where none is near): |q - k|^2 = |q|^2 - 2 r q.v + r^2."""
+        out = np.full((len(V), n, len(r)), np.inf)
+        for i, rel, need in posed:
+            A = rel @ V.T                                                                 # (m, k)
+            d2 = np.einsum("ij,ij->i", rel, rel)[:, None, None] - 2 * A[:, :, None] * r + r * r
+            out[:, i, :] = np.minimum(out[:, i, :], np.sqrt(np.maximum(d2.min(axis=0), 0.0)) - need)
+        return out
+
+    def least_twist(self, center, u, v, cb: str, ob: str, radii, joint: str | None = None,
+                    cap_r: float | None = None):
         """The second pin of a compound junction (circuit chains): of the directions about the
         first pin ``u`` every ``TWIST_PIN_STEP`` degrees from ``v``, the one whose largest
         *twist* over the posed states is least, among those whose yoke knuckles stay as clear
@@ -1163,9 +1193,23 @@ class _PinClearance:
         The half-way rule alone let one yoke of a pair turn into the line of the other's, laid
         out after it (``w_b_2_58_AB``-``w_b_2_58_CD``, 0.155 mm as printed in the Tetris
         circuit): the joints not yet laid out count with their untwisted yokes (``pending``,
-        :func:`_pending_yokes`), which they keep unless a turn stays as clear of this one."""
+        :func:`_pending_yokes`), which they keep unless a turn stays as clear of this one.
+
+        With ``cap_r`` (the far end of a one-sided yoke's cap, mm; ``ONE_SIDED_TWIST``) it
+        returns ``(pin, mode)``: ``"both"``, or ``"+"``/``"-"`` for a yoke on that side of the
+        hub only (its knuckle and the pin's cap at ``radii`` and ``cap_r`` along ``mode * pin``),
+        taken when the least twisted clear pin with a yoke on both sides twists by more than
+        ``ONE_SIDED_ABOVE`` and the one-sided one by ``ONE_SIDED_GAIN`` less.  The least twisted
+        pin of a chain's junction often points at the pair's other joint (the next layer bends
+        about the pair's axis), where two yokes on both sides meet: the one-sided yoke turns
+        away from it.  A 56-body sub-scene of the Tetris circuit (``w_b_2`` and ``w_y_3``,
+        half units 55-61): largest junction twist 16.1 -> 7.3 deg, ``states`` 123 -> 3
+        intersections (scratch; benchmarks/results/junction_kinematics.json: with the best pins,
+        no junction of that circuit twists by more than 6.8 deg over its 22 poses)."""
+        sides = cap_r is not None
+        keep = (v, "both") if sides else v
         if not self.state_T:
-            return v
+            return keep
         w = np.cross(u, v)
         a = np.radians(np.arange(0.0, 180.0, TWIST_PIN_STEP))
         cand = np.outer(np.cos(a), v) + np.outer(np.sin(a), w)         # (n, 3), cand[0] = v
@@ -1175,33 +1219,58 @@ class _PinClearance:
             worst = np.maximum(worst, np.abs(cand @ (Ts[ob][:3, :3].T @ U)))
         order = np.argsort(worst, kind="stable")
         if order[0] == 0 or worst[order[0]] >= worst[0] - 1e-12:
-            return v
+            return keep
         # (the joints not laid out yet: their untwisted yokes, at this one's radii)
         near = self._near(center, cb, ob) + [
             (bn, p + np.outer(np.r_[radii, -radii], pv), self.knuckle_need) for jn, (bn, p, pv) in self.pending.items()
             if jn != joint and bn not in (cb, ob) and np.linalg.norm(p - center) < self.crop]
         # each slab and knuckle near: as clear as from v's knuckles, or clear (a slab on the
         # same hinge as ob is always within reach of the knuckles, whatever their turn)
-        floor = np.minimum(0.0, self._clearances_many(center, v[None], ob, radii, near)[0]) - 1e-9
+        # Knuckle points: both sides at radii (columns 0-5), and the one-sided yoke's cap (6, 7)
+        r_all = np.r_[radii, -radii] if not sides else np.r_[radii, -radii, cap_r, -cap_r]
+        nr = len(radii)
+        cols = {"both": np.arange(2 * nr), "+": np.r_[np.arange(nr), 2 * nr], "-": np.r_[np.arange(nr, 2 * nr), 2 * nr + 1]}
+        posed = self._posed_near(center, ob, near, float(np.max(np.abs(r_all))))
+        floor = np.minimum(0.0, self._clear_r(v[None], posed, len(near), r_all)[0][:, cols["both"]].min(axis=1)) - 1e-9
         # ... and each knuckle within its own half of the way to every other joint point near
         # (the junction's other joint, whose yoke is laid out after this one: the two yokes of
         # a pair turned towards each other met as printed, min_gap 0 in the Tetris circuit)
         P = np.array([p for p in self.joint_points if 0 < np.linalg.norm(p - center) < self.crop])
         half = 0.5 * np.linalg.norm(P - center, axis=1) if len(P) else np.zeros(0)
         n = (P - center) / (2 * half[:, None]) if len(P) else np.zeros((0, 3))
-
-        def room(p):
-            return half - float(np.max(radii)) * np.abs(n @ p) - self.knuckle_need / 2
-        floor_p = np.minimum(0.0, room(v)) - 1e-9
+        rm = float(np.max(radii))
+        floor_p = np.minimum(0.0, half - rm * np.abs(n @ v) - self.knuckle_need / 2) - 1e-9
         better = [i for i in order if i != 0 and worst[i] < worst[0] - 1e-12]   # least twist first
+
+        def deg(i):
+            return math.degrees(math.asin(min(1.0, float(worst[i]))))
+        # the least twisted clear pin with a yoke on both sides; on one side only (ONE_SIDED_TWIST),
+        # taken when the first twists more than ONE_SIDED_ABOVE and it by ONE_SIDED_GAIN less
+        both = one = None
         for b in range(0, len(better), 24):       # in batches: the first few usually settle it
             ix = np.array(better[b:b + 24])
-            ok = np.all(np.abs(cand[ix] @ n.T) * float(np.max(radii)) <= (half - self.knuckle_need / 2 - floor_p), axis=1)
-            ok &= np.all(self._clearances_many(center, cand[ix], ob, radii, near) >= floor, axis=1)
-            if ok.any():
-                i = ix[np.argmax(ok)]
-                return cand[i] / np.linalg.norm(cand[i])
-        return v
+            if one is not None and deg(ix[0]) > max(ONE_SIDED_ABOVE, deg(one[0]) + ONE_SIDED_GAIN):
+                break               # no pin with both sides left to beat the one-sided one
+            proj = cand[ix] @ n.T                                            # (k, len(P))
+            cl = self._clear_r(cand[ix], posed, len(near), r_all)            # (k, near, r)
+            oks = {}
+            for mode in (("both", "+", "-") if sides and one is None else ("both",)):
+                reach = rm * (np.abs(proj) if mode == "both" else np.maximum(0.0, proj if mode == "+" else -proj))
+                ok = np.all(reach <= (half - self.knuckle_need / 2 - floor_p), axis=1)
+                oks[mode] = ok & np.all(cl[:, :, cols[mode]].min(axis=2) >= floor, axis=1)
+            if "+" in oks and (oks["+"] | oks["-"]).any():
+                j = int(np.argmax(oks["+"] | oks["-"]))
+                one = (ix[j], "+" if oks["+"][j] else "-")
+            if oks["both"].any():
+                both = ix[int(np.argmax(oks["both"]))]
+                break
+        tb = deg(0) if both is None else deg(both)
+        if one is not None and tb > ONE_SIDED_ABOVE and deg(one[0]) < tb - ONE_SIDED_GAIN:
+            return cand[one[0]] / np.linalg.norm(cand[one[0]]), one[1]
+        if both is None:
+            return keep
+        vv = cand[both] / np.linalg.norm(cand[both])
+        return (vv, "both") if sides else vv
 
     def choose(self, center, u, v, cb: str, ob: str, radii) -> np.ndarray:
         if not self.state_T:
