@@ -44,7 +44,10 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
-CASES = {"tetris": ("examples/tetris.tt", None), "expr": (None, "(a & b) | c")}
+CASES = {"tetris": ("examples/tetris.tt", None), "expr": (None, "(a & b) | c"),
+         # the README's robot: mlc compile examples/tetris.tt --robot examples/tetris.robot.yaml
+         "tetris_robot": ("examples/tetris.tt", None)}
+ROBOTS = {"tetris_robot": "examples/tetris.robot.yaml"}
 #: twists a printed cardan takes in its holes' clearance: whole twist on one pin, shared (deg)
 TWIST_ONE_PIN, TWIST_SHARED = 4.8, 7.6
 
@@ -202,7 +205,14 @@ def main(argv=None) -> int:
     for case in args.case:
         path, expr = CASES[case]
         t0 = time.perf_counter()
-        scene = pipeline.build(pipeline.compile_spec(pipeline.load(str(ROOT / path) if path else None, expr))).circuit.scene
+        from mlc.circuit.build import CircuitOptions
+        from mlc.robot.build import CIRCUIT_END_DROP
+        opts = CircuitOptions(end_drop=CIRCUIT_END_DROP) if case in ROBOTS else None     # as mlc compile --robot
+        scene = pipeline.build(pipeline.compile_spec(pipeline.load(str(ROOT / path) if path else None, expr)),
+                               options=opts).circuit.scene
+        if case in ROBOTS:       # the circuit, the skeleton and the levers as one scene
+            from mlc.commands.robot import robot_files
+            scene, _ = robot_files(scene, str(ROOT / ROBOTS[case]))
         res = {"joints": [], "branches": [], "mechanisms": []}
         for m in split_mechanisms(scene):
             sub = sub_scene(scene, m.bodies, m.scene.name)
