@@ -54,6 +54,13 @@ junction gets one too when it hangs on a half unit, or a tap stop (:func:`_lever
 when it hangs on a gate's output lever.  ``SLACK_FRACTION`` > 0 lengthens the chains so
 that none spans more than that fraction of its length in any row (section 2.4; off).
 
+**Two chains on one output** (docs/robot.md section 2.2).  The second chain leaves on a page: a
+half unit with long input posts, turned about its pair's axis.  With ``PAGE_ON_CHAIN`` (session 51)
+the page hangs on the first chain's first half unit's output pair, beside that chain's next half
+unit (a branch on a half unit, as the circuit's pages hang on a source half unit), so the gate's
+output lever carries the joints of one chain only; the page then gets NOT the output (the half unit
+inverts), and its chain is even.  Off, the page hangs on the output pair itself (session 8).
+
 **Chains kept apart** (docs/robot.md section 2.6; ``AVOID_CHAINS`` = 1.5 sigma, on since
 session 11).  Every chain after the first is routed with the router's ``avoid`` term, at least
 ``AVOID_CHAINS`` from the body centres of the chains placed before; if no start gives a
@@ -117,6 +124,9 @@ WRIST_POST = 1.5                   # sigma: the wrist half units' input posts (t
 WRIST_POSTS: dict = {}             # DOF name -> its own wrist posts (sigma), e.g. {"u4_up": 1.0} (probe)
 AVOID_CHAINS = 1.5                 # sigma, >0: routes pushed this far from the chains placed before, a start whose route
                                    # is not clear (of the others or of itself) falling back to the plain route (docs/robot.md 2.6)
+PAGE_ON_CHAIN = True               # a second chain on one output pair leaves on a page hung on the first chain's first
+                                   # half unit (a branch on a half unit, which the mesher prints as one joint part),
+                                   # not on the output pair itself (session 51; False: the session-8 page on the pair)
 CHAIN_STOPS = True                 # junction stops in the coupling chains (session 10, with the wrist; without
                                    # the wrist static row 11 of the Tetris robot folds wrong: docs/robot.md 2.2, 2.4, 6)
 
@@ -284,6 +294,51 @@ def _join_aligned(name: str, a: Pair, b: Pair, k: float) -> list[Bond]:
         return join(name, a, b, k)
     return [Bond(f"{name}_lo", a.lo, b.hi, k, 0.0, 0.0, "universal", f"{name}_lo"),
             Bond(f"{name}_hi", a.hi, b.lo, k, 0.0, 0.0, "universal", f"{name}_hi")]
+
+
+def page_contact_bend(geo, post: float, lower_post: float | None = None, step: float = 0.25) -> float:
+    """The bend (rad) at which a page hung on a half unit's output pair, its input posts
+    ``post`` long, first meets that half unit's layer (whose output posts are ``lower_post``,
+    g/2 when None), both turning about the pair's axis.  In the plane normal to the axis each
+    layer is a rectangle: ``width`` thick along its tangent, from its post's end, and the
+    layer's reach (the largest half diagonal) to either side; the two are tested by
+    separating axes every ``step`` degrees.  For ``post`` = ``lower_post`` = g/2 this is the
+    junction's :func:`mlc.gates.connector.max_bend` (to the step)."""
+    a = 0.5 * geo.gap if lower_post is None else float(lower_post)
+    r, w = geo.reach, geo.width
+    low = np.array([[-a - w, -r], [-a, -r], [-a, r], [-a - w, r]])
+    up0 = np.array([[post, -r], [post + w, -r], [post + w, r], [post, r]])
+
+    def apart(P, Q):
+        for poly in (P, Q):
+            for i in range(4):
+                e = poly[(i + 1) % 4] - poly[i]
+                n = np.array([-e[1], e[0]])
+                if (P @ n).max() <= (Q @ n).min() + 1e-12 or (Q @ n).max() <= (P @ n).min() + 1e-12:
+                    return True
+        return False
+
+    for deg in np.arange(0.0, 180.0 + 1e-9, step):
+        b = math.radians(deg)
+        R = np.array([[math.cos(b), -math.sin(b)], [math.sin(b), math.cos(b)]])
+        if not apart(low, up0 @ R.T):
+            return b
+    return math.pi
+
+
+def page_stop(name: str, lower: str, page: str, geo, post: float, k: float) -> list[Bond]:
+    """A junction stop (:func:`mlc.gates.connector.junction_stops`: a flat-bottom bond between
+    ``lower``'s ``stop_out`` and ``page``'s ``stop_in``, 2 m cos(beta/2) apart at a bend beta) for
+    a page hung on half unit ``lower``'s output pair with input posts ``post`` long: free up to
+    STOP_FRACTION of the bend at which the page meets ``lower``'s layer
+    (:func:`page_contact_bend`), where a chain junction's is free up to STOP_FRACTION of
+    :func:`mlc.gates.connector.max_bend`.  Units: sigma, k0."""
+    from mlc.gates.connector import STOP_FRACTION
+    m = STOP_ARM
+    d_stop = 2.0 * m * math.cos(0.5 * STOP_FRACTION * page_contact_bend(geo, post))
+    d_free = 2.0 * m + 0.5
+    return [Bond(name, f"{lower}_DA.stop_out", f"{page}_AB.stop_in", k, 0.5 * (d_stop + d_free),
+                 0.5 * (d_free - d_stop), "bond", None)]
 
 
 def _wrist(tag: str, tc, tax, state: int, geo, post: float | None = None):
@@ -527,6 +582,9 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
     placed = np.array([b.position for b in list(circuit.bodies) + bodies])
     by_body = {b.name: b for b in circuit.bodies}     # circuit bodies, some copied with a stop site
     used_pairs: set = set()                           # output pairs that already carry a chain
+    # PAGE_ON_CHAIN: output pair -> (its first chain's first half unit, that half unit's output pair, the
+    # state there, the tangent of the first chain's next half unit): where a second chain's page hangs
+    first_unit: dict = {}
     for ds, name, target, pr in targets:
         pa = cbyname[pr.a.split(".")[0]].world(pr.a.split(".", 1)[1])
         pb = cbyname[pr.b.split(".")[0]].world(pr.b.split(".", 1)[1])
@@ -564,6 +622,10 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
         # first chain's first layer; the chain goes on from the page's output pair
         shared = (pr.a, pr.b) in used_pairs
         used_pairs.add((pr.a, pr.b))
+        # PAGE_ON_CHAIN (session 51): the page hangs on the first chain's first half unit, beside that chain's
+        # next half unit (a branch on a half unit: the mesher prints the page's and the chain's junctions there
+        # as one joint part), not on the output pair, where a gate lever would carry two joint parts at one point
+        host = first_unit.get((pr.a, pr.b)) if (shared and PAGE_ON_CHAIN) else None
         # a chain on a half unit (a branch page): its first junction is a junction like any other, so it
         # may not be fanned out and its first bend stays within the routes' limit (past the largest
         # bend the two layers interpenetrate: 0.047 sigma in the tiny robot at a 50-degree limit)
@@ -577,7 +639,18 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
             from mlc.geometry.rotation import expmap
             tv = expmap(start.axis * math.radians(fan)) @ t0v
             pg = None
-            if shared:
+            if host is not None:
+                # turned by fan about the half unit's output axis from the first chain's next half unit
+                # (so the posts are those of two pages fan apart); the half unit inverts: the page gets
+                # NOT the output, gives the output, and the chain from it is even (as an unshared chain)
+                h_pre, h_pair, h_state, h_t1 = host
+                tv = expmap(h_pair.axis * math.radians(fan)) @ h_t1
+                post = max(geo.branch_post, geo.reach / math.tan(0.5 * math.radians(abs(fan))) + 0.25) + PAGE_CLEAR
+                pg, pin, pout = half_unit_parts(f"{tag}_pg", h_pair.centre, h_pair.axis, tv, h_state, geo,
+                                                in_post=post)
+                pg.bonds += join(f"{tag}_pg_j", h_pair, pin, geo.k)
+                c_start, parity, cstate, free, sb = pout, 0, 1 - h_state, True, BEND_FRACTION * max_bend(geo)
+            elif shared:
                 post = max(geo.branch_post, geo.reach / math.tan(0.5 * math.radians(abs(fan))) + 0.25) + PAGE_CLEAR
                 pg, pin, pout = half_unit_parts(f"{tag}_pg", start.centre, start.axis, tv, sstate, geo, in_post=post,
                                                 in_stop=LEVER_STOP if on_lever else POST_WIDTH)
@@ -622,22 +695,27 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
             depth = _chain_overlap(list(by_body.values()) + bodies + parts_bodies,
                                    list(circuit.bonds) + bonds + parts_bonds, parts, first + ends)
             if depth <= 0.0:
-                found = (route, parts, pairs, c_start, pg is not None, tv, fan, avoid)
+                found = (route, parts, pairs, c_start, pg is not None, tv, fan, avoid, post if pg else None)
                 break
             if fallback is None or depth < fallback[0]:
-                fallback = (depth, (route, parts, pairs, c_start, pg is not None, tv, fan, avoid))
+                fallback = (depth, (route, parts, pairs, c_start, pg is not None, tv, fan, avoid, post if pg else None))
         if found is None and fallback is not None:      # every start overlaps: the least (mlc verify reports it)
             found = fallback[1]
         if found is None:
             raise MlcError(f"cannot route output {ds.output} to dof {name}: no connector chain reaches it "
                            "clear of the others", ds.loc, "this is a placement limit of mlc; try a larger skeleton height")
-        route, parts, pairs, c_start, paged, tv, fan, avoid = found
+        route, parts, pairs, c_start, paged, tv, fan, avoid, pg_post = found
+        if not shared:
+            first_unit[(pr.a, pr.b)] = (f"{tag}_0", pairs[1], 1 - sstate,      # (an unshared chain starts on the pair)
+                                        (pairs[2].centre - pairs[1].centre) / geo.pitch)
         new_c = np.array([b.position for b in parts.bodies])
         placed = np.vstack([placed, new_c])
         parts.bonds += join(f"{tag}_j0", c_start, pairs[0], geo.k)
         if CHAIN_STOPS and paged:                      # the junction after the page
             parts.bonds += junction_stops(f"{tag}_s0", f"{tag}_pg", f"{tag}_0", geo, geo.k)
-        if CHAIN_STOPS and not on_lever and not paged:  # on a half unit (a branch page): its junction stop
+        if CHAIN_STOPS and paged and host is not None:  # the page on the first chain's half unit: its stop
+            parts.bonds += page_stop(f"{tag}_sp", host[0], f"{tag}_pg", geo, pg_post, geo.k)
+        elif CHAIN_STOPS and not on_lever and not paged:  # on a half unit (a branch page): its junction stop
             parts.bonds += junction_stops(f"{tag}_s0", half_unit_prefix(start), f"{tag}_0", geo, geo.k)
         elif CHAIN_STOPS and on_lever:                 # on a gate's lever: the tap stop (of the page or the chain)
             lname = start.lo.split(".")[0]
@@ -655,7 +733,8 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
             WRIST_UNITS * (WRIST_POSTS.get(name, WRIST_POST) + geo.width + 0.5 * geo.gap) if WRIST else 0.0)   # sigma
         n_half += nh
         next(d for d in dofs_meta if d["name"] == name)["chain"] = {
-            "half_units": nh, "prefix": tag, "page": paged, "fan_deg": fan, "avoid": avoid, "route_seconds": round(time.perf_counter() - tr, 2),
+            "half_units": nh, "prefix": tag, "page": paged,
+            "page_on": (host[0] if host is not None else start.lo.split(".")[0]) if paged else None, "fan_deg": fan, "avoid": avoid, "route_seconds": round(time.perf_counter() - tr, 2),
             "reach_max": round(max(d_rows), 3), "wrist_units": WRIST_UNITS if WRIST else 0,
             "contour": round(contour, 3), "reach_fraction": round(max(d_rows) / contour, 3)}
     rmeta = spec.as_dict()
