@@ -79,3 +79,34 @@ def test_short_page_posts_overlap_and_are_reported(pair_dir, monkeypatch):
     rep = clearance(sc)
     assert not rep.ok()
     assert any(a.startswith("rc_u2_dn_pg") or b.startswith("rc_u2_dn_pg") for a, b, _ in rep.overlaps)
+
+
+@pytest.mark.parametrize("on_chain", [True, False])
+def test_second_chain_page_hangs_on_the_first_chains_half_unit(pair_dir, monkeypatch, on_chain):
+    """PAGE_ON_CHAIN (docs/robot.md 2.2, session 51): the second chain's page hangs on the first
+    chain's first half unit (a branch on a half unit), so the gate lever's output sites carry the
+    joints of one chain only; the old build (PAGE_ON_CHAIN off) hangs both on the lever."""
+    monkeypatch.setattr(rb, "PAGE_ON_CHAIN", on_chain)
+    sc = _build(pair_dir)
+    pr = {p.name: p for p in sc.probes}["u1_up"]
+    lever_sites = {pr.a, pr.b}
+    assert not any(s.split(".")[0].startswith("rc_") for s in lever_sites)      # a gate's output lever
+    on_lever = {bd.name for bd in sc.bonds if bd.kind == "universal" and (bd.a in lever_sites or bd.b in lever_sites)
+                and bd.name.startswith("rc_")}
+    chains = {n.split("_j")[0].split("_pg")[0] for n in on_lever}
+    pg = {bd.name: bd for bd in sc.bonds if bd.name.startswith("rc_u2_dn_pg_j_")}
+    assert len(pg) == 2
+    meta = {d["name"]: d["chain"] for d in sc.meta["robot"]["dofs"] if d.get("chain")}
+    if on_chain:
+        assert chains == {"rc_u1_up"} and len(on_lever) == 2
+        assert {bd.a for bd in pg.values()} == {"rc_u1_up_0_DA.D", "rc_u1_up_0_BC.B"}
+        assert meta["u2_dn"]["page_on"] == "rc_u1_up_0"
+        # the page's stop on that half unit is free as built
+        by = {b.name: b for b in sc.bodies}
+        st = next(bd for bd in sc.bonds if bd.name == "rc_u2_dn_sp")
+        d = float(((by[st.a.split(".")[0]].world(st.a.split(".", 1)[1])
+                    - by[st.b.split(".")[0]].world(st.b.split(".", 1)[1])) ** 2).sum() ** 0.5)
+        assert st.a == "rc_u1_up_0_DA.stop_out" and abs(d - st.rest) <= st.tolerance
+    else:
+        assert chains == {"rc_u1_up", "rc_u2_dn"} and len(on_lever) == 4
+    assert clearance(sc).ok()
