@@ -583,7 +583,7 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
     by_body = {b.name: b for b in circuit.bodies}     # circuit bodies, some copied with a stop site
     used_pairs: set = set()                           # output pairs that already carry a chain
     # PAGE_ON_CHAIN: output pair -> (its first chain's first half unit, that half unit's output pair, the
-    # state there, the tangent of the first chain's next half unit): where a second chain's page hangs
+    # state there, that half unit's tangent, the first chain's next half unit's): where a second chain's page hangs
     first_unit: dict = {}
     for ds, name, target, pr in targets:
         pa = cbyname[pr.a.split(".")[0]].world(pr.a.split(".", 1)[1])
@@ -640,12 +640,15 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
             tv = expmap(start.axis * math.radians(fan)) @ t0v
             pg = None
             if host is not None:
-                # turned by fan about the half unit's output axis from the first chain's next half unit
-                # (so the posts are those of two pages fan apart); the half unit inverts: the page gets
-                # NOT the output, gives the output, and the chain from it is even (as an unshared chain)
-                h_pre, h_pair, h_state, h_t1 = host
-                tv = expmap(h_pair.axis * math.radians(fan)) @ h_t1
-                post = max(geo.branch_post, geo.reach / math.tan(0.5 * math.radians(abs(fan))) + 0.25) + PAGE_CLEAR
+                # turned by fan about the half unit's output axis from the half unit's own tangent, as the
+                # circuit's pages from their source's (at 90 degrees the page's arm then lies on the mesher's
+                # branch-junction pin); its posts those of two pages as far apart as it and the first chain's
+                # next half unit; the half unit inverts: the page gets NOT the output, gives the output, and
+                # the chain from it is even (as an unshared chain)
+                h_pre, h_pair, h_state, h_t0, h_t1 = host
+                tv = expmap(h_pair.axis * math.radians(fan)) @ h_t0
+                apart = math.acos(float(np.clip(tv @ h_t1, -1.0, 1.0)))
+                post = max(geo.branch_post, geo.reach / math.tan(0.5 * max(apart, 1e-3)) + 0.25) + PAGE_CLEAR
                 pg, pin, pout = half_unit_parts(f"{tag}_pg", h_pair.centre, h_pair.axis, tv, h_state, geo,
                                                 in_post=post)
                 pg.bonds += join(f"{tag}_pg_j", h_pair, pin, geo.k)
@@ -707,6 +710,7 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
         route, parts, pairs, c_start, paged, tv, fan, avoid, pg_post = found
         if not shared:
             first_unit[(pr.a, pr.b)] = (f"{tag}_0", pairs[1], 1 - sstate,      # (an unshared chain starts on the pair)
+                                        (pairs[1].centre - pairs[0].centre) / geo.pitch,
                                         (pairs[2].centre - pairs[1].centre) / geo.pitch)
         new_c = np.array([b.position for b in parts.bodies])
         placed = np.vstack([placed, new_c])
