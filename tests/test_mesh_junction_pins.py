@@ -84,107 +84,92 @@ def test_a_bent_junction_passes_the_states_check(bent):
     assert all(c.ok for c in rep.checks if c.blocking), [(c.name, c.failures[:3]) for c in rep.checks if not c.ok]
 
 
-def test_the_least_twisted_pin_keeps_its_yoke_clear_of_other_bodies():
-    # O turns by 10 degrees about x relative to C (u = z): the pin along x is not twisted, the
-    # pin along y by 10 degrees.  A third body's slab at the knuckles along x rules x out.
+# The unit tests of least_twist below: C holds the first pin u = z, O the second (v = y as
+# laid out), and O turns by 10 degrees about x relative to C: the pin along x is not twisted,
+# the pin along y by 10 degrees.  Profile-like sizes (mm): knuckle R, clearance c, slab t.
+R_, C_, T_ = 1.0, 0.2, 0.8
+CENTER = np.zeros(3)
+U, V, XA = np.array([0.0, 0, 1]), np.array([0.0, 1, 0]), np.array([1.0, 0, 0])
+RADII = np.array([2.0, 2.5, 3.0])
+FAR = np.array([[0.0, 0.0, -40.0]])
+
+
+def _turn_x():
     from mlc.geometry.rotation import expmap
-    R, c, t = 1.0, 0.2, 0.8
-    center = np.zeros(3)
-    u, v = np.array([0.0, 0, 1]), np.array([0.0, 1, 0])
-    radii = np.array([2.0, 2.5, 3.0])
     To = np.eye(4)
-    To[:3, :3] = expmap(np.array([1.0, 0, 0]) * np.radians(10.0))
-    far = np.array([[0.0, 0.0, -40.0]])
+    To[:3, :3] = expmap(XA * np.radians(10.0))
+    return To
 
-    def pick(X):
-        base = {"C": far, "O": far + 1.0, "X": X}
-        state_T = [("0", {"C": np.eye(4), "O": np.eye(4), "X": np.eye(4)}),
-                   ("1", {"C": np.eye(4), "O": To, "X": np.eye(4)})]
-        pc = B._PinClearance(base, state_T, R, c, t, 10.0)
-        return pc, pc.least_twist(center, u, v, "C", "O", radii)
 
-    def twist(p):
-        return np.degrees(np.arcsin(abs(float(u @ (To[:3, :3] @ p)))))
+def _pins(third: str, X) -> "B._PinClearance":
+    """A _PinClearance over rest and the 10-degree turn, with a third body ``third`` whose
+    slab samples are ``X`` (mm)."""
+    state_T = [("0", {"C": np.eye(4), "O": np.eye(4), third: np.eye(4)}),
+               ("1", {"C": np.eye(4), "O": _turn_x(), third: np.eye(4)})]
+    return B._PinClearance({"C": FAR, "O": FAR + 1.0, third: X}, state_T, R_, C_, T_, 10.0)
 
-    pc, p = pick(far - 2.0)                 # nothing near: the pin along x
-    assert abs(abs(p[0]) - 1) < 1e-9 and twist(p) < 1e-6
+
+def _twist(p) -> float:
+    return float(np.degrees(np.arcsin(abs(float(U @ (_turn_x()[:3, :3] @ p))))))
+
+
+def test_the_least_twisted_pin_keeps_its_yoke_clear_of_other_bodies():
+    # A third body's slab at the knuckles along x rules x out.
+    pc = _pins("X", FAR - 2.0)                 # nothing near: the pin along x
+    p = pc.least_twist(CENTER, U, V, "C", "O", RADII)
+    assert abs(abs(p[0]) - 1) < 1e-9 and _twist(p) < 1e-6
     # a slab across the x axis at 2.5 mm either side of the joint
     s = np.linspace(-1.0, 1.0, 9)
-    X = np.array([[sx * 2.5, y, z] for sx in (-1, 1) for y in s for z in s])
-    pc, p = pick(X)
-    near = pc._near(center, "C", "O")
-    assert pc._score(center, np.array([1.0, 0, 0]), "O", radii, near) < 0    # x is not clear
-    assert pc._score(center, p, "O", radii, near) >= 0                       # the pin chosen is
-    assert abs(float(p @ u)) < 1e-12 and abs(np.linalg.norm(p) - 1) < 1e-12
-    assert 0 < twist(p) < twist(v) - 1.0, (twist(p), twist(v))
+    pc = _pins("X", np.array([[sx * 2.5, y, z] for sx in (-1, 1) for y in s for z in s]))
+    p = pc.least_twist(CENTER, U, V, "C", "O", RADII)
+    near = pc._near(CENTER, "C", "O")
+    assert pc._score(CENTER, XA, "O", RADII, near) < 0                       # x is not clear
+    assert pc._score(CENTER, p, "O", RADII, near) >= 0                       # the pin chosen is
+    assert abs(float(p @ U)) < 1e-12 and abs(np.linalg.norm(p) - 1) < 1e-12
+    assert 0 < _twist(p) < _twist(V) - 1.0, (_twist(p), _twist(V))
 
 
 def test_the_least_twisted_pin_keeps_clear_of_a_yoke_laid_out_after_it():
     # Session 51: the half-way rule alone let one yoke of a junction's pair turn into the line
     # of the other's, laid out after it (0.155 mm as printed in the Tetris circuit).  A joint
     # not laid out yet counts with its untwisted yoke (``pending``); the joint's own entry not.
-    from mlc.geometry.rotation import expmap
-    R, c, t = 1.0, 0.2, 0.8
-    center = np.zeros(3)
-    u, v, x = np.array([0.0, 0, 1]), np.array([0.0, 1, 0]), np.array([1.0, 0, 0])
-    radii = np.array([2.0, 2.5, 3.0])
-    To = np.eye(4)
-    To[:3, :3] = expmap(x * np.radians(10.0))
-    far = np.array([[0.0, 0.0, -40.0]])
-    base = {"C": far, "O": far + 1.0, "Y": far - 1.0}
-    state_T = [("0", {"C": np.eye(4), "O": np.eye(4), "Y": np.eye(4)}),
-               ("1", {"C": np.eye(4), "O": To, "Y": np.eye(4)})]
-    pc = B._PinClearance(base, state_T, R, c, t, 10.0)
+    pc = _pins("Y", FAR - 1.0)
     # the joint's own untwisted yoke, and another joint's 1 mm above it along x (on body Y)
-    pc.pending = {"J1": ("Y", center, v), "J2": ("Y", np.array([0.0, 0, 1.0]), x)}
-    p = pc.least_twist(center, u, v, "C", "O", radii, "J1")
-    kn = np.r_[radii, -radii]
-    theirs = np.array([0.0, 0, 1.0]) + np.outer(kn, x)
+    pc.pending = {"J1": ("Y", CENTER, V), "J2": ("Y", np.array([0.0, 0, 1.0]), XA)}
+    p = pc.least_twist(CENTER, U, V, "C", "O", RADII, "J1")
+    kn = np.r_[RADII, -RADII]
+    theirs = np.array([0.0, 0, 1.0]) + np.outer(kn, XA)
     gap = np.linalg.norm((np.outer(kn, p))[:, None] - theirs[None], axis=2).min()
     assert gap >= pc.knuckle_need - 1e-9, gap               # clear of J2's yoke (x: 1 mm)
-    assert abs(float(p @ u)) < 1e-12 and abs(float(p @ x)) < 0.99
-    assert np.degrees(np.arcsin(abs(float(u @ (To[:3, :3] @ p))))) < 10.0 - 1.0     # still turned
+    assert abs(float(p @ U)) < 1e-12 and abs(float(p @ XA)) < 0.99
+    assert _twist(p) < 10.0 - 1.0                           # still turned
     # without J2 pending: the pin along x, the untwisted one
-    pc.pending = {"J1": ("Y", center, v)}
-    p = pc.least_twist(center, u, v, "C", "O", radii, "J1")
-    assert abs(abs(float(p @ x)) - 1) < 1e-9
+    pc.pending = {"J1": ("Y", CENTER, V)}
+    p = pc.least_twist(CENTER, U, V, "C", "O", RADII, "J1")
+    assert abs(abs(float(p @ XA)) - 1) < 1e-9
     # laid out: a joint leaves pending
-    pc.add("O", center, p, radii, "J1")
+    pc.add("O", CENTER, p, RADII, "J1")
     assert pc.pending == {}
 
 
 def test_a_one_sided_yoke_takes_the_least_twisted_pin_when_only_its_side_is_clear():
-    # Session 51: the pin along x is not twisted (O turns 10 degrees about x), but a third
-    # body's slab stands across the x axis on its -x side only.  A yoke on both sides of the
-    # hub must turn away from x (twisted by about 8 degrees); a one-sided yoke on +x, its pin
-    # capped, keeps the untwisted pin.  Without the cap's reach (cap_r) only the first is tried.
-    from mlc.geometry.rotation import expmap
-    R, c, t = 1.0, 0.2, 0.8
-    center = np.zeros(3)
-    u, v, x = np.array([0.0, 0, 1]), np.array([0.0, 1, 0]), np.array([1.0, 0, 0])
-    radii = np.array([2.0, 2.5, 3.0])
-    To = np.eye(4)
-    To[:3, :3] = expmap(x * np.radians(10.0))
-    far = np.array([[0.0, 0.0, -40.0]])
+    # Session 51: the pin along x is not twisted, but a third body's slab stands across the x
+    # axis on its -x side only.  A yoke on both sides of the hub must turn away from x (twisted
+    # by about 8 degrees); a one-sided yoke on +x, its pin capped, keeps the untwisted pin.
+    # Without the cap's reach (cap_r) only the first is tried.
     s = np.linspace(-1.0, 1.0, 9)
     X = np.array([[-2.5, y, z] for y in s for z in s])
-    state_T = [("0", {"C": np.eye(4), "O": np.eye(4), "X": np.eye(4)}),
-               ("1", {"C": np.eye(4), "O": To, "X": np.eye(4)})]
-
-    def twist(p):
-        return np.degrees(np.arcsin(abs(float(u @ (To[:3, :3] @ p)))))
-    pc = B._PinClearance({"C": far, "O": far + 1.0, "X": X}, state_T, R, c, t, 10.0)
-    p_both = pc.least_twist(center, u, v, "C", "O", radii)
-    assert twist(p_both) > B.ONE_SIDED_ABOVE + B.ONE_SIDED_GAIN, twist(p_both)
-    p, mode = pc.least_twist(center, u, v, "C", "O", radii, cap_r=3.8)
+    pc = _pins("X", X)
+    p_both = pc.least_twist(CENTER, U, V, "C", "O", RADII)
+    assert _twist(p_both) > B.ONE_SIDED_ABOVE + B.ONE_SIDED_GAIN, _twist(p_both)
+    p, mode = pc.least_twist(CENTER, U, V, "C", "O", RADII, cap_r=3.8)
     side = {"+": 1.0, "-": -1.0}[mode]                      # the knuckles lie along side * p: +x
-    assert abs(side * float(p @ x) - 1) < 1e-9 and twist(p) < 1e-6, (p, mode)
+    assert abs(side * float(p @ XA) - 1) < 1e-9 and _twist(p) < 1e-6, (p, mode)
     # its knuckles and cap are clear of X; the other side's would not be
-    near = pc._near(center, "C", "O")
-    assert pc._clearances_many(center, p[None], "O", radii, near, side * np.r_[radii, 3.8]).min() >= 0
-    assert pc._clearances_many(center, p[None], "O", radii, near).min() < 0
+    near = pc._near(CENTER, "C", "O")
+    assert pc._clearances_many(CENTER, p[None], "O", RADII, near, side * np.r_[RADII, 3.8]).min() >= 0
+    assert pc._clearances_many(CENTER, p[None], "O", RADII, near).min() < 0
     # a slab on both sides of x: no one-sided yoke either, the pin with both sides as before
-    X2 = np.concatenate([X, X * [-1, 1, 1]])
-    pc = B._PinClearance({"C": far, "O": far + 1.0, "X": X2}, state_T, R, c, t, 10.0)
-    p, mode = pc.least_twist(center, u, v, "C", "O", radii, cap_r=3.8)
-    assert mode == "both" and abs(float(p @ x)) < 0.99
+    pc = _pins("X", np.concatenate([X, X * [-1, 1, 1]]))
+    p, mode = pc.least_twist(CENTER, U, V, "C", "O", RADII, cap_r=3.8)
+    assert mode == "both" and abs(float(p @ XA)) < 0.99
