@@ -234,7 +234,8 @@ def join(name: str, a: Pair, b: Pair, k: float = 1.0, tolerance: float = 0.0) ->
             universal_joint(f"{name}_hi", a.hi, b.hi, k, tolerance)]
 
 
-def junction_stops(name: str, lower: str, upper: str, geo: "ConnectorGeometry", k: float = 1.0) -> list[Bond]:
+def junction_stops(name: str, lower: str, upper: str, geo: "ConnectorGeometry", k: float = 1.0,
+                   contact: float | None = None) -> list[Bond]:
     """A flat-bottom bond that stops the junction between half units ``lower`` and
     ``upper`` (prefixes; ``upper`` hangs on ``lower``'s output pair) before their layers
     touch (docs/circuits.md section 1.2, "Junction stops").
@@ -247,9 +248,10 @@ def junction_stops(name: str, lower: str, upper: str, geo: "ConnectorGeometry", 
     rhombi's opening (the wire's state), so no solver step can jump past the stop.  The
     bond (U = k/2 max(0, |d - rest| - tol)^2) is free down to the distance at
     ``STOP_FRACTION`` of :func:`max_bend` (the closing side's contact at the larger half
-    diagonal) and stiff below.  Units: sigma, k0."""
+    diagonal) and stiff below.  ``contact``: the bend (rad) where the two layers meet, when not
+    :func:`max_bend` (a page with long posts, ``mlc.robot.build.page_stop``).  Units: sigma, k0."""
     m = STOP_ARM
-    d_stop = 2.0 * m * math.cos(0.5 * STOP_FRACTION * max_bend(geo))
+    d_stop = 2.0 * m * math.cos(0.5 * STOP_FRACTION * (max_bend(geo) if contact is None else contact))
     d_free = 2.0 * m + 0.5                          # never reached (d <= 2 m)
     rest, tol = 0.5 * (d_stop + d_free), 0.5 * (d_free - d_stop)
     return [Bond(f"{name}", f"{lower}_DA.stop_out", f"{upper}_AB.stop_in", k, rest, tol, "bond", None)]

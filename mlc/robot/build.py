@@ -333,12 +333,7 @@ def page_stop(name: str, lower: str, page: str, geo, post: float, k: float) -> l
     STOP_FRACTION of the bend at which the page meets ``lower``'s layer
     (:func:`page_contact_bend`), where a chain junction's is free up to STOP_FRACTION of
     :func:`mlc.gates.connector.max_bend`.  Units: sigma, k0."""
-    from mlc.gates.connector import STOP_FRACTION
-    m = STOP_ARM
-    d_stop = 2.0 * m * math.cos(0.5 * STOP_FRACTION * page_contact_bend(geo, post))
-    d_free = 2.0 * m + 0.5
-    return [Bond(name, f"{lower}_DA.stop_out", f"{page}_AB.stop_in", k, 0.5 * (d_stop + d_free),
-                 0.5 * (d_free - d_stop), "bond", None)]
+    return junction_stops(name, lower, page, geo, k, contact=page_contact_bend(geo, post))
 
 
 def _wrist(tag: str, tc, tax, state: int, geo, post: float | None = None):
