@@ -173,3 +173,32 @@ def test_a_one_sided_yoke_takes_the_least_twisted_pin_when_only_its_side_is_clea
     pc = _pins("X", np.concatenate([X, X * [-1, 1, 1]]))
     p, mode = pc.least_twist(CENTER, U, V, "C", "O", RADII, cap_r=3.8)
     assert mode == "both" and abs(float(p @ XA)) < 0.99
+
+
+def _wrist():
+    """20 bodies of the Tetris robot (its wrist units ``rc_u4_dn_w0..w2`` and the coupling
+    chain's last half units) and the whole robot's 22 print poses (tests/data_mesh)."""
+    from pathlib import Path
+
+    from mlc.scene.io import load_scene
+    d = Path(__file__).parent / "data_mesh"
+    z = np.load(d / "robot_wrist_poses.npz")
+    return load_scene(d / "robot_wrist.yaml"), {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
+
+
+def test_a_turned_pin_that_cuts_its_other_body_in_two_is_chosen_again(monkeypatch):
+    # session 51's one-sided yoke of rc_u4_dn_wj0_lo turned the pair's pins 40 degrees out of
+    # the wrist slabs: their trims and yoke plates left w0_AB and w0_CD each in two pieces.
+    # Built again, those two joints take the least twisted pins that leave the slabs whole.
+    sc, poses = _wrist()
+    whole = ["rc_u4_dn_w0_AB", "rc_u4_dn_w0_CD"]
+    asm = build_assembly(sc, load_profile("mjp"), poses, resolve=False)
+    pieces = {p.name: len(p.solid.decompose()) for p in asm.parts}
+    assert all(k == 1 for k in pieces.values()), {n: k for n, k in pieces.items() if k > 1}
+    again = {u.name for u in asm.ujoints
+             if any(n.startswith(f"universal joint {u.name}: its turned pin cut") for n in asm.notes)}
+    assert again == {"rc_u4_dn_wj0_lo", "rc_u4_dn_wj0_hi"}, again
+    monkeypatch.setattr(B, "UNTWIST_SPLIT", False)
+    old = build_assembly(sc, load_profile("mjp"), poses, resolve=False)
+    split = sorted(p.name for p in old.parts if len(p.solid.decompose()) > 1)
+    assert split == whole, split

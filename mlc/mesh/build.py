@@ -83,6 +83,7 @@ PIN_TWIST = True      # compound junctions: the second pin turned about the firs
 ONE_SIDED_TWIST = True   # ... with a one-sided yoke where both sides would not be clear (session 51)
 ONE_SIDED_ABOVE = 4.0    # degrees: ... only when the least twist with both sides is more than this
 ONE_SIDED_GAIN = 1.0     # degrees: ... and the one-sided yoke's twist less by at least this
+UNTWIST_SPLIT = True     # ... not to a pin that cuts the other body in pieces (built again; session 52)
 
 
 # --------------------------------------------------------------------------- primitives
@@ -246,6 +247,7 @@ class UJoint:
     mates: list = field(default_factory=list)  # branch junction: the other pages on the same joint part
     free_pin: bool = False    # O's hinges run along u, so _PinClearance chose v: its yoke plate into a
                               # rod stops over the knuckles (_yoke_plates' rod_reach)
+    turned: bool = False      # compound junction: v turned about u by least_twist
 
 
 @dataclass
@@ -399,13 +401,35 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
     :data:`REUSE_MIN_PARTS` parts; then the parts that move in one plane (a gate's lever loop) get
     print-only feet down to the bed, clear of the other parts in these poses
     (:func:`mlc.mesh.feet.add_feet`)."""
+    untwist: set = set()
     try:
-        return _build_assembly(scene, profile, poses, resolve, reuse, motion_poses)
+        while True:
+            try:
+                return _build_assembly(scene, profile, poses, resolve, reuse, motion_poses, untwist)
+            except _Untwist as e:
+                # a compound junction's turned pin left its other body in pieces: built again,
+                # those joints' pins chosen among the ones that leave it whole (session 52, below)
+                _log(f"universal joints {', '.join(sorted(e.joints))}: the turned pin cut the other body "
+                     "in pieces; built again with pins that leave it whole")
+                untwist |= e.joints
     finally:
         _LOCAL[0] = None     # primitives are built in the world again, whatever happened
 
 
-def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) -> Assembly:
+class _Untwist(Exception):
+    """Raised by :func:`_build_assembly` when the turned second pin (``least_twist``) of compound
+    junctions left their other bodies in several pieces (the trim about the pin, with the yoke
+    plates a fin across the slab: the robot's wrist slabs ``rc_u4_dn_w0_AB``/``_CD``, whose
+    junctions' pins the one-sided yoke of the pair's other joint turned 40 degrees out of the
+    slab, session 52); :func:`build_assembly` builds again, those ``joints`` turned only to pins
+    that leave their other body whole (``least_twist``'s ``severs``; else as laid out)."""
+
+    def __init__(self, joints: set):
+        super().__init__(", ".join(sorted(joints)))
+        self.joints = set(joints)
+
+
+def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, untwist=frozenset()) -> Assembly:
     prof = profile
     _LOCAL[0] = None
     s = prof.sigma_mm
@@ -625,10 +649,37 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
         W = (_extent_along(slabs[cb], center, u), _extent_along(slabs[ob], center, v))
         cap = max(kmin, prof.min_wall)
         o_mode, cap_r = "both", radii[-1] + g + cap      # cap_r: a one-sided yoke's cap end (mm)
+        v_laid = v
+        part_name = jname if jname not in bodies else f"joint_{jname}"
+
+        def make_uj(v_, lays, hub_):
+            uj_ = UJoint(jname, part_name, center, (cb, ob), (u, v_), lays, hub_, R, r_pin, r_hole,
+                         (float(np.hypot(lays[1].extent, R)) + c, float(np.hypot(lays[0].extent, R)) + c))
+            uj_.free_pin = free_v
+            uj_.turned = v_ is not v_laid
+            if compound is not None:
+                uj_.host, uj_.hub_r, uj_.collar = compound["axis"], compound["hub_r"], compound["collar"]
+                if np.isfinite(compound["dO"]):
+                    uj_.fin = compound["dO"] + t
+                    uj_.o_axis = compound["o_axis"]
+            return uj_
         if compound is not None and PIN_TWIST and ONE_SIDED_TWIST:
             # or a one-sided yoke on the turned pin, its pin capped, where a yoke on both sides
-            # would meet the pair's other joint or a slab
-            v, o_mode = pin_clear.least_twist(center, u, v, cb, ob, radii, jname, cap_r=cap_r)
+            # would meet the pair's other joint or a slab.  Built again after its turned pin
+            # left O in pieces (_Untwist): only a pin whose trim leaves O's slabs, yoke plates and
+            # knuckles whole (:func:`_severs`; a model of the body, more cautious than the build,
+            # so not asked first: asked of every pin, it refused pins at 13 other junctions of the
+            # robot's couplings whose bodies the build keeps whole, their hinges' plates holding
+            # them together, and 72 more intersections followed in the states check)
+            def sev(pin, mode):
+                uj_ = make_uj(pin, (compound["layout_c"], _compound_yoke_layout(
+                    mode, compound["hub_v"], g, ky, cap, W[1], s)), compound["hub_v"])
+                return _severs(uj_, slabs[ob], reach, t, n)
+            v, o_mode = pin_clear.least_twist(center, u, v, cb, ob, radii, jname, cap_r=cap_r,
+                                              severs=sev if jname in untwist else None)
+            if jname in untwist:
+                notes.append(f"universal joint {jname}: its turned pin cut {ob} in pieces; "
+                             + ("pin as laid out" if v is v_laid else "turned less"))
         elif compound is not None and PIN_TWIST:
             v = pin_clear.least_twist(center, u, v, cb, ob, radii, jname)
         pin_clear.add(ob, center, v, radii, jname,
@@ -640,24 +691,10 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
             hub = compound["hub_v"]
         for modes in mode_list:
             if compound is not None:
-                ly = _yoke_layout(modes[1], hub, g, ky, cap, W[1], s)
-                if ly.mode != "both":
-                    # one-sided on a compound junction: trimmed where the joint part is (ball
-                    # hub to cap), not along the whole line, which may run through O's slab
-                    # (w_y_3_56_CD cut in two, session 51)
-                    ly.cut = (-(hub / 2 + g), ly.caps[0][1]) if ly.mode == "+" else (ly.caps[0][0], hub / 2 + g)
-                lays = (compound["layout_c"], ly)
+                lays = (compound["layout_c"], _compound_yoke_layout(modes[1], hub, g, ky, cap, W[1], s))
             else:
                 lays = tuple(_yoke_layout(m, hub, g, ky, cap, W[i], s) for i, m in enumerate(modes))
-            part_name = jname if jname not in bodies else f"joint_{jname}"
-            uj = UJoint(jname, part_name, center, (cb, ob), (u, v), lays, hub, R, r_pin, r_hole,
-                        (float(np.hypot(lays[1].extent, R)) + c, float(np.hypot(lays[0].extent, R)) + c))
-            uj.free_pin = free_v
-            if compound is not None:
-                uj.host, uj.hub_r, uj.collar = compound["axis"], compound["hub_r"], compound["collar"]
-                if np.isfinite(compound["dO"]):
-                    uj.fin = compound["dO"] + t
-                    uj.o_axis = compound["o_axis"]
+            uj = make_uj(v, lays, hub)
             if best is not None and not (uj.rho[0] + uj.rho[1], modes != ("both", "both")) < best[0]:
                 continue     # its trim radii are at least these: it cannot beat the best layout
             need = _ujoint_trim_memo(memo, uj, _uj_samples(uj, base_samples, slabs, reach, t, h), state_T, t, c, h)
@@ -778,6 +815,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
     fat_guard: dict[str, tuple] = {}     # reuse only: (hard, soft or None) guards grown by GUARD_PAD
     cone_cores: dict[str, mf.Manifold] = {}  # pin: cone: what the trims never touch (knuckles, cones, rings)
     pages = {uj.bodies[1] for uj in ujoints if uj.layouts[1].holes is not None}   # branch junctions' pages
+    split_by: set = set()      # turned junctions whose other body came out in pieces (_Untwist)
     for b in scene.bodies:
         bn = b.name
         # large assemblies: every primitive and boolean of the body in its own frame (its first
@@ -986,6 +1024,10 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None) ->
             if bn in fat_guard:
                 fat_guard[bn] = tuple(None if x is None else transform_solid(x, Fb) for x in fat_guard[bn])
         parts.append(Part(bn, "body", solid, partners))
+        if UNTWIST_SPLIT and len(solid.decompose()) > 1:
+            split_by.update(uj.name for uj, side in my_uj if side == 1 and uj.turned and uj.name not in untwist)
+    if split_by:
+        raise _Untwist(split_by)
 
     for uj in ujoints:
         if not uj.primary:      # branch junction: built with its first page
@@ -1168,7 +1210,7 @@ class _PinClearance:
         return out
 
     def least_twist(self, center, u, v, cb: str, ob: str, radii, joint: str | None = None,
-                    cap_r: float | None = None):
+                    cap_r: float | None = None, severs=None):
         """The second pin of a compound junction (circuit chains): of the directions about the
         first pin ``u`` every ``TWIST_PIN_STEP`` degrees from ``v``, the one whose largest
         *twist* over the posed states is least, among those whose yoke knuckles stay as clear
@@ -1205,7 +1247,10 @@ class _PinClearance:
         away from it.  A 56-body sub-scene of the Tetris circuit (``w_b_2`` and ``w_y_3``,
         half units 55-61): largest junction twist 16.1 -> 7.3 deg, ``states`` 123 -> 3
         intersections (scratch; benchmarks/results/junction_kinematics.json: with the best pins,
-        no junction of that circuit twists by more than 6.8 deg over its 22 poses)."""
+        no junction of that circuit twists by more than 6.8 deg over its 22 poses).
+
+        ``severs(pin, mode)``, if given, is true for a pin whose yoke's trim would cut ``ob`` in
+        pieces; such a pin is passed over (session 52, :class:`_Untwist`)."""
         sides = cap_r is not None
         keep = (v, "both") if sides else v
         if not self.state_T:
@@ -1258,11 +1303,12 @@ class _PinClearance:
                 reach = rm * (np.abs(proj) if mode == "both" else np.maximum(0.0, proj if mode == "+" else -proj))
                 ok = np.all(reach <= (half - self.knuckle_need / 2 - floor_p), axis=1)
                 oks[mode] = ok & np.all(cl[:, :, cols[mode]].min(axis=2) >= floor, axis=1)
-            if "+" in oks and (oks["+"] | oks["-"]).any():
-                j = int(np.argmax(oks["+"] | oks["-"]))
-                one = (ix[j], "+" if oks["+"][j] else "-")
-            if oks["both"].any():
-                both = ix[int(np.argmax(oks["both"]))]
+            if "+" in oks:      # the first clear in order, and not refused by severs
+                one = next(((ix[j], m) for j in np.flatnonzero(oks["+"] | oks["-"]) for m in "+-"
+                            if oks[m][j] and not (severs and severs(cand[ix[j]], m))), None)
+            both = next((ix[j] for j in np.flatnonzero(oks["both"])
+                         if not (severs and severs(cand[ix[j]], "both"))), None)
+            if both is not None:
                 break
         tb = deg(0) if both is None else deg(both)
         if one is not None and tb > ONE_SIDED_ABOVE and deg(one[0]) < tb - ONE_SIDED_GAIN:
@@ -2105,6 +2151,29 @@ def _own_ends(ax: HingeAxis, bn: str) -> None:
     ax.intervals = {b: [] for b in blist}
     for b, iv in zip(layout, slots):
         ax.intervals[b].append(iv)
+
+
+def _compound_yoke_layout(mode, hub, g, k, cap, W, s) -> YokeLayout:
+    """:func:`_yoke_layout` of a compound junction's second pin: one-sided, it is trimmed where
+    the joint part is (ball hub to cap), not along the whole line, which may run through O's
+    slab (w_y_3_56_CD cut in two, session 51)."""
+    ly = _yoke_layout(mode, hub, g, k, cap, W, s)
+    if ly.mode != "both":
+        ly.cut = (-(hub / 2 + g), ly.caps[0][1]) if ly.mode == "+" else (ly.caps[0][0], hub / 2 + g)
+    return ly
+
+
+def _severs(uj: UJoint, sbs, reach, t, n) -> bool:
+    """Whether the trim about a universal joint's second pin, at its least radius, cuts the other
+    body in pieces: a model of that body, its slabs ``sbs`` with the joint's yoke plates and
+    knuckles only (the build adds the plates of its hinges, which may hold it together)."""
+    lay = uj.layouts[1]
+    knuckles = [cylinder(uj.center, uj.axes[1], a0, a1, uj.R, n) for a0, a1 in lay.own]
+    body = union([box(sb.center, sb.R, sb.size) for sb in sbs + _uj_plates(uj, 1, sbs, uj.rho[1] + reach, t)]
+                 + knuckles)
+    cut = _clean(union([subtract(body, [cylinder(uj.center, uj.axes[1], a0, a1, uj.rho[1], n, cutter=True)
+                                        for a0, a1 in _complement(lay.own, *lay.cut)])] + knuckles))
+    return len(cut.decompose()) > len(_clean(body).decompose())
 
 
 def _yoke_layout(mode, hub, g, k, cap, W, s) -> YokeLayout:
