@@ -127,6 +127,9 @@ TAP_CONTACT = math.radians(85.0)   # its first layer meets the output lever's sl
 TAP_FREE = (math.radians(10.0), math.radians(70.0))   # the tap stop's free swing about the built direction
 SOURCE_LEAN, SOURCE_TURN = 0.5, 0.3   # a chain or stub on a source leans 0.5 max_bend, turned by at most 0.3
 RISER_PITCH = 3.5           # sigma between the risers of the routes from one tap (x)
+BRANCH_TREE = True          # a fan-out to k > 2 consumers is a tree of 2-way branches, pages at -90/+90 degrees
+                            # (_branch_tree; session 52: the printed branch joint's one cross pin); False: one
+                            # k-way branch, pages at branch_angles(k) (-90..90 degrees)
 # Gates are turned by +90 degrees about z (gate x -> world y): every output pair's axis is
 # then along world x, so branch pages (turned about that axis) fan out towards -y, where
 # the routes run, and a gate's input levers reach along +-y.
@@ -223,6 +226,57 @@ def _page_stop(name: str, parts0: Parts, parts1: Parts, page0: str, page1: str, 
     d_stop, d_free = 2.0 * R * math.sin(0.5 * PAGE_MIN_ANGLE), 2.0 * R + 0.5
     return [Bond(name, f"{page0}_AB.stop_in", f"{page1}_AB.stop_in", k, 0.5 * (d_stop + d_free),
                  0.5 * (d_free - d_stop), "bond", None)]
+
+
+def _branch_split(n: int) -> tuple[int, int]:
+    """How a branch tree splits ``n`` consumers (in x order) between its two pages: the
+    first (-90 degrees, lower x) takes ``n // 2``, the second the rest."""
+    return n // 2, n - n // 2
+
+
+def _branch_tree(prefix: str, tap: Pair, t_ref, sgn: float, pol: int, zero_w: int, n: int, geo,
+                 stop_at_tap: float) -> tuple[list, list]:
+    """The pages of a fan-out to ``n`` consumers (``n >= 2``, in x order) as a tree of 2-way
+    branches (``BRANCH_TREE``; docs/circuits.md, "Branch trees"): two pages hang on ``tap``
+    (which carries polarity ``pol``; ``zero_w``: the wire's state in the all-zero row), turned
+    -90 and +90 degrees about its axis from ``t_ref`` (``sgn``: the sign that turns towards -y);
+    a page whose share of the consumers (``_branch_split``) is more than one hangs two pages of
+    its own on its output pair, -90 and +90 degrees about that pair's axis from its own tangent,
+    and so on, so that every branch junction carries two pages whose tangents are antiparallel
+    (the printed joint's one cross pin: both pages turn about it).  The pages are named
+    ``{prefix}_p0``/``_p1`` at the tap and ``{parent}_p0``/``_p1`` below; of two sub-pages the
+    one whose tangent points to lower x takes the consumers of lower x.  Returns (the starts of
+    the consumers' chains, in their order: ``(pair, polarity, free, tangent, None)`` as
+    ``_build_circuit``'s ``starts``; the pages' Parts, parents first)."""
+    angs = branch_angles(2)
+    spread = abs(angs[1] - angs[0])
+    post = max(geo.branch_post, geo.reach / math.tan(0.5 * spread) + 0.25) + PAGE_CLEAR
+    starts: list = []
+    pages: list = []
+
+    def hang(name, pair, tref, s, ppol, m, in_stop, x_order):
+        ts = [rotate(tref, pair.axis, s * a) for a in angs]
+        order = [0, 1]
+        if x_order and abs(float(ts[0][0] - ts[1][0])) > 1e-6 and ts[1][0] < ts[0][0]:
+            order = [1, 0]               # the page towards lower x takes the consumers of lower x
+        shares = dict(zip(order, _branch_split(m)))
+        subs = []
+        for k in (0, 1):
+            pname = f"{name}_p{k}"
+            parts, pin, pout = half_unit_parts(pname, pair.centre, pair.axis, ts[k], zero_w ^ ppol, geo,
+                                               in_post=post, in_stop=in_stop)
+            parts.bonds += join(f"{pname}_j", pair, pin, geo.k)
+            pages.append(parts)
+            subs.append((pname, pout, ts[k], shares[k]))
+        for k in order:
+            pname, pout, t, mk = subs[k]
+            if mk == 1:
+                starts.append((pout, ppol ^ 1, True, t, None))
+            else:
+                hang(pname, pout, t, 1.0, ppol ^ 1, mk, POST_WIDTH, True)
+
+    hang(prefix, tap, t_ref, sgn, pol, n, stop_at_tap, False)
+    return starts, pages
 
 
 def _wire_values(netlist, bits: dict) -> dict:
@@ -668,6 +722,12 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             # junction with the chain bends at most max_bend: lean less, turn less
             lean = TAP_LEAN if wire[0] == "gate" else SOURCE_LEAN * max_bend(geo)
             starts = [(tap, pol, True, rotate(t_up, tap.axis, sgn * lean), None)]
+        elif BRANCH_TREE and not (method == "fast" and len(cons) == 2):
+            # a tree of 2-way branches, pages at -90/+90 degrees (_branch_tree); for 2 consumers
+            # the same two pages, built by the same calls, as the k-way branch below
+            starts, pages = _branch_tree(f"w_{wname}", tap, t_up, sgn, pol, zero[wire], len(cons), geo, stop_at_tap)
+            deferred += pages
+            n_half += len(pages)
         else:
             starts = []
             angs = branch_angles(len(cons))
