@@ -23,8 +23,11 @@ Rules (docs/circuits.md):
   lever an input drives carries a muscle of its own, and only an output that reads an
   input directly still needs the input's source.
 * **Taps and fan-out.**  A wire's tap is a gate's output pair (or a source's).  One
-  consumer: a chain hangs on the tap.  Several: a branch: one half unit (a page) per
-  consumer hangs on the tap, turned about the tap's axis, and each page's chain goes on.
+  consumer: a chain hangs on the tap.  Several: a branch: half units (pages) hang on the
+  tap, turned about the tap's axis, and each consumer's chain goes on from a page.  With
+  ``BRANCH_TREE`` (the default) every branch has two pages, at -90 and +90 degrees, and a
+  page that serves more than one consumer hangs two pages of its own (a tree,
+  ``_branch_tree``); without it, one page per consumer hangs on the tap (``branch_angles``).
 * **Chains** are routed by inverse kinematics (:mod:`mlc.circuit.route`) from the tap
   (or page) to the consumer's input lever, arriving from below, with the parity the
   signal needs: every half unit is a NOT, so a path has an even count of them, or an
@@ -127,6 +130,8 @@ TAP_CONTACT = math.radians(85.0)   # its first layer meets the output lever's sl
 TAP_FREE = (math.radians(10.0), math.radians(70.0))   # the tap stop's free swing about the built direction
 SOURCE_LEAN, SOURCE_TURN = 0.5, 0.3   # a chain or stub on a source leans 0.5 max_bend, turned by at most 0.3
 RISER_PITCH = 3.5           # sigma between the risers of the routes from one tap (x)
+BRANCH_LEAN = 0.6           # a branch tree's chain on a page on a page (which leaves along +-x) leaves leaned by this
+                            # fraction of max_bend, up where it heads +x and down where it heads -x (_branch_tree)
 BRANCH_TREE = True          # a fan-out to k > 2 consumers is a tree of 2-way branches, pages at -90/+90 degrees
                             # (_branch_tree; session 52: the printed branch joint's one cross pin); False: one
                             # k-way branch, pages at branch_angles(k) (-90..90 degrees)
@@ -229,54 +234,68 @@ def _page_stop(name: str, parts0: Parts, parts1: Parts, page0: str, page1: str, 
 
 
 def _branch_split(n: int) -> tuple[int, int]:
-    """How a branch tree splits ``n`` consumers (in x order) between its two pages: the
-    first (-90 degrees, lower x) takes ``n // 2``, the second the rest."""
+    """How many of ``n`` consumers each page of a branch tree's node serves: the first page
+    (-90 degrees) ``n // 2``, the second the rest."""
     return n // 2, n - n // 2
 
 
 def _branch_tree(prefix: str, tap: Pair, t_ref, sgn: float, pol: int, zero_w: int, n: int, geo,
                  stop_at_tap: float) -> tuple[list, list]:
-    """The pages of a fan-out to ``n`` consumers (``n >= 2``, in x order) as a tree of 2-way
-    branches (``BRANCH_TREE``; docs/circuits.md, "Branch trees"): two pages hang on ``tap``
-    (which carries polarity ``pol``; ``zero_w``: the wire's state in the all-zero row), turned
-    -90 and +90 degrees about its axis from ``t_ref`` (``sgn``: the sign that turns towards -y);
-    a page whose share of the consumers (``_branch_split``) is more than one hangs two pages of
-    its own on its output pair, -90 and +90 degrees about that pair's axis from its own tangent,
-    and so on, so that every branch junction carries two pages whose tangents are antiparallel
-    (the printed joint's one cross pin: both pages turn about it).  The pages are named
-    ``{prefix}_p0``/``_p1`` at the tap and ``{parent}_p0``/``_p1`` below; of two sub-pages the
-    one whose tangent points to lower x takes the consumers of lower x.  Returns (the starts of
-    the consumers' chains, in their order: ``(pair, polarity, free, tangent, None)`` as
-    ``_build_circuit``'s ``starts``; the pages' Parts, parents first)."""
+    """The pages of a fan-out to ``n`` consumers (``n >= 2``) as a tree of 2-way branches
+    (``BRANCH_TREE``; docs/circuits.md, "Branch trees (session 52)"): two pages hang on
+    ``tap`` (which carries polarity ``pol``; ``zero_w``: the wire's state in the all-zero row),
+    turned -90 and +90 degrees about its axis from ``t_ref`` (``sgn``: the sign that turns
+    towards -y); a page that serves more than one consumer (``_branch_split``) hangs two pages
+    of its own on its output pair, -90 and +90 degrees about that pair's axis from its own
+    tangent, and so on, so that every branch junction carries two pages whose tangents are
+    antiparallel (the printed joint's one cross pin: both pages turn about it).  Pages are
+    named ``{prefix}_p0``/``_p1`` at the tap and ``{parent}_p0``/``_p1`` below.
+
+    A page on a page leaves along the tap's axis (world x: pages on the tap leave along
+    +-y), where a wire's risers are spaced (``RISER_PITCH``, in the consumers' x order), so
+    the leaves are handed to the consumers in the x order of the point ``RISER_PITCH`` on
+    from each leaf's output along its tangent (ties in the tree's order): a leaf that leaves
+    towards -x serves a consumer whose riser is on that side.  For 2 consumers that is the
+    k-way branch's order (page -90 degrees first).  A chain on a page on a page starts
+    leaned (``BRANCH_LEAN``, below).  Returns (the starts of the consumers' chains in that
+    order, ``(pair, polarity, free, tangent, None)`` as ``_build_circuit``'s ``starts``; the
+    pages' Parts, parents first)."""
     angs = branch_angles(2)
     spread = abs(angs[1] - angs[0])
     post = max(geo.branch_post, geo.reach / math.tan(0.5 * spread) + 0.25) + PAGE_CLEAR
-    starts: list = []
+    leaves: list = []
     pages: list = []
 
-    def hang(name, pair, tref, s, ppol, m, in_stop, x_order):
-        ts = [rotate(tref, pair.axis, s * a) for a in angs]
-        order = [0, 1]
-        if x_order and abs(float(ts[0][0] - ts[1][0])) > 1e-6 and ts[1][0] < ts[0][0]:
-            order = [1, 0]               # the page towards lower x takes the consumers of lower x
-        shares = dict(zip(order, _branch_split(m)))
+    def hang(name, pair, tref, s, ppol, m, in_stop):
         subs = []
-        for k in (0, 1):
+        for k, (a, mk) in enumerate(zip(angs, _branch_split(m))):
             pname = f"{name}_p{k}"
-            parts, pin, pout = half_unit_parts(pname, pair.centre, pair.axis, ts[k], zero_w ^ ppol, geo,
+            t = rotate(tref, pair.axis, s * a)
+            parts, pin, pout = half_unit_parts(pname, pair.centre, pair.axis, t, zero_w ^ ppol, geo,
                                                in_post=post, in_stop=in_stop)
             parts.bonds += join(f"{pname}_j", pair, pin, geo.k)
             pages.append(parts)
-            subs.append((pname, pout, ts[k], shares[k]))
-        for k in order:
-            pname, pout, t, mk = subs[k]
-            if mk == 1:
-                starts.append((pout, ppol ^ 1, True, t, None))
-            else:
-                hang(pname, pout, t, 1.0, ppol ^ 1, mk, POST_WIDTH, True)
+            subs.append((pname, pout, t, mk))
+        for pname, pout, t, mk in subs:
+            if mk > 1:
+                hang(pname, pout, t, 1.0, ppol ^ 1, mk, POST_WIDTH)
+                continue
+            t0 = t
+            if pair is not tap and abs(float(t[0])) > 0.5 and BRANCH_LEAN:
+                # a page on a page leaves along +-x, towards the chains of the next tap in its
+                # level, whose facing pages head the other way: the chain's first half unit
+                # leans by BRANCH_LEAN of the largest bend about the page's output axis, up
+                # heading +x and down heading -x, so that the two pass at different heights
+                # (the first END_JUNCTIONS junctions hardly bend: straight on they met)
+                lean = rotate(t, pout.axis, BRANCH_LEAN * max_bend(geo))
+                if (lean[2] > t[2]) != (t[0] > 0):
+                    lean = rotate(t, pout.axis, -BRANCH_LEAN * max_bend(geo))
+                t0 = lean
+            leaves.append((pout, ppol ^ 1, True, t0, None))
 
-    hang(prefix, tap, t_ref, sgn, pol, n, stop_at_tap, False)
-    return starts, pages
+    hang(prefix, tap, t_ref, sgn, pol, n, stop_at_tap)
+    key = [round(float(lf[0].centre[0] + RISER_PITCH * lf[3][0]), 6) for lf in leaves]
+    return [leaves[i] for i in sorted(range(len(leaves)), key=lambda i: (key[i], i))], pages
 
 
 def _wire_values(netlist, bits: dict) -> dict:
