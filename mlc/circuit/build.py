@@ -240,7 +240,7 @@ def _branch_split(n: int) -> tuple[int, int]:
 
 
 def _branch_tree(prefix: str, tap: Pair, t_ref, sgn: float, pol: int, zero_w: int, n: int, geo,
-                 stop_at_tap: float) -> tuple[list, list]:
+                 stop_at_tap: float, lean: float = BRANCH_LEAN) -> tuple[list, list]:
     """The pages of a fan-out to ``n`` consumers (``n >= 2``) as a tree of 2-way branches
     (``BRANCH_TREE``; docs/circuits.md, "Branch trees (session 52)"): two pages hang on
     ``tap`` (which carries polarity ``pol``; ``zero_w``: the wire's state in the all-zero row),
@@ -281,16 +281,15 @@ def _branch_tree(prefix: str, tap: Pair, t_ref, sgn: float, pol: int, zero_w: in
                 hang(pname, pout, t, 1.0, ppol ^ 1, mk, POST_WIDTH)
                 continue
             t0 = t
-            if pair is not tap and abs(float(t[0])) > 0.5 and BRANCH_LEAN:
+            if pair is not tap and abs(float(t[0])) > 0.5 and lean:
                 # a page on a page leaves along +-x, towards the chains of the next tap in its
                 # level, whose facing pages head the other way: the chain's first half unit
                 # leans by BRANCH_LEAN of the largest bend about the page's output axis, up
                 # heading +x and down heading -x, so that the two pass at different heights
                 # (the first END_JUNCTIONS junctions hardly bend: straight on they met)
-                lean = rotate(t, pout.axis, BRANCH_LEAN * max_bend(geo))
-                if (lean[2] > t[2]) != (t[0] > 0):
-                    lean = rotate(t, pout.axis, -BRANCH_LEAN * max_bend(geo))
-                t0 = lean
+                t0 = rotate(t, pout.axis, lean * max_bend(geo))
+                if (t0[2] > t[2]) != (t[0] > 0):
+                    t0 = rotate(t, pout.axis, -lean * max_bend(geo))
             leaves.append((pout, ppol ^ 1, True, t0, None))
 
     hang(prefix, tap, t_ref, sgn, pol, n, stop_at_tap)
@@ -481,18 +480,30 @@ def _build_routed(netlist, spec, options: CircuitOptions, progress) -> Circuit:
     build (once); the build kept is the one whose chains' layers would touch in no row
     (or less deeply), then whose tight chains come closest to another chain by the larger
     distance (:func:`_merit`; the first on a tie): one chain pressed into another is
-    worse than several just inside the keep-apart distance."""
+    worse than several just inside the keep-apart distance.  When both leave chains tight
+    and the circuit has branch trees whose chains lean (``BRANCH_LEAN``), the same one or
+    two builds without the lean are tried too, and the best of all is kept (session 52: the
+    lean kept the examples' chains apart, and pressed two chains of a 5-way fan-out into
+    each other, which the unleaned build keeps apart)."""
+    def tight_wires(r):
+        return tuple(dict.fromkeys(t[2:].rsplit("_", 1)[0] for t, _ in r.tight))
+
     first = _build_circuit(netlist, spec, options, progress)
     if not first.tight:
         return first.assemble()
-    wires = tuple(dict.fromkeys(t[2:].rsplit("_", 1)[0] for t, _ in first.tight))
-    second = _build_circuit(netlist, spec, options, progress, first_wires=wires)
-    if _merit(second) > _merit(first):
-        kept, other, key = second, first, "first_build"
-    else:
-        kept, other, key = first, second, "second_build"
-    c = kept.assemble()             # only the build kept is assembled
-    c.seconds[key] = sum(other.seconds.values())
+    builds = [("first_build", first),
+              ("second_build", _build_circuit(netlist, spec, options, progress, first_wires=tight_wires(first)))]
+    if first.leaned and all(r.tight for _, r in builds):
+        third = _build_circuit(netlist, spec, options, progress, lean=0.0)
+        builds.append(("unleaned_build", third))
+        if third.tight:
+            builds.append(("unleaned_second_build", _build_circuit(netlist, spec, options, progress,
+                                                                   first_wires=tight_wires(third), lean=0.0)))
+    best = max(range(len(builds)), key=lambda i: _merit(builds[i][1]))     # (the first on a tie)
+    c = builds[best][1].assemble()             # only the build kept is assembled
+    for i, (key, r) in enumerate(builds):
+        if i != best:
+            c.seconds[key] = sum(r.seconds.values())
     return c
 
 
@@ -508,6 +519,7 @@ class _Routed:
     contacts: list
     seconds: dict
     assemble: object
+    leaned: bool = False             # its branch trees' chains on pages on pages lean (BRANCH_LEAN)
 
 
 def _merit(c) -> tuple:
@@ -519,9 +531,10 @@ def _merit(c) -> tuple:
 
 
 def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, progress=None,
-                   first_wires: tuple = ()) -> _Routed:
+                   first_wires: tuple = (), lean: float = BRANCH_LEAN) -> _Routed:
     """One build, routed (its assembly deferred: :class:`_Routed`); ``first_wires`` (wire
-    names: a gate id or a circuit input) are routed first."""
+    names: a gate id or a circuit input) are routed first; ``lean``: the branch trees' lean
+    (``_branch_tree``)."""
     import time
 
     from scipy.spatial import cKDTree
@@ -713,6 +726,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     wires = [w for w in taps if consumers.get(w)]
     wires.sort(key=lambda w: w[1] not in first_wires)          # stable: the rest keep their order
     chains: list[_Chain] = []               # in routing order (routed after the loop, see _route_all)
+    leaned = False                          # a branch tree has pages on pages (their chains lean)
     for wire in wires:
         tap, pol = taps[wire]
         cons = consumers[wire]
@@ -744,7 +758,9 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         elif BRANCH_TREE and not (method == "fast" and len(cons) == 2):
             # a tree of 2-way branches, pages at -90/+90 degrees (_branch_tree); for 2 consumers
             # the same two pages, built by the same calls, as the k-way branch below
-            starts, pages = _branch_tree(f"w_{wname}", tap, t_up, sgn, pol, zero[wire], len(cons), geo, stop_at_tap)
+            starts, pages = _branch_tree(f"w_{wname}", tap, t_up, sgn, pol, zero[wire], len(cons), geo, stop_at_tap,
+                                         lean)
+            leaned = leaned or len(cons) > 2            # (pages on pages: leaves along +-x, leaned)
             deferred += pages
             n_half += len(pages)
         else:
@@ -925,7 +941,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         return Circuit(scene, origin, n_chains, n_half, dict(seconds, assemble=t_end - t_asm),
                        min((g for _, g in tight), default=float("inf")), contacts)
 
-    return _Routed(tight, min((g for _, g in tight), default=float("inf")), contacts, seconds, _assemble)
+    return _Routed(tight, min((g for _, g in tight), default=float("inf")), contacts, seconds, _assemble,
+                   leaned and lean != 0.0)
 
 
 def _check_reach(netlist, taps, consumers, by_name, level, geo, drop: float = END_DROP) -> None:
