@@ -250,14 +250,19 @@ def test_slab_points_run_along_every_slab_of_the_gates(tetris):
     assert n > 5 and len(pts) >= n * 2
 
 
-def test_five_way_branch_pages_clear_each_other():
+@pytest.mark.parametrize("tree", [False, True])
+def test_five_way_branch_pages_clear_each_other(tree, monkeypatch):
     """The input posts of a branch's pages meet at the tap's joint; from 5 pages on (45
     degrees apart) they stop farther from it, and the built circuit has no overlap
-    (it had, by 0.0117 sigma, between adjacent pages' posts)."""
+    (it had, by 0.0117 sigma, between adjacent pages' posts).  That is the k-way branch
+    (``BRANCH_TREE = False``); the default tree of 2-way branches (session 52) hangs
+    2 (k - 1) = 8 pages, 3 deep, and is clear too."""
+    from mlc.circuit import build as B
+    monkeypatch.setattr(B, "BRANCH_TREE", tree)
     spec = load(None, "f1 = a & b; f2 = a & c; f3 = a | d; f4 = ~a & e; f5 = a | e")
     c = compile_spec(spec)
     sc = build_circuit(c.netlist, spec).scene
-    assert sum(b.name.startswith("w_a_p") and b.name.endswith("_AB") for b in sc.bodies) == 5
+    assert sum(b.name.startswith("w_a_p") and b.name.endswith("_AB") for b in sc.bodies) == (8 if tree else 5)
     rep = clearance(sc)
     print("smallest clearance", rep.min_clearance, rep.pair)
     assert rep.min_clearance > 0.0, rep.pair

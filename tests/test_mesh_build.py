@@ -16,9 +16,16 @@ from mlc.scene.model import Scene
 def tetris_y_branch():
     # the Tetris circuit's branch of input y: its source half unit and the 4 pages on it (two
     # leave along the joint's second pin, two diagonally), at rest, without muscles
+    # (built with BRANCH_TREE = False, the k-way branch: since session 52 the default build
+    # hangs 2-way branches in a tree, and no page leaves diagonally)
     from mlc import pipeline
+    from mlc.circuit import build as B
     from helpers import ROOT
-    sc = pipeline.build(pipeline.compile_spec(pipeline.load(str(ROOT / "examples" / "tetris.tt"), None))).circuit.scene
+    tree, B.BRANCH_TREE = B.BRANCH_TREE, False
+    try:
+        sc = pipeline.build(pipeline.compile_spec(pipeline.load(str(ROOT / "examples" / "tetris.tt"), None))).circuit.scene
+    finally:
+        B.BRANCH_TREE = tree
     keep = {b.name for b in sc.bodies if b.name.startswith(("src_y_", "w_y_p"))}
     assert len(keep) == 20
     sub = Scene(name="y_branch", bodies=[b for b in sc.bodies if b.name in keep],
