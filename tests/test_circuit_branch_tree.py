@@ -7,6 +7,7 @@ other about that one pin, which pages at -90/+90 do (and pages at 0 or +-30 degr
 old k-way branch did not: 19-22 degrees off the pin in the Tetris circuit)."""
 import numpy as np
 import pytest
+from helpers import ROOT
 
 from mlc.circuit import build as B
 from mlc.front.load import load
@@ -102,3 +103,17 @@ def test_two_pages_turn_about_their_common_line_when_the_signal_switches(monkeyp
 def test_two_consumers_build_the_same_scene_with_or_without_the_tree(monkeypatch):
     expr = "p = a; q = a & b"
     assert dump_scene(_build(expr, True, monkeypatch)) == dump_scene(_build(expr, False, monkeypatch))
+
+
+def test_the_full_adders_two_way_branches_are_built_as_before(monkeypatch):
+    """The full adder fans out to two consumers only, from sources and from gates; gate g3's
+    output pair is posed tilted off x, so its two pages lead to different x: they keep the
+    k-way branch's order all the same (the scene is the same, bit for bit)."""
+    from mlc.circuit import build as B
+    spec = load(str(ROOT / "examples" / "full_adder.tt"), None)
+    netlist = compile_spec(spec).netlist
+    scenes = []
+    for tree in (True, False):
+        monkeypatch.setattr(B, "BRANCH_TREE", tree)
+        scenes.append(dump_scene(B.build_circuit(netlist, spec).scene))
+    assert scenes[0] == scenes[1]

@@ -255,8 +255,8 @@ def _branch_tree(prefix: str, tap: Pair, t_ref, sgn: float, pol: int, zero_w: in
     +-y), where a wire's risers are spaced (``RISER_PITCH``, in the consumers' x order), so
     the leaves are handed to the consumers in the x order of the point ``RISER_PITCH`` on
     from each leaf's output along its tangent (ties in the tree's order): a leaf that leaves
-    towards -x serves a consumer whose riser is on that side.  For 2 consumers that is the
-    k-way branch's order (page -90 degrees first).  A chain on a page on a page starts
+    towards -x serves a consumer whose riser is on that side.  For 2 consumers: the k-way
+    branch's order (page -90 degrees first).  A chain on a page on a page starts
     leaned (``BRANCH_LEAN``, below).  Returns (the starts of the consumers' chains in that
     order, ``(pair, polarity, free, tangent, None)`` as ``_build_circuit``'s ``starts``; the
     pages' Parts, parents first)."""
@@ -293,7 +293,9 @@ def _branch_tree(prefix: str, tap: Pair, t_ref, sgn: float, pol: int, zero_w: in
             leaves.append((pout, ppol ^ 1, True, t0, None))
 
     hang(prefix, tap, t_ref, sgn, pol, n, stop_at_tap)
-    key = [round(float(lf[0].centre[0] + RISER_PITCH * lf[3][0]), 6) for lf in leaves]
+    if n == 2:              # the k-way branch's order (a gate's output pair is not exactly along x)
+        return leaves, pages
+    key = [round(float(lf[0].centre[0] + RISER_PITCH * lf[3][0]), 1) for lf in leaves]     # (0.1 sigma: ties)
     return [leaves[i] for i in sorted(range(len(leaves)), key=lambda i: (key[i], i))], pages
 
 
