@@ -496,11 +496,11 @@ def _build_routed(netlist, spec, options: CircuitOptions, progress) -> Circuit:
     builds = [("first_build", first),
               ("second_build", _build_circuit(netlist, spec, options, progress, first_wires=tight_wires(first)))]
     if first.leaned and all(r.tight for _, r in builds):
-        third = _build_circuit(netlist, spec, options, progress, lean=0.0)
+        third = _build_circuit(netlist, spec, options, progress, branch_lean=0.0)
         builds.append(("unleaned_build", third))
         if third.tight:
             builds.append(("unleaned_second_build", _build_circuit(netlist, spec, options, progress,
-                                                                   first_wires=tight_wires(third), lean=0.0)))
+                                                                   first_wires=tight_wires(third), branch_lean=0.0)))
     best = max(range(len(builds)), key=lambda i: _merit(builds[i][1]))     # (the first on a tie)
     c = builds[best][1].assemble()             # only the build kept is assembled
     for i, (key, r) in enumerate(builds):
@@ -533,10 +533,10 @@ def _merit(c) -> tuple:
 
 
 def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, progress=None,
-                   first_wires: tuple = (), lean: float = BRANCH_LEAN) -> _Routed:
+                   first_wires: tuple = (), branch_lean: float = BRANCH_LEAN) -> _Routed:
     """One build, routed (its assembly deferred: :class:`_Routed`); ``first_wires`` (wire
-    names: a gate id or a circuit input) are routed first; ``lean``: the branch trees' lean
-    (``_branch_tree``)."""
+    names: a gate id or a circuit input) are routed first; ``branch_lean``: the branch trees'
+    lean (``_branch_tree``)."""
     import time
 
     from scipy.spatial import cKDTree
@@ -761,7 +761,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             # a tree of 2-way branches, pages at -90/+90 degrees (_branch_tree); for 2 consumers
             # the same two pages, built by the same calls, as the k-way branch below
             starts, pages = _branch_tree(f"w_{wname}", tap, t_up, sgn, pol, zero[wire], len(cons), geo, stop_at_tap,
-                                         lean)
+                                         branch_lean)
             leaned = leaned or len(cons) > 2            # (pages on pages: leaves along +-x, leaned)
             deferred += pages
             n_half += len(pages)
@@ -944,7 +944,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                        min((g for _, g in tight), default=float("inf")), contacts)
 
     return _Routed(tight, min((g for _, g in tight), default=float("inf")), contacts, seconds, _assemble,
-                   leaned and lean != 0.0)
+                   leaned and branch_lean != 0.0)
 
 
 def _check_reach(netlist, taps, consumers, by_name, level, geo, drop: float = END_DROP) -> None:
