@@ -131,7 +131,8 @@ TAP_FREE = (math.radians(10.0), math.radians(70.0))   # the tap stop's free swin
 SOURCE_LEAN, SOURCE_TURN = 0.5, 0.3   # a chain or stub on a source leans 0.5 max_bend, turned by at most 0.3
 RISER_PITCH = 3.5           # sigma between the risers of the routes from one tap (x)
 BRANCH_LEAN = 0.6           # a branch tree's chain on a page on a page (which leaves along +-x) leaves leaned by this
-                            # fraction of max_bend, up where it heads +x and down where it heads -x (_branch_tree)
+                            # fraction of max_bend, up where it heads +x and down where it heads -x (_branch_tree;
+                            # with the "ik" router only)
 BRANCH_TREE = True          # a fan-out to k > 2 consumers is a tree of 2-way branches, pages at -90/+90 degrees
                             # (_branch_tree; session 52: the printed branch joint's one cross pin); False: one
                             # k-way branch, pages at branch_angles(k) (-90..90 degrees)
@@ -760,9 +761,12 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         elif BRANCH_TREE and not (method == "fast" and len(cons) == 2):
             # a tree of 2-way branches, pages at -90/+90 degrees (_branch_tree); for 2 consumers
             # the same two pages, built by the same calls, as the k-way branch below
+            # (the lean with the whole solve only: the fast router's Tetris then bent a chain back
+            # into its own leaf page, -0.05 sigma; unleaned it is clear, two chains tight)
+            bl = branch_lean if method == "ik" else 0.0
             starts, pages = _branch_tree(f"w_{wname}", tap, t_up, sgn, pol, zero[wire], len(cons), geo, stop_at_tap,
-                                         branch_lean)
-            leaned = leaned or len(cons) > 2            # (pages on pages: leaves along +-x, leaned)
+                                         bl)
+            leaned = leaned or (len(cons) > 2 and bl != 0.0)     # (pages on pages: leaves along +-x, leaned)
             deferred += pages
             n_half += len(pages)
         else:
@@ -944,7 +948,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                        min((g for _, g in tight), default=float("inf")), contacts)
 
     return _Routed(tight, min((g for _, g in tight), default=float("inf")), contacts, seconds, _assemble,
-                   leaned and branch_lean != 0.0)
+                   leaned)
 
 
 def _check_reach(netlist, taps, consumers, by_name, level, geo, drop: float = END_DROP) -> None:
