@@ -663,9 +663,9 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
                     uj_.fin = compound["dO"] + t
                     uj_.o_axis = compound["o_axis"]
             return uj_
-        if compound is not None and PIN_TWIST and ONE_SIDED_TWIST:
-            # or a one-sided yoke on the turned pin, its pin capped, where a yoke on both sides
-            # would meet the pair's other joint or a slab.  Built again after its turned pin
+        if compound is not None and PIN_TWIST:
+            # (ONE_SIDED_TWIST) or a one-sided yoke on the turned pin, its pin capped, where a yoke
+            # on both sides would meet the pair's other joint or a slab.  Built again after its turned pin
             # left O in pieces (_Untwist): only a pin whose trim leaves O's slabs, yoke plates and
             # knuckles whole (:func:`_severs`; a model of the body, more cautious than the build,
             # so not asked first: asked of every pin, it refused pins at 13 other junctions of the
@@ -675,13 +675,14 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
                 uj_ = make_uj(pin, (compound["layout_c"], _compound_yoke_layout(
                     mode, compound["hub_v"], g, ky, cap, W[1], s)), compound["hub_v"])
                 return _severs(uj_, slabs[ob], reach, t, n)
-            v, o_mode = pin_clear.least_twist(center, u, v, cb, ob, radii, jname, cap_r=cap_r,
-                                              severs=sev if jname in untwist else None)
+            sv = sev if jname in untwist else None
+            if ONE_SIDED_TWIST:
+                v, o_mode = pin_clear.least_twist(center, u, v, cb, ob, radii, jname, cap_r=cap_r, severs=sv)
+            else:
+                v = pin_clear.least_twist(center, u, v, cb, ob, radii, jname, severs=sv)
             if jname in untwist:
                 notes.append(f"universal joint {jname}: its turned pin cut {ob} in pieces; "
                              + ("pin as laid out" if v is v_laid else "turned less"))
-        elif compound is not None and PIN_TWIST:
-            v = pin_clear.least_twist(center, u, v, cb, ob, radii, jname)
         pin_clear.add(ob, center, v, radii, jname,
                       r=None if o_mode == "both" else (1 if o_mode == "+" else -1) * np.r_[radii, cap_r])
         best = None
