@@ -240,6 +240,13 @@ def _branch_split(n: int) -> tuple[int, int]:
     return n // 2, n - n // 2
 
 
+def _page_post(geo, spread: float) -> float:
+    """A branch page's input post (sigma): long enough that two pages ``spread`` (rad) apart
+    about the tap clear each other's reach, at least the connector's ``branch_post``, plus
+    ``PAGE_CLEAR`` from the driving lever."""
+    return max(geo.branch_post, geo.reach / math.tan(0.5 * spread) + 0.25) + PAGE_CLEAR
+
+
 def _branch_tree(prefix: str, tap: Pair, t_ref, sgn: float, pol: int, zero_w: int, n: int, geo,
                  stop_at_tap: float, lean: float = BRANCH_LEAN) -> tuple[list, list]:
     """The pages of a fan-out to ``n`` consumers (``n >= 2``) as a tree of 2-way branches
@@ -262,8 +269,7 @@ def _branch_tree(prefix: str, tap: Pair, t_ref, sgn: float, pol: int, zero_w: in
     order, ``(pair, polarity, free, tangent, None)`` as ``_build_circuit``'s ``starts``; the
     pages' Parts, parents first)."""
     angs = branch_angles(2)
-    spread = abs(angs[1] - angs[0])
-    post = max(geo.branch_post, geo.reach / math.tan(0.5 * spread) + 0.25) + PAGE_CLEAR
+    post = _page_post(geo, abs(angs[1] - angs[0]))
     leaves: list = []
     pages: list = []
 
@@ -777,7 +783,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                 angs = list(FAST_PAIR_PAGES)
             spread = abs(angs[1] - angs[0])
             # (held pages: posts long enough for the smallest angle their stop lets them close to)
-            post = max(geo.branch_post, geo.reach / math.tan(0.5 * (PAGE_MIN_ANGLE if held else spread)) + 0.25) + PAGE_CLEAR
+            post = _page_post(geo, PAGE_MIN_ANGLE if held else spread)
             # the pages' input posts meet at the tap's joint: their ends, d from it, are
             # 2 d sin(s/2) apart, a post's width w at d = w for 4 pages (s = 60 deg; measured
             # clear, +0.0107 sigma); 5 pages at d = w overlapped by 0.0117 sigma, so from 5
