@@ -85,3 +85,22 @@ def test_memory_estimate_covers_measured_compiled_circuits():
         est = profiles.estimate_memory(prof, scene)["bytes"]
         assert est >= peak, (case, est, peak)
         assert est <= 2.5 * peak, (case, est, peak)      # and not so far above that it refuses needlessly
+
+
+def test_the_readme_robot_is_not_refused_for_its_size(tmp_path):
+    """The README's main job meshes the Tetris robot (``mlc stl out/robot/robot.yaml``); its
+    largest mechanism must be within MAX_MECHANISM_BODIES, which ``check_against_scene``
+    refuses past (session 53: with session 52's branch trees the robot's mechanism had 2669
+    bodies against a limit of 2500, and the job stopped there with exit 2)."""
+    from pathlib import Path
+
+    from mlc.cli import main
+    from mlc.mesh import profiles
+    from mlc.scene.io import load_scene
+    root = Path(__file__).resolve().parents[1]
+    assert main(["compile", str(root / "examples" / "tetris.tt"), "--robot", str(root / "examples" / "tetris.robot.yaml"),
+                 "-o", str(tmp_path / "robot")]) == 0
+    scene = load_scene(tmp_path / "robot" / "robot.yaml")
+    reps, _ = profiles._mechanisms(scene)
+    largest = max(len(b) for b in reps)
+    assert largest <= profiles.MAX_MECHANISM_BODIES, largest
