@@ -111,6 +111,11 @@ WAYPOINT_WEIGHT = 1.0       # their weight in the inverse kinematics
 END_JUNCTIONS, END_BEND = 4, 0.2   # the 4 junctions at either end bend at most 0.2 of the largest (lever travel)
 LANE_EXTRAS = (0, 4, 8)     # chain lengths (half units beyond the steered guess) tried in a plane before the next
 CONTACT_MARGIN = 0.05       # sigma: layers of two chains must clear each other by this in every state of their wires
+PRINT_MARGIN = 0.8          # sigma: ... and should by this for the printed parts (knuckles, joint parts) to clear
+                            # (session 53: mjp parts of two Tetris chains met at scene clearances up to 0.67 sigma,
+                            # none at 0.77 or more); _build_routed tries PRINT_LEANS for a build left closer
+PRINT_LEANS = (0.8,)        # branch leans (BRANCH_LEAN) tried, in order, when a leaned build leaves chains closer
+                            # than PRINT_MARGIN (_build_routed)
 RIP_GAP = 1.2               # sigma: a chain this much closer to another is routed again with it (_rip_up);
                             # measured: chains 1.29 sigma apart and more were clear in every row of every
                             # example, one 0.93 apart (3-bit adder) overlapped by 0.23 sigma
@@ -177,6 +182,7 @@ class Circuit:
     seconds: dict = field(default_factory=dict)
     closest: float = float("inf")    # sigma: smallest layer-centre distance of a tight chain to another chain
     contacts: list = field(default_factory=list)   # contact.Contact of the chains' close layers, smallest first
+    print_contacts: list = field(default_factory=list)   # ... those closer than PRINT_MARGIN (the print's)
 
 
 @lru_cache(maxsize=None)
@@ -287,7 +293,7 @@ def _branch_tree(prefix: str, tap: Pair, t_ref, sgn: float, pol: int, zero_w: in
             if mk > 1:
                 hang(pname, pout, t, 1.0, ppol ^ 1, mk, POST_WIDTH)
                 continue
-            t0 = t
+            t0, leaned = t, None
             if pair is not tap and abs(float(t[0])) > 0.5 and lean:
                 # a page on a page leaves along +-x, towards the chains of the next tap in its
                 # level, whose facing pages head the other way: the chain's first half unit
@@ -297,7 +303,8 @@ def _branch_tree(prefix: str, tap: Pair, t_ref, sgn: float, pol: int, zero_w: in
                 t0 = rotate(t, pout.axis, lean * max_bend(geo))
                 if (t0[2] > t[2]) != (t[0] > 0):
                     t0 = rotate(t, pout.axis, -lean * max_bend(geo))
-            leaves.append((pout, ppol ^ 1, True, t0, None))
+                leaned = lean
+            leaves.append((pout, ppol ^ 1, True, t0, leaned))
 
     hang(prefix, tap, t_ref, sgn, pol, n, stop_at_tap)
     if n == 2:              # the k-way branch's order (a gate's output pair is not exactly along x)
@@ -493,15 +500,26 @@ def _build_routed(netlist, spec, options: CircuitOptions, progress) -> Circuit:
     and the circuit has branch trees whose chains lean (``BRANCH_LEAN``), the same one or
     two builds without the lean are tried too, and the best of all is kept (session 52: the
     lean kept the examples' chains apart, and pressed two chains of a 5-way fan-out into
-    each other, which the unleaned build keeps apart)."""
+    each other, which the unleaned build keeps apart).
+
+    Then, when the build kept leaves two chains' layers closer than ``PRINT_MARGIN`` in some
+    row (``print_contacts``: the printed parts' knuckles and joint parts would meet, session
+    53) and its circuit has leaned branch trees, the build with each lean of ``PRINT_LEANS``
+    in turn, kept instead if it is no worse by the above (no closer contact below
+    ``CONTACT_MARGIN``, no more tight chains, none closer) and keeps those layers farther
+    apart, until one keeps ``PRINT_MARGIN`` (session 53: Tetris's chains ``w_b_0`` and
+    ``w_y_3``, from facing leaves of the y and b trees, passed 0.42 sigma apart in row 11
+    with the lean 0.6, more than 1.2 with 0.8; its closest chains then 0.64 sigma apart).
+    In such a build a leaned chain's first junction turns no farther from its leaf page than
+    ``BRANCH_LEAN + END_BEND`` of the largest bend, as before (``_build_circuit``)."""
     def tight_wires(r):
         return tuple(dict.fromkeys(t[2:].rsplit("_", 1)[0] for t, _ in r.tight))
 
     first = _build_circuit(netlist, spec, options, progress)
-    if not first.tight:
-        return first.assemble()
-    builds = [("first_build", first),
-              ("second_build", _build_circuit(netlist, spec, options, progress, first_wires=tight_wires(first)))]
+    builds = [("first_build", first)]
+    if first.tight:
+        builds.append(("second_build", _build_circuit(netlist, spec, options, progress,
+                                                      first_wires=tight_wires(first))))
     if first.leaned and all(r.tight for _, r in builds):
         third = _build_circuit(netlist, spec, options, progress, branch_lean=0.0)
         builds.append(("unleaned_build", third))
@@ -509,6 +527,15 @@ def _build_routed(netlist, spec, options: CircuitOptions, progress) -> Circuit:
             builds.append(("unleaned_second_build", _build_circuit(netlist, spec, options, progress,
                                                                    first_wires=tight_wires(third), branch_lean=0.0)))
     best = max(range(len(builds)), key=lambda i: _merit(builds[i][1]))     # (the first on a tie)
+    if first.leaned:
+        for lean in PRINT_LEANS:
+            if builds[best][1].print_clear >= PRINT_MARGIN:
+                break
+            builds.append((f"print_lean_{lean:g}_build", _build_circuit(netlist, spec, options, progress,
+                                                                         branch_lean=lean,
+                                                                         contact_margin=PRINT_MARGIN)))
+            if _print_better(builds[-1][1], builds[best][1]):
+                best = len(builds) - 1
     c = builds[best][1].assemble()             # only the build kept is assembled
     for i, (key, r) in enumerate(builds):
         if i != best:
@@ -529,6 +556,23 @@ class _Routed:
     seconds: dict
     assemble: object
     leaned: bool = False             # its branch trees' chains on pages on pages lean (BRANCH_LEAN)
+    print_contacts: list = field(default_factory=list)   # contacts closer than PRINT_MARGIN, smallest first
+
+    @property
+    def print_clear(self) -> float:
+        """The smallest clearance of two chains' layers over the wires' states, up to
+        ``PRINT_MARGIN`` (sigma; inf: none closer)."""
+        return min((k.clearance for k in self.print_contacts), default=math.inf)
+
+
+def _print_better(new, old) -> bool:
+    """Whether build ``new`` keeps its chains' layers farther apart for the print than ``old``
+    (``print_clear``, up to ``PRINT_MARGIN``) while no worse by :func:`_merit`'s measures: its
+    smallest contact clearance up to ``CONTACT_MARGIN`` no smaller, no more tight chains, and
+    its tight chains' smallest distance no smaller."""
+    return (min(new.print_clear, PRINT_MARGIN) > min(old.print_clear, PRINT_MARGIN)
+            and _merit(new)[0] >= _merit(old)[0] and len(new.tight) <= len(old.tight)
+            and new.closest >= old.closest)
 
 
 def _merit(c) -> tuple:
@@ -540,10 +584,13 @@ def _merit(c) -> tuple:
 
 
 def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, progress=None,
-                   first_wires: tuple = (), branch_lean: float = BRANCH_LEAN) -> _Routed:
+                   first_wires: tuple = (), branch_lean: float = BRANCH_LEAN,
+                   contact_margin: float | None = None) -> _Routed:
     """One build, routed (its assembly deferred: :class:`_Routed`); ``first_wires`` (wire
     names: a gate id or a circuit input) are routed first; ``branch_lean``: the branch trees'
-    lean (``_branch_tree``)."""
+    lean (``_branch_tree``); ``contact_margin``: the clearance below which two chains' layers
+    are routed again (``_rip_up_contacts``; None: ``CONTACT_MARGIN``, ``PRINT_MARGIN`` in a
+    build for the print)."""
     import time
 
     from scipy.spatial import cKDTree
@@ -801,7 +848,7 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
                 deferred.append(parts)
                 n_half += 1
                 starts.append((pout, pol ^ 1, True, t, None))
-        for k, (c, (start, spol, free, t0, _)) in enumerate(zip(cons, starts)):
+        for k, (c, (start, spol, free, t0, lean_k)) in enumerate(zip(cons, starts)):
             sstate = zero[wire] ^ spol
             tag = f"w_{wname}_{k}"
             if c[0] == "out":
@@ -843,6 +890,11 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             lane = Lane(x_rise, start.centre[2] + 3.0, z_run, x_in, z_in, x_end, zp - 6.0)
             sbm = (END_BEND * max_bend(geo) if len(starts) > 1 else TAP_TURN if wire[0] == "gate"
                    else SOURCE_TURN * max_bend(geo))
+            if lean_k is not None and lean_k > BRANCH_LEAN:
+                # a larger lean (PRINT_LEANS): the first junction bends no farther from its page than
+                # BRANCH_LEAN + END_BEND, as before (session 53: lean 0.8 + 0.2 brought the chain's
+                # first slab 0.05 sigma from its leaf page, 0.2 mm^3 into it in print)
+                sbm = max(0.0, BRANCH_LEAN + END_BEND - lean_k) * max_bend(geo)
             # a branch's chains leave their pages side by side: their first layers are the branch's
             skip = BRANCH_LAYERS if start is not tap else 0
             # the gates this chain may touch: its driver's and its sink's (with their direct units)
@@ -867,7 +919,10 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     _route_all(chains, routed, lanes, space, space_clear, opt.jobs, netlist.source, progress)
     t_rip = time.perf_counter()
     rip_ups = _rip_up(routed, lanes, space, space_clear)
-    contact_rips, contacts = _rip_up_contacts(routed, lanes, space, space_clear, geo)
+    contact_rips, contacts = _rip_up_contacts(routed, lanes, space, space_clear, geo,
+                                              **({} if contact_margin is None else {"margin": contact_margin}))
+    # the layers' contacts within the print's margin (PRINT_MARGIN), as the rows switch them
+    print_contacts = [k for k in _state_contacts(routed, geo, margin=PRINT_MARGIN) if k.clearance < PRINT_MARGIN]
     t_done = time.perf_counter()
     tight += [(t, round(float(routed[t].gap), 3)) for t in deferred
               if not isinstance(t, Parts) and routed[t].gap < space_clear]
@@ -936,6 +991,8 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
             scene.meta["connector"]["rerouted"] = [list(p) for p in rip_ups]
         if contact_rips:
             scene.meta["connector"]["rerouted_contacts"] = [list(p) for p in contact_rips]
+        if leaned and branch_lean != BRANCH_LEAN:   # a lean of PRINT_LEANS (_build_routed)
+            scene.meta["connector"]["branch_lean"] = branch_lean
         touching = [k for k in contacts if k.clearance < CONTACT_MARGIN]
         if touching:        # layers that may touch in some row: named, with their clearance (sigma)
             scene.meta["connector"]["state_contacts"] = [[k.a, k.i, k.b, k.j, round(k.clearance, 4)] for k in touching]
@@ -951,10 +1008,10 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         scene.check()
         t_end = time.perf_counter()
         return Circuit(scene, origin, n_chains, n_half, dict(seconds, assemble=t_end - t_asm),
-                       min((g for _, g in tight), default=float("inf")), contacts)
+                       min((g for _, g in tight), default=float("inf")), contacts, print_contacts)
 
     return _Routed(tight, min((g for _, g in tight), default=float("inf")), contacts, seconds, _assemble,
-                   leaned)
+                   leaned, print_contacts)
 
 
 def _check_reach(netlist, taps, consumers, by_name, level, geo, drop: float = END_DROP) -> None:
@@ -1056,15 +1113,15 @@ def _last_unit(tag: str, last: int, pair_in, pair_out, state: int, geo, ext: flo
                            out_post=0.5 * geo.gap + ext, out_stop=LEVER_STOP)
 
 
-def _state_contacts(routed: dict, geo, tags=None, cache: dict | None = None) -> list:
+def _state_contacts(routed: dict, geo, tags=None, cache: dict | None = None, margin: float | None = None) -> list:
     """:func:`mlc.circuit.contact.state_contacts` of the routed chains (of those involving a
     chain of ``tags`` when given): every pair of layers of two chains within two bounding
-    radii plus ``CONTACT_MARGIN``, tested as rigid layers in every state of their wires.
-    ``cache``: the layers' boxes of each chain and state, kept across calls while the chain
-    keeps the same route (the caller's: one build)."""
+    radii plus ``margin`` (None: ``CONTACT_MARGIN``; ``PRINT_MARGIN`` for the print's), tested as
+    rigid layers in every state of their wires.  ``cache``: the layers' boxes of each chain
+    and state, kept across calls while the chain keeps the same route (the caller's: one build)."""
     from mlc.circuit.contact import candidate_pairs, layer_boxes, state_contacts
     centres = {t: ch.layers() for t, ch in routed.items() if ch.route is not None}
-    pairs = candidate_pairs(centres, 2.0 * LAYER_RADIUS + CONTACT_MARGIN)
+    pairs = candidate_pairs(centres, 2.0 * LAYER_RADIUS + (CONTACT_MARGIN if margin is None else margin))
     if tags is not None:
         pairs = [p for p in pairs if p[0] in tags or p[2] in tags]
     cache = {} if cache is None else cache
@@ -1276,27 +1333,30 @@ def _rip_up(routed: dict, lanes, space, space_clear: float) -> list:
     return done
 
 
-def _rip_up_contacts(routed: dict, lanes, space, space_clear: float, geo) -> tuple[list, list]:
+def _rip_up_contacts(routed: dict, lanes, space, space_clear: float, geo,
+                      margin: float | None = None) -> tuple[list, list]:
     """Chains whose layers would touch in some input row (:func:`_state_contacts` below
-    ``CONTACT_MARGIN``): for each such pair of chains (closest first), the one routed
+    ``margin``: None for ``CONTACT_MARGIN``, or ``PRINT_MARGIN`` in a build for the print,
+    :func:`_build_routed`): for each such pair of chains (closest first), the one routed
     earlier, which did not see the other, is taken out and routed again with every other
     chain in place, then the other one; the new routes are kept if the pair's smallest
     clearance (each chain against every chain, in every state) grew, else the old ones are
     put back.  Returns (the pairs re-routed, the contacts left, smallest first)."""
     boxes: dict = {}
-    contacts = _state_contacts(routed, geo, cache=boxes)
+    margin = CONTACT_MARGIN if margin is None else margin
+    contacts = _state_contacts(routed, geo, cache=boxes, margin=margin)
     order = {t: k for k, t in enumerate(routed)}
     done, seen = [], set()
     for k in list(contacts):
-        if k.clearance >= CONTACT_MARGIN:
+        if k.clearance >= margin:
             break
         if (k.a, k.b) in seen:
             continue
         seen.add((k.a, k.b))
         tags = {k.a, k.b}
         # (none left within reach: an earlier re-route moved them apart)
-        old_score = min((c.clearance for c in _state_contacts(routed, geo, tags, boxes)), default=math.inf)
-        if old_score >= CONTACT_MARGIN:          # an earlier re-route settled it
+        old_score = min((c.clearance for c in _state_contacts(routed, geo, tags, boxes, margin)), default=math.inf)
+        if old_score >= margin:          # an earlier re-route settled it
             continue
         pair = sorted((routed[k.a], routed[k.b]), key=lambda c: order[c.tag])
         old = [(c.route, c.gap, c.plane) for c in pair]
@@ -1306,7 +1366,7 @@ def _rip_up_contacts(routed: dict, lanes, space, space_clear: float, geo) -> tup
             if c.route is None:
                 break
         if all(c.route is not None for c in pair):
-            new_score = min((c.clearance for c in _state_contacts(routed, geo, tags, boxes)), default=math.inf)
+            new_score = min((c.clearance for c in _state_contacts(routed, geo, tags, boxes, margin)), default=math.inf)
             if new_score > old_score:
                 for c in pair:
                     c.gap = c.gap_of(c.route)
@@ -1318,7 +1378,7 @@ def _rip_up_contacts(routed: dict, lanes, space, space_clear: float, geo) -> tup
             lanes.take(c.lane, plane)
             space.add(c.layers(route), c.tag, c.skip, c.ctx[0])
     if done:
-        contacts = _state_contacts(routed, geo, cache=boxes)
+        contacts = _state_contacts(routed, geo, cache=boxes, margin=margin)
     return done, contacts
 
 
