@@ -268,10 +268,10 @@ def test_five_way_branch_pages_clear_each_other(tree, monkeypatch):
     assert rep.min_clearance > 0.0, rep.pair
 
 
-def _no_contact_rip_up(routed, lanes, space, space_clear, geo):
+def _no_contact_rip_up(routed, lanes, space, space_clear, geo, margin=None, cache=None):
     """build._rip_up_contacts that only measures."""
     from mlc.circuit import build as B
-    return [], B._state_contacts(routed, geo)
+    return [], B._state_contacts(routed, geo, cache=cache, margin=margin)
 
 
 def test_rip_up_reroutes_a_chain_and_the_one_it_presses_into(monkeypatch):

@@ -919,10 +919,14 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     _route_all(chains, routed, lanes, space, space_clear, opt.jobs, netlist.source, progress)
     t_rip = time.perf_counter()
     rip_ups = _rip_up(routed, lanes, space, space_clear)
-    contact_rips, contacts = _rip_up_contacts(routed, lanes, space, space_clear, geo,
-                                              **({} if contact_margin is None else {"margin": contact_margin}))
-    # the layers' contacts within the print's margin (PRINT_MARGIN), as the rows switch them
-    print_contacts = [k for k in _state_contacts(routed, geo, margin=PRINT_MARGIN) if k.clearance < PRINT_MARGIN]
+    layer_cache: dict = {}      # the layers' boxes per chain and state, shared by both contact passes
+    contact_rips, contacts = _rip_up_contacts(routed, lanes, space, space_clear, geo, margin=contact_margin,
+                                              cache=layer_cache)
+    # the layers' contacts within the print's margin (PRINT_MARGIN), as the rows switch them (a
+    # build for the print has just listed them at that margin)
+    near = contacts if contact_margin == PRINT_MARGIN else _state_contacts(routed, geo, cache=layer_cache,
+                                                                           margin=PRINT_MARGIN)
+    print_contacts = [k for k in near if k.clearance < PRINT_MARGIN]
     t_done = time.perf_counter()
     tight += [(t, round(float(routed[t].gap), 3)) for t in deferred
               if not isinstance(t, Parts) and routed[t].gap < space_clear]
@@ -1334,15 +1338,16 @@ def _rip_up(routed: dict, lanes, space, space_clear: float) -> list:
 
 
 def _rip_up_contacts(routed: dict, lanes, space, space_clear: float, geo,
-                      margin: float | None = None) -> tuple[list, list]:
+                      margin: float | None = None, cache: dict | None = None) -> tuple[list, list]:
     """Chains whose layers would touch in some input row (:func:`_state_contacts` below
     ``margin``: None for ``CONTACT_MARGIN``, or ``PRINT_MARGIN`` in a build for the print,
     :func:`_build_routed`): for each such pair of chains (closest first), the one routed
     earlier, which did not see the other, is taken out and routed again with every other
     chain in place, then the other one; the new routes are kept if the pair's smallest
     clearance (each chain against every chain, in every state) grew, else the old ones are
-    put back.  Returns (the pairs re-routed, the contacts left, smallest first)."""
-    boxes: dict = {}
+    put back.  ``cache``: :func:`_state_contacts`'s, the caller's to reuse.  Returns (the pairs
+    re-routed, the contacts left, smallest first)."""
+    boxes: dict = {} if cache is None else cache
     margin = CONTACT_MARGIN if margin is None else margin
     contacts = _state_contacts(routed, geo, cache=boxes, margin=margin)
     order = {t: k for k, t in enumerate(routed)}
