@@ -1097,14 +1097,6 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
         _log("feet")
         add_feet(asm, [asm.part_transforms(*pq) for pq in (poses or {}).values()] + motion_T)
     asm.orient = _orientation(asm)
-    if resolve and motion_T:
-        # print-only chamfers of the arms that cross other bodies' knuckle layers on the hinges
-        # flat on the bed (mlc.mesh.pivot): after the orientation, which says which hinges are flat
-        # and teardrops under their knuckles, in the room the chamfers leave
-        from mlc.mesh.pivot import chamfer_crossings, teardrops
-        _log("chamfers and teardrops")
-        asm.notes += chamfer_crossings(asm)
-        asm.notes += teardrops(asm)
     _log("assembly done")
     return asm
 

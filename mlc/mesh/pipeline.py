@@ -300,6 +300,13 @@ def export_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
             dense = _dense_poses(scene, profile, notes)
         _log("building parts")
         asm = build_assembly(scene, profile, poses, motion_poses=dense)
+        if dense:
+            # a mechanism of its own with dense poses (a library gate): its hinges flat on the bed
+            # made to print with less support, after the orientation that says which are flat
+            # (mlc.mesh.pivot: print-only; compiled circuits are built as before)
+            from mlc.mesh.pivot import flat_hinges
+            _log("flat hinges: chamfers and teardrops")
+            asm.notes += flat_hinges(asm)
         asm.notes[:0] = notes
         _log("printability checks")
         rep = check_assembly(asm, motion_poses=dense)

@@ -17,7 +17,8 @@ the pivot (session 54; docs/printing.md).  A gusset from a knuckle down to its o
 stay above 45 degrees there (the arms leave at about 49 degrees, the knuckle is 2.6 times as wide
 as the arm: session 40), so the knuckle keeps a small flat.
 
-*What*, once the print's up is known (after the orientation), on every hinge axis flat on the bed:
+*What*, once the print's up is known (after the orientation), on every hinge axis flat on the bed
+(:func:`flat_hinges`; ``mlc stl`` on a library gate, not on compiled circuits):
 
 1. :func:`chamfer_crossings`: each body's cut around the other bodies' knuckles is a cone instead
    of a cylinder, from the face of the body's own knuckle, where it starts at the radius the other
@@ -244,5 +245,12 @@ def teardrops(asm) -> list:
     return notes
 
 
-__all__ = ["CHAMFER", "FLAT_DEG", "SLOPE", "TEARDROPS", "chamfer_crossings", "chamfer_cuts", "teardrop",
+def flat_hinges(asm) -> list:
+    """:func:`chamfer_crossings`, then :func:`teardrops` in the room they leave; the notes.
+    ``mlc stl`` (:func:`mlc.mesh.pipeline.export_assembly`) runs it on a mechanism of its own built
+    with dense poses (a library gate), after the build and its orientation."""
+    return chamfer_crossings(asm) + teardrops(asm)
+
+
+__all__ = ["CHAMFER", "flat_hinges", "FLAT_DEG", "SLOPE", "TEARDROPS", "chamfer_crossings", "chamfer_cuts", "teardrop",
            "teardrops"]
