@@ -36,8 +36,10 @@ as the arm: session 40), so the knuckle keeps a small flat.
    teardrop, flanks at :data:`FLANK_DEG` tangent to the knuckle down to a flat about one minimum
    wall wide, as deep as the other bodies' material (measured) leaves the clearance in any turn.
 
-NAND expanding, fdm: mlc's support estimate 3862 -> 1100 mm^3 (58.2 -> 16.9 % of the part
-volume), no island left, every blocking check passing (docs/printing.md, session 54).
+Measured (benchmarks/results/mesh_support_where_s54.json, fdm): mlc's support estimate 3862 ->
+1106 mm^3 for the NAND expanding (58.2 -> 17.2 % of the part volume; under the pivot 2182 -> 276),
+no island left, every blocking check passing; PrusaSlicer 2.5's support 3700 -> 3160 mm^3
+(docs/printing.md, session 54).
 """
 from __future__ import annotations
 
