@@ -210,7 +210,9 @@ def teardrops(asm) -> list:
     it keeps the clearance from them in any turn of the hinge; the flat goes as deep as that
     allows (down to ``R``; a hinge whose other bodies are cut back only to ``rho = R + c`` gets
     none).  Needs the knuckle gap at least the clearance (the teardrop's end faces are as far
-    from the next knuckle's body as the knuckle's own)."""
+    from the next knuckle's body as the knuckle's own).  Parts not on the axis are left to the
+    report's ``min_gap``, ``states`` and ``motion_clearance`` checks (passed in every library gate
+    and profile measured, session 54)."""
     from mlc.mesh.build import _clean, cylinder, subtract, union
     if not TEARDROPS:
         return []
