@@ -206,8 +206,8 @@ def main(argv=None) -> int:
         path, expr = CASES[case]
         t0 = time.perf_counter()
         from mlc.circuit.build import CircuitOptions
-        from mlc.robot.build import CIRCUIT_END_DROP
-        opts = CircuitOptions(end_drop=CIRCUIT_END_DROP) if case in ROBOTS else None     # as mlc compile --robot
+        from mlc.robot.build import CIRCUIT_END_DROP, CIRCUIT_PRINT_LEANS
+        opts = CircuitOptions(end_drop=CIRCUIT_END_DROP, print_leans=CIRCUIT_PRINT_LEANS) if case in ROBOTS else None     # as mlc compile --robot
         scene = pipeline.build(pipeline.compile_spec(pipeline.load(str(ROOT / path) if path else None, expr)),
                                options=opts).circuit.scene
         if case in ROBOTS:       # the circuit, the skeleton and the levers as one scene

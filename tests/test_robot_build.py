@@ -337,3 +337,25 @@ def test_a_computed_tau_is_the_dense_spectrum_up_to_the_robot_limit(robot, monke
     rep = verify_robot_dynamic(sc, rows=["0"], seeds=1, max_time=1.0, tau="compute")
     assert asked == [D.DENSE_ROBOT] and 6 * len(sc.bodies) < D.DENSE_ROBOT
     assert rep.params["tau"] == pytest.approx(real(sc), rel=1e-9) and rep.params["tau"] > 0
+
+
+def test_the_readme_robot_folds_row_10_statically_and_is_clear_as_built(tmp_path):
+    """The README's Tetris robot (``mlc compile examples/tetris.tt --robot ...``) folds S in row
+    10 at its static equilibrium, every output and DOF probe right, and no two slabs
+    interpenetrate as built.  Session 53's print lean (``mlc.circuit.build.PRINT_LEANS``) changed
+    the robot's circuit (1675 bodies) and with it its couplings: every start of the coupling to
+    ``u4_dn`` met another body, the builder kept the least overlapping one (through gate g2 and
+    against ``rc_u4_up``: -0.229 sigma as built), and row 10 stopped 12.6 degrees short of its
+    turn (``u4_dn`` read 1.449 sigma); a robot's circuit takes no print lean
+    (``mlc.robot.build.CIRCUIT_PRINT_LEANS``, docs/robot.md 6)."""
+    from mlc.robot.verify import verify_robot_static
+    root = Path(__file__).resolve().parents[1]
+    assert main(["compile", str(root / "examples" / "tetris.tt"), "--robot", str(root / "examples" / "tetris.robot.yaml"),
+                 "-o", str(tmp_path / "robot")]) == 0
+    scene = load_scene(tmp_path / "robot" / "robot.yaml")
+    rep = verify_robot_static(scene, rows=["10"])
+    assert rep.params["as_built"]["clearance"] > -1e-3, rep.params["as_built"]
+    (row,) = rep.rows
+    assert row["shape_ok"] and row["ok"], row
+    assert all(e["ok"] for e in rep.entries), [e for e in rep.entries if not e["ok"]]
+    assert "branch_lean" not in load_scene(tmp_path / "robot" / "circuit.yaml").meta["connector"]

@@ -169,6 +169,8 @@ class CircuitOptions:
     end_drop: float = END_DROP       # sigma: chains end this far under their input levers' in sites (_add_end_sites);
                                      # 0: on the in sites, as before session 44 (a robot's circuit
                                      # takes mlc.robot.build.CIRCUIT_END_DROP, 1.0)
+    print_leans: tuple | None = None # branch leans tried for the print's margin (_build_routed); None:
+                                     # PRINT_LEANS (a robot's circuit takes mlc.robot.build.CIRCUIT_PRINT_LEANS, none)
 
 
 @dataclass
@@ -528,7 +530,7 @@ def _build_routed(netlist, spec, options: CircuitOptions, progress) -> Circuit:
                                                                    first_wires=tight_wires(third), branch_lean=0.0)))
     best = max(range(len(builds)), key=lambda i: _merit(builds[i][1]))     # (the first on a tie)
     if first.leaned:
-        for lean in PRINT_LEANS:
+        for lean in (PRINT_LEANS if options.print_leans is None else options.print_leans):
             if builds[best][1].print_clear >= PRINT_MARGIN:
                 break
             builds.append((f"print_lean_{lean:g}_build", _build_circuit(netlist, spec, options, progress,

@@ -303,8 +303,9 @@ def run(args) -> int:
         from mlc.scene.io import dump_scene
         extra = {} if joint_k is None else {"joint_k": joint_k}
         if args.robot:
-            from mlc.robot.build import CIRCUIT_END_DROP
+            from mlc.robot.build import CIRCUIT_END_DROP, CIRCUIT_PRINT_LEANS
             extra["end_drop"] = CIRCUIT_END_DROP
+            extra["print_leans"] = CIRCUIT_PRINT_LEANS
         opts = CircuitOptions(direct=bool(getattr(args, "direct", False)), max_gates=max_gates, jobs=args.jobs,
                               router=getattr(args, "router", "auto"),
                               muscle_per_lever=bool(getattr(args, "muscle_per_lever", False)), **extra)

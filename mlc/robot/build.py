@@ -103,6 +103,14 @@ POST = 0.6               # sigma: the lever sites sit this far below the skeleto
 #: found no route clear of them ("cannot route output u3_up"); with 1.0 every coupling routes
 #: clear, and the end joints still keep 0.48 sigma from the gate's joint at d (docs/robot.md 6)
 CIRCUIT_END_DROP = 1.0
+#: the branch leans the circuit a robot is built on tries for the print's margin
+#: (mlc.circuit.build.CircuitOptions.print_leans): none. With PRINT_LEANS (0.8, session 53) the
+#: Tetris robot's circuit changed (1675 bodies) and its couplings with it: every start of the
+#: coupling to u4_dn then met another body (the builder kept the least overlapping, through gate g2
+#: and against rc_u4_up, -0.229 sigma as built) and the static row 10 (S) stopped 12.6 degrees short
+#: of its turn; without the lean the robot (2672 bodies) folds all four rows statically with no DOF
+#: error and is clear as built (docs/robot.md 6, session 54)
+CIRCUIT_PRINT_LEANS: tuple = ()
 HINGE_WIDTH = 0.5        # sigma between the two bonds of a skeleton hinge (along z)
 APPROACH_RUN = 4.0       # sigma: the chain's last stretch rises straight into the skeleton
 FAN_ANGLES = (0.0, 70.0, -70.0, 140.0, -140.0, 180.0)   # deg: a chain's first tangent turned about its output pair
