@@ -19,7 +19,12 @@ For a chain slab it records the half unit's index and the chain's length in half
 (0 and n - 1 are its ends: the circuit's output pair and the lever sites).  Optionally
 (``--bend``) the bend of each junction involved, against the connector's largest bend.
 
-    python benchmarks/robot_overlaps.py OUT/robot.yaml [--rows 01 10 11]
+``--outside`` confirms each pose's list without mlc.verify.overlap: manifold3d's boolean
+intersection of every two nearby boxes of different bodies (benchmarks/outside_overlap.py,
+hinge contact within 0.06 sigma of a shared joint left out), recording its pairs, their
+intersection volumes, and which pairs only one of the two tests lists.
+
+    python benchmarks/robot_overlaps.py OUT/robot.yaml [--rows 01 10 11] [--outside]
         [-o benchmarks/results/robot_overlaps.json]
 
 Units: sigma (depths), degrees, seconds wall.
@@ -32,6 +37,7 @@ import json
 import re
 import sys
 import time
+from pathlib import Path
 
 from mlc.io.atomic import atomic_path
 
@@ -70,7 +76,31 @@ def classify(a: str, b: str) -> str:
     return "circuit"
 
 
-def analyse(scene, pos, quat) -> dict:
+def outside(scene, pos, quat, box_pairs) -> dict:
+    """The boolean check of one pose (benchmarks/outside_overlap.py) against the box test's
+    pairs ``box_pairs`` ({(a, b): depth})."""
+    import numpy as np
+    from outside_overlap import boolean_contacts
+
+    if pos is None:
+        pos = np.array([b.position for b in scene.bodies], float)
+        quat = np.array([b.orientation for b in scene.bodies], float)
+    t = time.perf_counter()
+    bad = boolean_contacts(scene, pos, quat)
+    vol: dict = {}
+    for a, b, v, _ in bad:
+        key = tuple(sorted((a, b)))
+        vol[key] = vol.get(key, 0.0) + v
+    boxed = {tuple(sorted(k)): d for k, d in box_pairs.items()}
+    return {"n_pairs": len(vol), "volume_max": round(max(vol.values(), default=0.0), 6),
+            "pairs": [{"a": a, "b": b, "volume": round(v, 6), "box_depth": boxed.get((a, b))}
+                      for (a, b), v in sorted(vol.items(), key=lambda kv: -kv[1])],
+            "only_boolean": [list(k) for k in sorted(set(vol) - set(boxed))],
+            "only_box": [list(k) for k in sorted(set(boxed) - set(vol))],
+            "wall_s": round(time.perf_counter() - t, 1)}
+
+
+def analyse(scene, pos, quat, check_outside: bool = False) -> dict:
     from mlc.verify.overlap import clearance
 
     c = clearance(scene, pos, quat)
@@ -91,9 +121,12 @@ def analyse(scene, pos, quat) -> dict:
     by = collections.defaultdict(list)
     for p in pairs:
         by[p["class"]].append(p["depth"])
-    return {"min_clearance": round(c.min_clearance, 4), "pair": list(c.pair), "n_overlaps": len(pairs),
-            "by_class": {k: {"n": len(v), "deepest": max(v)} for k, v in sorted(by.items())},
-            "overlaps": pairs}
+    out = {"min_clearance": round(c.min_clearance, 4), "pair": list(c.pair), "n_overlaps": len(pairs),
+           "by_class": {k: {"n": len(v), "deepest": max(v)} for k, v in sorted(by.items())},
+           "overlaps": pairs}
+    if check_outside:
+        out["outside"] = outside(scene, pos, quat, {(p["a"], p["b"]): p["depth"] for p in pairs})
+    return out
 
 
 def main(argv=None) -> int:
@@ -103,20 +136,24 @@ def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("scene")
     ap.add_argument("--rows", nargs="*")
+    ap.add_argument("--outside", action="store_true",
+                    help="confirm each pose by manifold3d's boolean intersections (benchmarks/outside_overlap.py)")
     ap.add_argument("-o", "--out", default="benchmarks/results/robot_overlaps.json")
     a = ap.parse_args(argv)
+    sys.path.insert(0, str(Path(__file__).resolve().parent))      # gitstate, outside_overlap
     sc = load_scene(a.scene)
     rows = a.rows or sorted(sc.truth_table)
+    from gitstate import commit
     out = {"what": "slab overlaps of a robot's static poses, by class (benchmarks/robot_overlaps.py)",
-           "scene": a.scene, "bodies": len(sc.bodies),
+           "commit": commit(), "scene": a.scene, "bodies": len(sc.bodies),
            "joint_k": float((sc.meta.get("circuit", {}).get("connector", {}) or {}).get("joint_k", 1.0)),
            "build_overrides": sc.meta.get("robot", {}).get("build_overrides", {}),
-           "units": "sigma (depth), degrees, seconds wall", "as_built": analyse(sc, None, None), "rows": {}}
+           "units": "sigma (depth), degrees, seconds wall", "as_built": analyse(sc, None, None, a.outside), "rows": {}}
     for row in rows:
         t = time.perf_counter()
         rep = verify_robot_static(sc, rows=[row], keep_poses=True, clearance=False)
         pos, quat = rep.poses[row]
-        r = analyse(sc, pos, quat)
+        r = analyse(sc, pos, quat, a.outside)
         r.update({"shape_read": rep.rows[0]["shape_read"], "shape_ok": rep.rows[0]["shape_ok"],
                   "joint_stretch": rep.rows[0]["joint_stretch"], "row_ok": rep.rows[0]["ok"],
                   "max_dof_error_deg": round(rep.rows[0]["max_dof_error_deg"], 3),
@@ -124,7 +161,10 @@ def main(argv=None) -> int:
         out["rows"][row] = r
         print(f"row {row}: {r['shape_read']} (verdict {'ok' if r['row_ok'] else 'WRONG'}, DOF error "
               f"{r['max_dof_error_deg']:.1f} deg, stretch {r['joint_stretch']:.1e}), clearance {r['min_clearance']} {r['pair']}, {r['n_overlaps']} pairs: "
-              + ", ".join(f"{k} {v['n']} (deepest {v['deepest']:.3f})" for k, v in r["by_class"].items()), flush=True)
+              + ", ".join(f"{k} {v['n']} (deepest {v['deepest']:.3f})" for k, v in r["by_class"].items())
+              + (f"; boolean: {r['outside']['n_pairs']} pairs (largest {r['outside']['volume_max']:.2e} sigma^3), "
+                 f"{len(r['outside']['only_boolean'])} not in the box test's list, "
+                 f"{len(r['outside']['only_box'])} not in the boolean's" if a.outside else ""), flush=True)
         with atomic_path(a.out) as tmp, open(tmp, "w") as f:
             json.dump(out, f, indent=1)
     return 0

@@ -36,11 +36,11 @@ def pair_dir(tmp_path_factory):
     return d
 
 
-def _build(d):
+def _build(d, **kw):
     from mlc.robot.spec import load_robot
     from mlc.scene.io import load_scene
     circ = load_scene(d / "out" / "circuit.yaml")
-    return rb.build_robot(circ, load_robot(str(d / "pair.robot.yaml"), circ)).scene
+    return rb.build_robot(circ, load_robot(str(d / "pair.robot.yaml"), circ), **kw).scene
 
 
 def test_second_chain_on_a_pair_leaves_on_a_page_clear_of_the_first(pair_dir):
@@ -70,15 +70,38 @@ def test_static_verify_reports_clearance_and_the_page_keeps_parity(pair_dir, tmp
     assert "slab clearance as built: +0.0000 sigma" in capsys.readouterr().out
 
 
-def test_short_page_posts_overlap_and_are_reported(pair_dir, monkeypatch):
+def test_short_page_posts_overlap_refused_unless_allowed_then_reported(pair_dir, monkeypatch, tmp_path, capsys):
+    """Every start of the second chain overlaps: the builder refuses the robot, naming the DOF's
+    line in the robot file; with ``allow_overlap`` (``mlc compile --allow-overlap``) it keeps the
+    least overlapping start, records its depth, and the clearance test finds the overlap there."""
+    from mlc.cli import main
+    from mlc.errors import MlcError
     monkeypatch.setattr(rb, "PAGE_CLEAR", -1.0)          # posts 1 sigma shorter: the page's layer meets the first chain's
     # without the wrist (docs/robot.md 2.6): with it, the chains reach the levers by other routes and one of
     # the page's turns is clear even with these posts, so the test would not show the overlap
     monkeypatch.setattr(rb, "WRIST", False)
-    sc = _build(pair_dir)
+    with pytest.raises(MlcError) as ei:
+        _build(pair_dir)
+    e = ei.value
+    assert "dof u2_dn" in e.message and "interpenetrates" in e.message and "--allow-overlap" in e.fix
+    assert "pair.robot.yaml:7" in str(e.where), e.where              # the line of dof u2_dn
+    sc = _build(pair_dir, allow_overlap=True)
     rep = clearance(sc)
     assert not rep.ok()
+    hit = [d for a, b, d in rep.overlaps if a.startswith("rc_u2_dn") or b.startswith("rc_u2_dn")]
     assert any(a.startswith("rc_u2_dn_pg") or b.startswith("rc_u2_dn_pg") for a, b, _ in rep.overlaps)
+    kept = {d["name"]: d["chain"]["overlap"] for d in sc.meta["robot"]["dofs"] if d.get("chain")}
+    assert kept["u1_up"] == 0.0 and kept["u2_dn"] > 0.0
+    assert kept["u2_dn"] == pytest.approx(max(hit), abs=1e-3)
+    # the command line: one message, exit 2 (a user error), nothing written; --allow-overlap writes the robot
+    out = tmp_path / "o"
+    assert main(["compile", "-e", "u1_up = a & b; u2_dn = a & b", "--robot", str(pair_dir / "pair.robot.yaml"),
+                 "-o", str(out)]) == 2
+    err = capsys.readouterr().err
+    assert "pair.robot.yaml:7" in err and "Traceback" not in err and not out.exists()
+    assert main(["compile", "-e", "u1_up = a & b; u2_dn = a & b", "--robot", str(pair_dir / "pair.robot.yaml"),
+                 "-o", str(out), "--allow-overlap"]) == 0
+    assert (out / "robot.yaml").exists()
 
 
 @pytest.mark.parametrize("on_chain", [True, False])

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 import trimesh
 from scipy.spatial import ConvexHull
+from helpers import ROOT
 
 from mlc.gates.parts import EX, EY, EZ, hinge, slab_body, universal_joint
 from mlc.scene.model import Body, Box, Scene
@@ -226,78 +227,14 @@ def test_check_gate_reports_clearance_and_fails_on_interpenetration(capsys, monk
 
 
 def _boolean_contacts(scene, pos, quat, near=0.06, contact=None):
-    """Independent of mlc.verify.overlap: manifold3d's boolean intersection of every two boxes of
-    different bodies.  Returns the pairs (names, volume, farthest vertex from a joint the two
-    bodies share) whose intersection is not within ``near`` sigma of such a joint (the line
-    through a hinge's sites, the point of a universal joint; a joint's bonds, and joints sharing a
-    site, merged)."""
-    import itertools
-
-    import manifold3d as mf
-
-    from mlc.geometry.rotation import quat_to_matrix
-
-    names = [b.name for b in scene.bodies]
-    Rb = [quat_to_matrix(q) for q in quat]
-
-    def world(ref):
-        b, site = ref.split(".")
-        i = names.index(b)
-        return pos[i] + Rb[i] @ np.asarray(scene.bodies[i].sites[site], float)
-
-    boxes = []
-    for i, body in enumerate(scene.bodies):
-        for bx in body.boxes:
-            T = np.zeros((3, 4))
-            T[:, :3] = Rb[i] @ quat_to_matrix(np.asarray(bx.orientation, float))
-            T[:, 3] = pos[i] + Rb[i] @ np.asarray(bx.center, float)
-            boxes.append((i, mf.Manifold.cube(list(np.asarray(bx.size, float)), True).transform(T.tolist())))
-    parent = {}
-
-    def find(x):
-        while parent.setdefault(x, x) != x:
-            x = parent[x]
-        return x
-
-    joint_bonds = [bd for bd in scene.bonds if bd.kind in ("hinge", "universal") or bd.rest == 0.0]
-    for bd in joint_bonds:                       # a joint's bonds (a hinge: two) and shared sites merge
-        for r in (bd.a, bd.b):
-            ra, rb = find(r), find(("joint", bd.joint or bd.name))
-            if ra != rb:
-                parent[ra] = rb
-    groups = {}
-    for bd in joint_bonds:
-        groups.setdefault(find(bd.a), set()).update((bd.a, bd.b))
-    shared = {}
-    for refs in groups.values():
-        pts = np.array([world(r) for r in sorted(refs)])
-        for a, b in itertools.combinations(sorted({names.index(r.split(".")[0]) for r in refs}), 2):
-            shared.setdefault((a, b), []).append(pts)
-    bad = []
-    contact = [0.0] if contact is None else contact     # [0]: farthest vertex of an accepted contact
-    for (i, A), (j, B) in itertools.combinations(boxes, 2):
-        if i == j:
-            continue
-        X = A ^ B
-        if X.volume() <= 1e-12:
-            continue
-        V = np.asarray(X.to_mesh().vert_properties)[:, :3]
-        far = np.inf
-        for pts in shared.get((min(i, j), max(i, j)), []):
-            D = np.linalg.norm(pts[:, None] - pts[None], axis=2)
-            a, b = np.unravel_index(np.argmax(D), D.shape)
-            if D[a, b] > 1e-9:
-                u = (pts[b] - pts[a]) / D[a, b]
-                w = V - pts[a]
-                d = np.linalg.norm(w - np.outer(w @ u, u), axis=1)
-            else:
-                d = np.linalg.norm(V - pts[0], axis=1)
-            far = min(far, float(d.max()))
-        if not far <= near:
-            bad.append((names[i], names[j], X.volume(), far))
-        else:
-            contact[0] = max(contact[0], far)
-    return bad
+    """Independent of mlc.verify.overlap: manifold3d's boolean intersection of the boxes of
+    different bodies (benchmarks/outside_overlap.py): the pairs (names, volume, farthest vertex
+    from a joint the two bodies share) whose intersection is not within ``near`` sigma of such a
+    joint."""
+    import sys
+    sys.path.insert(0, str(ROOT / "benchmarks"))
+    from outside_overlap import boolean_contacts
+    return boolean_contacts(scene, pos, quat, near=near, contact=contact)
 
 
 @pytest.mark.parametrize("signal", ["expand", "contract"])

@@ -184,7 +184,12 @@ class Circuit:
     seconds: dict = field(default_factory=dict)
     closest: float = float("inf")    # sigma: smallest layer-centre distance of a tight chain to another chain
     contacts: list = field(default_factory=list)   # contact.Contact of the chains' close layers, smallest first
-    print_contacts: list = field(default_factory=list)   # ... those closer than PRINT_MARGIN (the print's)
+    near_print: object = None      # () -> those closer than PRINT_MARGIN (listed on first read: print_contacts)
+
+    @property
+    def print_contacts(self) -> list:
+        """The chains' layers' contacts closer than ``PRINT_MARGIN`` (the print's), smallest first."""
+        return self.near_print() if self.near_print is not None else []
 
 
 @lru_cache(maxsize=None)
@@ -558,7 +563,11 @@ class _Routed:
     seconds: dict
     assemble: object
     leaned: bool = False             # its branch trees' chains on pages on pages lean (BRANCH_LEAN)
-    print_contacts: list = field(default_factory=list)   # contacts closer than PRINT_MARGIN, smallest first
+    near_print: object = None        # () -> contacts closer than PRINT_MARGIN, smallest first (listed once, on first call)
+
+    @property
+    def print_contacts(self) -> list:
+        return self.near_print() if self.near_print is not None else []
 
     @property
     def print_clear(self) -> float:
@@ -924,12 +933,19 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
     layer_cache: dict = {}      # the layers' boxes per chain and state, shared by both contact passes
     contact_rips, contacts = _rip_up_contacts(routed, lanes, space, space_clear, geo, margin=contact_margin,
                                               cache=layer_cache)
-    # the layers' contacts within the print's margin (PRINT_MARGIN), as the rows switch them (a
-    # build for the print has just listed them at that margin)
-    near = contacts if contact_margin == PRINT_MARGIN else _state_contacts(routed, geo, cache=layer_cache,
-                                                                           margin=PRINT_MARGIN)
-    print_contacts = [k for k in near if k.clearance < PRINT_MARGIN]
     t_done = time.perf_counter()
+    printed: list = []
+
+    def near_print() -> list:
+        """The layers' contacts within the print's margin (PRINT_MARGIN), as the rows switch them,
+        listed on the first call only (only a build choosing a print lean reads them; a build for
+        the print has just listed them at that margin); the routes are not changed after this."""
+        if not printed:
+            near = contacts if contact_margin == PRINT_MARGIN else _state_contacts(routed, geo, cache=layer_cache,
+                                                                                   margin=PRINT_MARGIN)
+            printed.append([k for k in near if k.clearance < PRINT_MARGIN])
+            layer_cache.clear()
+        return printed[0]
     tight += [(t, round(float(routed[t].gap), 3)) for t in deferred
               if not isinstance(t, Parts) and routed[t].gap < space_clear]
     seconds = {"place": t_route - t_start, "route": t_rip - t_route, "rip_up": t_done - t_rip}
@@ -1014,10 +1030,10 @@ def _build_circuit(netlist, spec=None, options: CircuitOptions | None = None, pr
         scene.check()
         t_end = time.perf_counter()
         return Circuit(scene, origin, n_chains, n_half, dict(seconds, assemble=t_end - t_asm),
-                       min((g for _, g in tight), default=float("inf")), contacts, print_contacts)
+                       min((g for _, g in tight), default=float("inf")), contacts, near_print)
 
     return _Routed(tight, min((g for _, g in tight), default=float("inf")), contacts, seconds, _assemble,
-                   leaned, print_contacts)
+                   leaned, near_print)
 
 
 def _check_reach(netlist, taps, consumers, by_name, level, geo, drop: float = END_DROP) -> None:

@@ -107,6 +107,9 @@ def register(sub):
     p.add_argument("--robot", metavar="ROBOT.yaml",
                    help="also build the robot body the circuit drives (docs/robot.md): OUTDIR/robot.yaml, one scene; "
                         "--verify, --stl and --3mf then apply to the robot")
+    p.add_argument("--allow-overlap", action="store_true",
+                   help="with --robot: keep a coupling chain whose every start interpenetrates another slab (the "
+                        "least overlapping; mlc verify reports the clearance) instead of refusing the robot")
     p.add_argument("--json", action="store_true", help="print the summary as JSON")
     p.set_defaults(func=run)
 
@@ -275,6 +278,9 @@ def run(args) -> int:
         raise MlcError("--direct only applies to the circuit", "--no-circuit", "drop --no-circuit")
     if getattr(args, "muscle_per_lever", False) and not want_circuit:
         raise MlcError("--muscle-per-lever only applies to the circuit", "--no-circuit", "drop --no-circuit")
+    if getattr(args, "allow_overlap", False) and not getattr(args, "robot", None):
+        raise MlcError("--allow-overlap only applies to a robot's coupling chains", "--allow-overlap",
+                       "add --robot ROBOT.yaml or drop --allow-overlap")
     if getattr(args, "robot", None):
         if not want_circuit:
             raise MlcError("--robot needs the circuit", "--no-circuit", "drop --no-circuit")
@@ -317,7 +323,7 @@ def run(args) -> int:
         files["circuit.png"] = render_circuit(scene)
         if args.robot:                              # docs/robot.md
             from mlc.commands.robot import robot_files
-            robot_scene, robot_out = robot_files(scene, args.robot)
+            robot_scene, robot_out = robot_files(scene, args.robot, allow_overlap=bool(getattr(args, "allow_overlap", False)))
             files.update(robot_out)
             scene = robot_scene
         if args.verify:

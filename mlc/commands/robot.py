@@ -15,14 +15,15 @@ import json
 import math
 
 
-def robot_files(circuit_scene, robot_path):
-    """(robot scene, {"robot.yaml": bytes}) for a built circuit and a robot file."""
+def robot_files(circuit_scene, robot_path, allow_overlap: bool = False):
+    """(robot scene, {"robot.yaml": bytes}) for a built circuit and a robot file
+    (``allow_overlap``: :func:`mlc.robot.build.build_robot`)."""
     from mlc.robot.build import build_robot
     from mlc.robot.spec import load_robot
     from mlc.scene.io import dump_scene
 
     spec = load_robot(robot_path, circuit_scene)
-    robot = build_robot(circuit_scene, spec)
+    robot = build_robot(circuit_scene, spec, allow_overlap=allow_overlap)
     return robot.scene, {"robot.yaml": dump_scene(robot.scene).encode()}
 
 

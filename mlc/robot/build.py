@@ -392,9 +392,14 @@ def _chain_overlap(placed: list[Body], placed_bonds: list[Bond], parts, new_bond
     return max((d for a, b, d in rep.overlaps if a in new_names or b in new_names), default=0.0)
 
 
-def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
+def build_robot(circuit: Scene, spec: RobotSpec, allow_overlap: bool = False) -> Robot:
     """One scene: the circuit, the skeleton and a coupling per DOF (see the module doc),
-    posed in the all-zero input row."""
+    posed in the all-zero input row.
+
+    A coupling chain whose every start (fan turn, page turn, kept apart or not) interpenetrates
+    a slab placed before is refused (:class:`MlcError` naming the DOF's line in the robot file),
+    unless ``allow_overlap``: then the least overlapping start is kept and its depth (sigma)
+    recorded in ``meta.robot.dofs[].chain.overlap`` (``mlc verify`` reports the clearance)."""
     import time
 
     from mlc.circuit.route import BEND_FRACTION, solve_route
@@ -705,7 +710,15 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
                 break
             if fallback is None or depth < fallback[0]:
                 fallback = (depth, (route, parts, pairs, c_start, pg is not None, tv, fan, avoid, post if pg else None))
-        if found is None and fallback is not None:      # every start overlaps: the least (mlc verify reports it)
+        kept = None
+        if found is None and fallback is not None:      # every start overlaps: refused, unless allowed
+            kept = fallback[0]
+            if not allow_overlap:
+                raise MlcError(f"cannot couple output {ds.output} to dof {name} clear of the other slabs: every "
+                               f"start tried ({len(avoids) * len(fans)}) interpenetrates a body placed before, the "
+                               f"least by {kept:.3f} sigma", ds.loc,
+                               "a placement limit of mlc: try a larger skeleton height, or build it anyway with "
+                               "mlc compile --allow-overlap and read the slab clearance mlc verify reports")
             found = fallback[1]
         if found is None:
             raise MlcError(f"cannot route output {ds.output} to dof {name}: no connector chain reaches it "
@@ -743,7 +756,8 @@ def build_robot(circuit: Scene, spec: RobotSpec) -> Robot:
             "half_units": nh, "prefix": tag, "page": paged,
             "page_on": (host[0] if host is not None else start.lo.split(".")[0]) if paged else None, "fan_deg": fan, "avoid": avoid, "route_seconds": round(time.perf_counter() - tr, 2),
             "reach_max": round(max(d_rows), 3), "wrist_units": WRIST_UNITS if WRIST else 0,
-            "contour": round(contour, 3), "reach_fraction": round(max(d_rows) / contour, 3)}
+            "contour": round(contour, 3), "reach_fraction": round(max(d_rows) / contour, 3),
+            "overlap": round(kept, 4) if kept is not None else 0.0}
     rmeta = spec.as_dict()
     rmeta.update({"origin": [float(v) for v in origin], "plane_normal": [0.0, 0.0, 1.0], "x_axis": [1.0, 0, 0],
                   "joint_length": s, "links": [f"skel_u{i}" for i in range(spec.units + 1)],
