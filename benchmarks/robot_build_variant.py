@@ -16,6 +16,7 @@ import argparse
 import ast
 import sys
 import time
+from pathlib import Path
 
 
 def main(argv=None) -> int:
@@ -41,6 +42,7 @@ def main(argv=None) -> int:
     t = time.perf_counter()
     rob = B.build_robot(circ, spec)
     rob.scene.meta["robot"]["build_overrides"] = over
+    Path(a.out).parent.mkdir(parents=True, exist_ok=True)
     with open(a.out, "w") as f:
         f.write(dump_scene(rob.scene))
     print(f"{len(rob.scene.bodies)} bodies, {rob.chains} chains of {rob.half_units} half units, "
@@ -48,7 +50,8 @@ def main(argv=None) -> int:
     for d in rob.scene.meta["robot"]["dofs"]:
         if "chain" in d:
             c = d["chain"]
-            print(f"  {d['name']}: {c['half_units']} half units, reach fraction {c['reach_fraction']}")
+            print(f"  {d['name']}: {c['half_units']} half units, reach fraction {c['reach_fraction']}, fan "
+                  f"{c['fan_deg']}, avoid {c['avoid']}, overlap {c.get('overlap')}, margin short {c.get('margin_short')}")
     return 0
 
 

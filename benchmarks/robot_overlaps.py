@@ -16,8 +16,10 @@ bodies sorted into a class by the bodies' names:
 * ``skeleton``: two skeleton bodies; ``circuit``: two circuit bodies.
 
 For a chain slab it records the half unit's index and the chain's length in half units
-(0 and n - 1 are its ends: the circuit's output pair and the lever sites).  Optionally
-(``--bend``) the bend of each junction involved, against the connector's largest bend.
+(0 and n - 1 are its ends: the circuit's output pair and the lever sites).  For every two
+coupling chains within 4 sigma: their smallest slab clearance, as built and in each row
+(``chain_pairs``; chains do not act on each other, so a pair that keeps apart as built may
+meet as the skeleton folds).
 
 ``--outside`` confirms each pose's list without mlc.verify.overlap: manifold3d's boolean
 intersection of every two nearby boxes of different bodies (benchmarks/outside_overlap.py,
@@ -100,6 +102,37 @@ def outside(scene, pos, quat, box_pairs) -> dict:
             "wall_s": round(time.perf_counter() - t, 1)}
 
 
+def chain_pairs(scene, pos, quat, reach: float = 4.0) -> dict:
+    """The smallest slab clearance (sigma; negative: interpenetration) of every two coupling
+    chains whose slabs come within ``reach`` (box centres), with the two bodies:
+    ``{"u4_up/u4_dn": [clearance, body, body]}`` (the oriented-box distance of
+    mlc.verify.overlap, no contact left out: two chains share no joint)."""
+    import numpy as np
+    from scipy.spatial import cKDTree
+
+    from mlc.verify.overlap import _world_boxes, box_clearance
+
+    if pos is None:
+        pos = np.array([b.position for b in scene.bodies], float)
+        quat = np.array([b.orientation for b in scene.bodies], float)
+    C, A, H, B = _world_boxes(scene, np.asarray(pos, float), np.asarray(quat, float))
+    names = [b.name for b in scene.bodies]
+    ch = np.array([part(names[int(b)])[1] or "" for b in B])
+    idx = np.nonzero(ch != "")[0]
+    pr = cKDTree(C[idx]).query_pairs(reach, output_type="ndarray")
+    I, J = idx[pr[:, 0]], idx[pr[:, 1]]
+    keep = ch[I] != ch[J]
+    I, J = I[keep], J[keep]
+    out: dict = {}
+    for i, j, c in zip(I, J, box_clearance(C[I], A[I], H[I], C[J], A[J], H[J])):
+        a, b = sorted((ch[i], ch[j]))
+        key = f"{a}/{b}"
+        if key not in out or c < out[key][0]:
+            na, nb = names[int(B[i])], names[int(B[j])]
+            out[key] = [round(float(c), 4), *((na, nb) if ch[i] == a else (nb, na))]
+    return dict(sorted(out.items()))
+
+
 def analyse(scene, pos, quat, check_outside: bool = False) -> dict:
     from mlc.verify.overlap import clearance
 
@@ -123,7 +156,7 @@ def analyse(scene, pos, quat, check_outside: bool = False) -> dict:
         by[p["class"]].append(p["depth"])
     out = {"min_clearance": round(c.min_clearance, 4), "pair": list(c.pair), "n_overlaps": len(pairs),
            "by_class": {k: {"n": len(v), "deepest": max(v)} for k, v in sorted(by.items())},
-           "overlaps": pairs}
+           "overlaps": pairs, "chain_pairs": chain_pairs(scene, pos, quat)}
     if check_outside:
         out["outside"] = outside(scene, pos, quat, {(p["a"], p["b"]): p["depth"] for p in pairs})
     return out
