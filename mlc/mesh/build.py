@@ -1084,6 +1084,9 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
         _resolve(asm, protected, soft, state_T, asm.congruence, fat_guard)
         if motion_T:
             _clear_motion(asm, protected, soft, list(motion_poses), motion_T)
+        if reuse and BEVEL_ENDS:
+            _log("bevels of facing end knuckles")
+            _bevel_facing_ends(asm, notes)
     _log("final trims done; drilling")
     # attachment holes shaped for the print's up where it is known now: the feet's (fdm's
     # orient: auto; the as_is profiles, mjp and sla, print their own support and keep round holes)
@@ -1099,6 +1102,134 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
     asm.orient = _orientation(asm)
     _log("assembly done")
     return asm
+
+
+# -- facing end knuckles of two hinges (session 55) -----------------------------------------
+#: compiled circuits: the end knuckles of two hinges that face each other across a bent junction
+#: (a chain's layers; a branch's leaf page and its chain's first half unit) bevelled apart
+BEVEL_ENDS = True
+BEVEL_FACING = 0.5        # end faces whose outward normals meet at more than 120 degrees face each other
+BEVEL_RINGS = (0.0, 0.5, 1.0)   # ... sampled on these fractions of the knuckle radius
+
+
+def _end_knuckles(axes) -> list:
+    """(axis, sign, body, knuckle length) of every hinge's two end knuckles: the knuckle that
+    ends on the span's end ``sign * span / 2`` and the body it belongs to."""
+    out = []
+    for ax in axes:
+        for sg in (-1.0, 1.0):
+            e = sg * ax.span / 2
+            for bn, ivs in ax.intervals.items():
+                for a0, a1 in ivs:
+                    if abs((a1 if sg > 0 else a0) - e) < 1e-6:
+                        out.append((ax, sg, bn, a1 - a0))
+    return out
+
+
+def _face_points(o, d, R, n_ang=16):
+    """Points of an end face's disk (centre ``o``, normal ``d``, radius ``R``) on BEVEL_RINGS."""
+    P = _perp_frame(d)
+    a = np.linspace(0, 2 * np.pi, n_ang, endpoint=False)
+    ring = np.cos(a)[:, None] * P[:, 0] + np.sin(a)[:, None] * P[:, 1]
+    pts = [o[None, :]] + [o + f * R * ring for f in BEVEL_RINGS if f > 0]
+    return np.vstack(pts)
+
+
+def _to_cylinder(p, o, n, k, R):
+    """Distance of points ``p`` to the knuckle whose end face is centred at ``o`` with outward
+    normal ``n`` (unit), ``k`` long and of radius ``R`` (0 inside)."""
+    v = p - o
+    depth = -(v @ n)
+    r = np.linalg.norm(v + np.outer(depth, n), axis=1)
+    dz = np.maximum(np.maximum(-depth, depth - k), 0.0)
+    return np.hypot(dz, np.maximum(r - R, 0.0))
+
+
+def _bevel_facing_ends(asm: "Assembly", notes: list) -> None:
+    """Bevel the end knuckles of two hinges of different bodies that face each other and come
+    closer than the clearance in a pose.
+
+    A connector's layers are a junction gap apart, and the scene stops a junction's bend where
+    the layers' slabs would meet at the far corner (``mlc.gates.connector.max_bend``: 36.9
+    degrees, the stop at 90 % of it).  The printed knuckles stand ``R`` (1.1 mm at mjp) round
+    that corner's hinge, so the end faces of the two layers' far-corner knuckles met from about
+    29 degrees on (the Tetris circuit: junctions bent by 29.5 to 33.2 degrees in its logic states,
+    and a branch's leaf page against its chain's first half unit, bent by 29.5 degrees at rest).
+    For every such pair and pose, the plane half way between the two posed end faces (the
+    bisector of their planes) is found, and each knuckle loses what lies within half the
+    clearance of it on its side, inside its own end knuckle only (a bevel of the far rim; the
+    knuckle's inner faces, which hold the stack along the pin, are untouched).  A bevel that
+    would leave the body in pieces is not made."""
+    if not asm.poses:
+        return
+    c = asm.profile.clearance
+    n = asm.profile.circular_segments
+    ends = _end_knuckles(asm.axes)
+    if not ends:
+        return
+    from scipy.spatial import cKDTree
+    Ts = [asm.part_transforms(pos, quat) for pos, quat in asm.poses.values()]
+    R = max(ax.R for ax, _, _, _ in ends)
+    bodies_of = [set(ax.bodies) for ax, _, _, _ in ends]
+    O = np.array([ax.origin + sg * ax.span / 2 * ax.direction for ax, sg, _, _ in ends])
+    N = np.array([sg * ax.direction for ax, sg, _, _ in ends])
+    cuts: dict = {}      # end index -> [(m, h)]: cut where m . p > h (rest frame of its body)
+    for T in Ts:
+        Tb = [T[bn] for _, _, bn, _ in ends]
+        Op = np.array([t[:3, :3] @ o + t[:3, 3] for t, o in zip(Tb, O)])
+        Np = np.array([t[:3, :3] @ v for t, v in zip(Tb, N)])
+        for i, j in cKDTree(Op).query_pairs(2 * R + 2 * c):
+            if ends[i][2] == ends[j][2] or bodies_of[i] & bodies_of[j] or Np[i] @ Np[j] > -BEVEL_FACING:
+                continue
+            (ai, _, _, ki), (aj, _, _, kj) = ends[i], ends[j]
+            near = min(_to_cylinder(_face_points(Op[i], Np[i], ai.R), Op[j], Np[j], kj, aj.R).min(),
+                       _to_cylinder(_face_points(Op[j], Np[j], aj.R), Op[i], Np[i], ki, ai.R).min())
+            if near >= c:
+                continue
+            w = Np[i] - Np[j]
+            L = float(np.linalg.norm(w))
+            m, h = w / L, (Op[i] @ Np[i] - Op[j] @ Np[j]) / L    # f(p) = m . p - h: + toward j
+            for k, sgn in ((i, 1.0), (j, -1.0)):
+                t = Tb[k]
+                # the cut's plane in k's rest frame: sgn * f(p) > -c / 2
+                mk = t[:3, :3].T @ (sgn * m)
+                hk = sgn * h - c / 2 - (sgn * m) @ t[:3, 3]
+                cuts.setdefault(k, []).append((mk, hk))
+    if not cuts:
+        return
+    by = {p.name: p for p in asm.parts}
+    per_body: dict = {}
+    for k, planes in cuts.items():
+        ax, sg, bn, kk = ends[k]
+        o = O[k]
+        zone = cylinder(o - N[k] * kk, N[k], 0.0, kk + 0.05, ax.R + 0.05, n)
+        big = 4 * (ax.R + kk) + 1.0
+        for mk, hk in planes:
+            # the half space m . p > h, clipped to the end knuckle
+            F = _perp_frame(mk)
+            p0 = o + (hk - mk @ o) * mk          # on the plane, nearest the face centre
+            half = box(p0 + mk * big / 2, F, np.array([big, big, big]))
+            per_body.setdefault(bn, []).append(zone ^ half)
+    done = []
+    for bn, pieces in per_body.items():
+        part = by[bn]
+        cutter = union(pieces)
+        new = part.solid - cutter
+        removed = part.solid.volume() - new.volume()
+        if removed <= 1e-9:
+            continue
+        if len(new.decompose()) != len(part.solid.decompose()):
+            notes.append(f"{bn}: the bevel of its end knuckles facing another hinge's would leave it in pieces: not made")
+            continue
+        part.solid = new
+        cores = getattr(asm, "cores", None)
+        if cores and bn in cores:     # retention counts what is left of the knuckle
+            cores[bn] = cores[bn] - cutter
+        done.append((bn, removed))
+    if done:
+        notes.append(f"end knuckles facing another hinge's across a bent junction: {len(done)} bodies bevelled, "
+                     f"{sum(r for _, r in done):.3g} mm^3 removed (largest {max(r for _, r in done):.3g} mm^3, "
+                     f"{max(done, key=lambda x: x[1])[0]})")
 
 
 # --------------------------------------------------------------------------- helpers
