@@ -1087,6 +1087,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
         if reuse and BEVEL_ENDS:
             _log("bevels of facing end knuckles")
             _bevel_facing_ends(asm, notes)
+        if reuse and PIN_RELIEF:
+            _relieve_host_holes(asm, notes)
     _log("final trims done; drilling")
     # attachment holes shaped for the print's up where it is known now: the feet's (fdm's
     # orient: auto; the as_is profiles, mjp and sla, print their own support and keep round holes)
@@ -1228,6 +1230,78 @@ def _bevel_facing_ends(asm: "Assembly", notes: list) -> None:
         done.append((bn, removed))
     if done:
         notes.append(f"end knuckles facing another hinge's across a bent junction: {len(done)} bodies bevelled, "
+                     f"{sum(r for _, r in done):.3g} mm^3 removed (largest {max(r for _, r in done):.3g} mm^3, "
+                     f"{max(done, key=lambda x: x[1])[0]})")
+
+
+#: compiled circuits: a compound junction's pin relieved in the stack's holes where it swings (session 55)
+PIN_RELIEF = True
+PIN_RELIEF_MARGIN = 0.01  # mm: the relief clears the posed pin by this much
+
+
+def _relieve_host_holes(asm: "Assembly", notes: list) -> None:
+    """Relieve the holes of a compound junction's host stack where the joint part's pin,
+    posed in a logic state, reaches the hole's wall.
+
+    The joint part floats in its holes' clearance and is posed with the junction's twist shared
+    between its two pins (``_split_twist``), its hub half way between the bodies' copies of the
+    joint point: in the Tetris circuit's most bent junctions its first pin met the wall of the
+    hole at the far end of the stack (0.0003 mm^3, `w_b_0_60_AB` against `w_b_0_j61_hi`, row 01).
+    Each knuckle of the stack whose hole the posed pin comes within ``PIN_RELIEF_MARGIN`` of
+    the wall loses the posed pin grown by that margin, inside that knuckle only: a relief of a
+    few hundredths of a millimetre at the hole's mouth."""
+    if not asm.poses:
+        return
+    n = asm.profile.circular_segments
+    e = PIN_RELIEF_MARGIN
+    Ts = [asm.part_transforms(pos, quat) for pos, quat in asm.poses.values()]
+    by = {p.name: p for p in asm.parts}
+    per_body: dict = {}
+    for uj in asm.ujoints:
+        hx = uj.host
+        if hx is None or not uj.primary or uj.part not in by:
+            continue
+        u = uj.axes[0]
+        p0, p1 = uj.layouts[0].pin
+        for bn in hx.bodies:
+            if bn not in by or bn == uj.part:
+                continue
+            for a0, a1 in hx.intervals.get(bn, []):
+                ends = hx.origin + np.outer([a0, a1], hx.direction)
+                for T in Ts:
+                    M = np.linalg.inv(T[bn]) @ T[uj.part]
+                    c0 = M[:3, :3] @ uj.center + M[:3, 3]
+                    d = M[:3, :3] @ u
+                    # the posed pin's axis where it crosses the knuckle's end planes
+                    den = d @ hx.direction
+                    if abs(den) < 0.5:
+                        continue
+                    s = ((ends - c0) @ hx.direction) / den
+                    if s.max() < p0 or s.min() > p1:
+                        continue
+                    q = c0 + np.outer(np.clip(s, p0, p1), d)
+                    v = q - hx.origin
+                    off = np.linalg.norm(v - np.outer(v @ hx.direction, hx.direction), axis=1)
+                    if off.max() + uj.r_pin < hx.r_hole - e:
+                        continue
+                    zone = cylinder(hx.origin, hx.direction, a0 - 1e-3, a1 + 1e-3, hx.R + 0.05, n)
+                    pin = cylinder(c0, d, p0 - 0.05, p1 + 0.05, uj.r_pin + e, n, cutter=True)
+                    per_body.setdefault(bn, []).append(zone ^ pin)
+    done = []
+    cores = getattr(asm, "cores", None)
+    for bn, pieces in per_body.items():
+        part = by[bn]
+        cutter = union(pieces)
+        new = part.solid - cutter
+        removed = part.solid.volume() - new.volume()
+        if removed <= 1e-9 or len(new.decompose()) != len(part.solid.decompose()):
+            continue
+        part.solid = new
+        if cores and bn in cores:
+            cores[bn] = cores[bn] - cutter
+        done.append((bn, removed))
+    if done:
+        notes.append(f"compound junctions' pins relieved in their stacks' holes where they swing: {len(done)} bodies, "
                      f"{sum(r for _, r in done):.3g} mm^3 removed (largest {max(r for _, r in done):.3g} mm^3, "
                      f"{max(done, key=lambda x: x[1])[0]})")
 
