@@ -1089,6 +1089,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
             _bevel_facing_ends(asm, notes)
         if reuse and PIN_RELIEF:
             _relieve_host_holes(asm, notes)
+        if reuse and YOKE_TIP_CLEAR:
+            _clear_tipped_yokes(asm, notes)
     _log("final trims done; drilling")
     # attachment holes shaped for the print's up where it is known now: the feet's (fdm's
     # orient: auto; the as_is profiles, mjp and sla, print their own support and keep round holes)
@@ -1304,6 +1306,77 @@ def _relieve_host_holes(asm: "Assembly", notes: list) -> None:
         notes.append(f"compound junctions' pins relieved in their stacks' holes where they swing: {len(done)} bodies, "
                      f"{sum(r for _, r in done):.3g} mm^3 removed (largest {max(r for _, r in done):.3g} mm^3, "
                      f"{max(done, key=lambda x: x[1])[0]})")
+
+
+#: compiled circuits: a compound junction's host hinge bodies cleared of the yoke where the posed
+#: junction's twist tips it below the host's cut (session 55)
+YOKE_TIP_CLEAR = True
+
+
+def _clear_tipped_yokes(asm: "Assembly", notes: list) -> None:
+    """Trim a compound junction's host-hinge bodies where the other body's yoke knuckles, posed,
+    reach past the end of the cut that clears them (``layouts[0].cut``, along the first pin).
+
+    The cut runs from just inside the host layer's face (0.05 mm) across the junction gap; the
+    yoke's knuckles (radius ``R``, up to 2.4 mm along the second pin) clear it as long as the
+    joint's twist stays under about 5 degrees, and the circuit's statics twist some junctions
+    more (``_split_twist``): in the Tetris circuit ``w_b_0_62_AB``'s yoke grazed the face of
+    ``w_b_0_61_DA`` (row 11) and ``w_b_1_111_AB``'s that of ``w_b_1_110_CD`` (row 01), 2e-5 and
+    8e-5 mm^3.  Each host-hinge body loses those posed knuckles grown by half the clearance,
+    outside its own stack on the host axis (radius ``R`` + clearance)."""
+    if not asm.poses:
+        return
+    c = asm.profile.clearance
+    n = asm.profile.circular_segments
+    Ts = [asm.part_transforms(pos, quat) for pos, quat in asm.poses.values()]
+    by = {p.name: p for p in asm.parts}
+    per_body: dict = {}
+    for uj in asm.ujoints:
+        hx = uj.host
+        if hx is None or not uj.primary:
+            continue
+        O = uj.bodies[1]
+        lay, d = uj.layouts[1], hx.direction
+        c_h = float((uj.center - hx.origin) @ d)
+        ends = sorted(c_h + float(uj.axes[0] @ d) * np.array(uj.layouts[0].cut), key=abs)
+        h_cut = ends[0]                  # the cut's end at the host layer
+        sl = -np.sign(c_h) if c_h else 1.0   # toward the layer
+        for X in hx.bodies:
+            if X == O or X not in by or O not in by:
+                continue
+            for T in Ts:
+                M = np.linalg.inv(T[X]) @ T[O]
+                cc = M[:3, :3] @ uj.center + M[:3, 3]
+                v = M[:3, :3] @ uj.axes[1]
+                lean = float(np.sqrt(max(0.0, 1.0 - (v @ d) ** 2)))
+                for a0, a1 in lay.own:
+                    g = max(sl * ((cc + a * v - hx.origin) @ d) for a in (a0, a1)) + uj.R * lean
+                    if g < sl * h_cut - c / 2:
+                        continue
+                    per_body.setdefault(X, []).append(cylinder(cc, v, a0 - c / 2, a1 + c / 2, uj.R + c / 2, n,
+                                                               cutter=True))
+    done = []
+    cores = getattr(asm, "cores", None)
+    stacks: dict = {}
+    for ax in asm.axes:
+        for bn in ax.bodies:
+            stacks.setdefault(bn, []).append(cylinder(ax.origin, ax.direction, -ax.span / 2 - c, ax.span / 2 + c,
+                                                      ax.R + c, n))
+    for bn, pieces in per_body.items():
+        part = by[bn]
+        cutter = union(pieces) - union(stacks.get(bn, []))
+        new = part.solid - cutter
+        removed = part.solid.volume() - new.volume()
+        if removed <= 1e-9 or len(new.decompose()) != len(part.solid.decompose()):
+            continue
+        part.solid = new
+        if cores and bn in cores:
+            cores[bn] = cores[bn] - cutter
+        done.append((bn, removed))
+    if done:
+        notes.append(f"compound junctions' yokes tipped by the twist past their hosts' cut: {len(done)} host-hinge "
+                     f"bodies trimmed, {sum(r for _, r in done):.3g} mm^3 removed (largest {max(r for _, r in done):.3g} "
+                     f"mm^3, {max(done, key=lambda x: x[1])[0]})")
 
 
 # --------------------------------------------------------------------------- helpers
