@@ -83,6 +83,7 @@ PIN_TWIST = True      # compound junctions: the second pin turned about the firs
 ONE_SIDED_TWIST = True   # ... with a one-sided yoke where both sides would not be clear (session 51)
 ONE_SIDED_ABOVE = 4.0    # degrees: ... only when the least twist with both sides is more than this
 ONE_SIDED_GAIN = 1.0     # degrees: ... and the one-sided yoke's twist less by at least this
+CLIP_UJ_PLATES = True    # a yoke plate past the end of another hinge of its body stops at its trim radius (session 55)
 UNTWIST_SPLIT = True     # ... not to a pin that cuts the other body in pieces (built again; session 52)
 
 
@@ -767,9 +768,12 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
                                                reach, t)
                     notes.append(f"hinge {ax.name}: {bn}'s knuckles lie off its slab: a fin across the slab "
                                  "carries them")
+    uj_plates = []      # (body, joint, plate): the universal joints' yoke plates (CLIP_UJ_PLATES)
     for uj in ujoints:
         for side, bn in enumerate(uj.bodies):
-            plates[bn] += _uj_plates(uj, side, slabs[bn], uj.rho[side] + reach, t)
+            for sb in _uj_plates(uj, side, slabs[bn], uj.rho[side] + reach, t):
+                plates[bn].append(sb)
+                uj_plates.append((bn, uj, sb))
     shapes = {bn: slabs[bn] + plates[bn] for bn in slabs}
     samples = {bn: _slab_samples(shapes[bn], h) for bn in shapes}
 
@@ -787,6 +791,37 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
             ox.rho = max(ox.rho, float(np.hypot(half, t / 2)) + c)
     if memo is not None:
         _share_hinge_radii(axes, samples, slabs)
+    if CLIP_UJ_PLATES and uj_plates:
+        # a yoke plate that runs down its body past the end of another hinge of the body stops
+        # at that hinge's trim radius (session 55): the trims clear the other bodies only over
+        # the hinge's span, and past it the plate met the other body's (a gate's two crossed
+        # output levers, each carrying a universal joint with a plain yoke, at their pivot)
+        # ... only where, past the span, it comes within the slab thickness and clearance of
+        # another body's material past the span too, in a logic state (a gate whose output
+        # levers carry no chain, as built before: the plate of its joint d on out_hi meets only
+        # out_lo's slab at the span's end, which the hinge's own cuts clear)
+        def past(ax, P):
+            return P[np.abs(_axis_coords(ax.origin, ax.direction, P)[0]) > ax.span / 2 + 1e-6]
+
+        def clash(bn, ax, cut_sb):
+            P = past(ax, _slab_samples([cut_sb], h))
+            states = state_T or [("rest", None)]
+            return any(len(ii) for B in ax.bodies if B != bn
+                       for ii, _ in _close_pairs_posed(P, past(ax, samples[B]),
+                                                       [_relative(bn, B, Ts) for _, Ts in states], t + c + h))
+        clipped = []
+        for bn, uj, sb in uj_plates:
+            nb = _clip_at_axes(sb, [ax for ax in axes if bn in ax.bodies and ax is not uj.host],
+                               max(uj.R, uj.hub_r) + t, t, lambda ax, cut_sb, bn=bn: clash(bn, ax, cut_sb))
+            if nb is not sb:
+                plates[bn][next(i for i, x in enumerate(plates[bn]) if x is sb)] = nb
+                clipped.append((bn, uj.name, float(sb.size[1] - nb.size[1])))
+        if clipped:
+            for bn, jn, cut in clipped:
+                notes.append(f"universal joint {jn}: {bn}'s yoke plate stops {cut:.2f} mm short, at the trim "
+                             "radius of its hinge whose span it ran past")
+            shapes = {bn: slabs[bn] + plates[bn] for bn in slabs}
+            samples = {bn: _slab_samples(shapes[bn], h) for bn in shapes}
 
     # -- muscle and probe attachment holes -------------------------------------------
     lug_hole = max(prof.min_feature, 0.08 * s) / 2
@@ -3747,6 +3782,50 @@ def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False, rod_reach=Non
             out.append(SlabBox(origin + d * 0.5 * (a0 + a1) + w * reach_b / 2 + shift, Rm,
                                np.array([a1 - a0, reach_b, t]), 2, sb.offset))
     return out
+
+
+def _clip_at_axes(sb: SlabBox, axes, least, t, clash=None) -> SlabBox:
+    """A universal joint's yoke plate (:func:`_yoke_plates`: along ``R[:, 0]`` the pin, along
+    ``R[:, 1]`` away from it over ``size[1]``) shortened to stop at the trim radius ``rho`` of
+    every hinge in ``axes`` (the body's other hinges) that runs parallel to the pin, lies in the
+    plate's layer within its reach, and whose span the plate runs past; never shorter than
+    ``least`` (mm); with ``clash(ax, cut)`` only where it is true of the plate's part cut off
+    (a slab box).  The trims clear the other bodies of a hinge within ``rho`` only over its
+    span (:func:`_trim_radius` takes the points past it as trimmed): a plate past the span's end
+    is where the other body's material is too (six bodies of the Tetris robot's gate g2 and its
+    coupling, tests/data_mesh/robot_g2_outputs: both crossed output levers' plates, 5.2 mm wide
+    over a 2.5 mm pivot, met past its end, 0.16 mm^3; session 55)."""
+    d, w, nrm = sb.R[:, 0], sb.R[:, 1], sb.R[:, 2]
+    L = float(sb.size[1])
+    start = sb.center - w * L / 2
+    reach_b = L
+    for ax in axes:
+        if abs(abs(float(np.dot(ax.direction, d))) - 1) > 1e-6 or ax.rho <= 0:
+            continue
+        rel = ax.origin - start
+        if abs(float(np.dot(rel, nrm))) > t / 2 + ax.R:
+            continue          # not in the plate's layer
+        a = float(np.dot(rel, w))
+        if a <= 0 or a - ax.rho >= reach_b:
+            continue          # behind the plate, or farther than it reaches
+        ca = float(np.dot(sb.center - ax.origin, ax.direction))
+        half = 0.5 * float(sb.size[0])
+        if ca - half >= -ax.span / 2 - 1e-6 and ca + half <= ax.span / 2 + 1e-6:
+            continue          # within the span: the hinge's trims clear it
+        r = max(min(reach_b, a - ax.rho), min(L, least))
+        if r >= reach_b - 1e-9:
+            continue
+        if clash is not None:
+            size = sb.size.copy()
+            size[1] = reach_b - r
+            if not clash(ax, SlabBox(start + w * 0.5 * (r + reach_b), sb.R, size, sb.normal_axis, sb.offset)):
+                continue      # nothing of the hinge's other bodies comes near it
+        reach_b = r
+    if reach_b >= L - 1e-9:
+        return sb
+    size = sb.size.copy()
+    size[1] = reach_b
+    return SlabBox(start + w * reach_b / 2, sb.R, size, sb.normal_axis, sb.offset)
 
 
 def _on_slab(sb: SlabBox, p, w) -> float:

@@ -1,0 +1,83 @@
+"""Session 55 (issue 13): a gate's two crossed output levers, each carrying a universal joint
+with a plain yoke, keep the clearance at their pivot.
+
+``robot_g2_outputs`` (tests/data_mesh) is six bodies of the README's Tetris robot (``mlc robot``
+of examples/tetris.tt), at the pose they are built in: gate g2's output levers ``g2_out_lo`` and
+``g2_out_hi`` with its cores, and two slabs of the coupling chain's first half unit
+(``rc_u4_dn_0_AB``, ``rc_u4_dn_0_CD``) hung on the levers' output sites by the universal joints
+``rc_u4_dn_j0_lo``/``_hi``.  Without the half unit's other two slabs the joints are not compound
+junctions (as in the whole robot, where the half unit's hinges host them) but plain yokes, whose
+yoke plates widen each lever to the yoke's knuckles (5.2 mm across) all the way down to the
+levers' crossing pivot ``g2_pivot_out``, whose knuckles span only 2.5 mm: past the span's end the
+pivot's trims cut nothing, and the two levers' plates met there (0.16 mm^3, min_gap 0).  The
+plates now stop at the pivot's trim radius where they run past its span and meet the other
+lever's material there (``_clip_at_axes``); the same gate without the chain is built as before."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from mlc.mesh import build as B
+from mlc.mesh.build import build_assembly
+from mlc.mesh.checks import check_assembly
+from mlc.mesh.pipeline import sub_scene
+from mlc.mesh.profiles import load_profile
+
+DATA = Path(__file__).parent / "data_mesh"
+PAIR = ("g2_out_lo", "g2_out_hi")
+
+
+def _pose(sc):
+    return {"00": (np.array([b.position for b in sc.bodies], float), np.array([b.orientation for b in sc.bodies], float))}
+
+
+@pytest.fixture(scope="module")
+def scene():
+    from mlc.scene.io import load_scene
+    return load_scene(DATA / "robot_g2_outputs.yaml")
+
+
+def _build(sc):
+    return build_assembly(sc, load_profile("mjp"), _pose(sc), reuse=True)
+
+
+def _pair_failures(rep):
+    by = {c.name: c for c in rep.checks}
+    return [f for name in ("min_gap", "states") for f in by[name].failures if all(n in f for n in PAIR)]
+
+
+def test_crossed_output_levers_with_joints_keep_the_clearance(scene, monkeypatch):
+    asm = _build(scene)
+    rep = check_assembly(asm, walls=False)
+    by = {c.name: c for c in rep.checks}
+    for name in ("watertight", "retention", "features"):
+        assert by[name].ok, (name, by[name].detail, by[name].failures)
+    assert _pair_failures(rep) == []
+    assert by["states"].ok, by["states"].failures
+    for n in PAIR:          # each lever one piece, its pivot knuckles and yoke knuckles kept
+        assert len(asm.part(n).solid.decompose()) == 1
+    assert not any(n in f for f in by["part_count"].failures for n in PAIR)
+    assert sum("yoke plate stops" in n for n in asm.notes) == 3
+    X = asm.part(PAIR[0]).solid ^ asm.part(PAIR[1]).solid
+    assert X.volume() < 1e-9
+    # without the clipped plates the two levers meet past the pivot's end
+    monkeypatch.setattr(B, "CLIP_UJ_PLATES", False)
+    old = _build(scene)
+    fails = _pair_failures(check_assembly(old, walls=False))
+    assert any(f.startswith("g2_out_lo - g2_out_hi") for f in fails), fails
+    assert any("g2_out_lo intersects g2_out_hi" in f for f in fails), fails
+
+
+def test_the_gate_alone_is_built_as_before(scene, monkeypatch):
+    """Without the chain the output levers' plates (the gate's own joint d on g2_out_hi) meet
+    nothing past the pivot's span: no plate is clipped, the levers are the same solids."""
+    keep = [i for i, b in enumerate(scene.bodies) if b.name.startswith("g2_")]
+    sc = sub_scene(scene, keep, "g2_alone")
+    asm = _build(sc)
+    assert not any("yoke plate stops" in n for n in asm.notes)
+    monkeypatch.setattr(B, "CLIP_UJ_PLATES", False)
+    old = _build(sc)
+    for n in PAIR:
+        assert abs(asm.part(n).solid.volume() - old.part(n).solid.volume()) < 1e-9
