@@ -81,3 +81,38 @@ def test_the_gate_alone_is_built_as_before(scene, monkeypatch):
     old = _build(sc)
     for n in PAIR:
         assert abs(asm.part(n).solid.volume() - old.part(n).solid.volume()) < 1e-9
+
+
+def _robot_g2():
+    """Gate g2 of the README robot and two bond hops round it (20 bodies: its input chains' last
+    and the coupling's first half units whole), with the whole robot's 22 print poses
+    (``state_poses`` of its largest mechanism)."""
+    from mlc.scene.io import load_scene
+    z = np.load(DATA / "robot_g2_poses.npz")
+    return (load_scene(DATA / "robot_g2.yaml"),
+            {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])})
+
+
+def test_turned_one_sided_yokes_on_crossed_output_levers_leave_their_free_side(monkeypatch):
+    """The whole robot's failure (the same 1.772 mm^3 in states 00, 01 and 11): the coupling's
+    first junctions are compound (hosted on the half unit's hinges), their second pins turned
+    (least_twist) to point at each other across the two output levers' V, one-sided; each lever's
+    yoke plate still ran half the lever's width past the hub on the free side, where the other
+    lever's plate was.  Now it stops at the hub there: the pair's intersection drops 38-fold (what
+    is left: g2_out_lo's trim radii, shrunk to keep it in one piece, leave its pivot cut short)."""
+    sc, poses = _robot_g2()
+
+    def pair_volume():
+        asm = build_assembly(sc, load_profile("mjp"), poses, reuse=True)
+        rep = check_assembly(asm, walls=False)
+        by = {c.name: c for c in rep.checks}
+        for name in ("watertight", "part_count", "retention", "features"):
+            assert by[name].ok, (name, by[name].detail, by[name].failures)
+        vols = [float(f.split("(")[1].split(" mm")[0]) for f in by["states"].failures
+                if "g2_out_lo intersects g2_out_hi" in f]
+        return max(vols, default=0.0)
+    after = pair_volume()
+    monkeypatch.setattr(B, "TURNED_FREE_SIDE", False)
+    before = pair_volume()
+    assert before > 1.7, before
+    assert after < 0.05, after

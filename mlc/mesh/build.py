@@ -83,6 +83,7 @@ PIN_TWIST = True      # compound junctions: the second pin turned about the firs
 ONE_SIDED_TWIST = True   # ... with a one-sided yoke where both sides would not be clear (session 51)
 ONE_SIDED_ABOVE = 4.0    # degrees: ... only when the least twist with both sides is more than this
 ONE_SIDED_GAIN = 1.0     # degrees: ... and the one-sided yoke's twist less by at least this
+TURNED_FREE_SIDE = True  # a turned one-sided compound yoke: no plate past the hub on its free side (session 55)
 CLIP_UJ_PLATES = True    # a yoke plate past the end of another hinge of its body stops at its trim radius (session 55)
 UNTWIST_SPLIT = True     # ... not to a pin that cuts the other body in pieces (built again; session 52)
 
@@ -693,7 +694,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
             hub = compound["hub_v"]
         for modes in mode_list:
             if compound is not None:
-                lays = (compound["layout_c"], _compound_yoke_layout(modes[1], hub, g, ky, cap, W[1], s))
+                lays = (compound["layout_c"], _compound_yoke_layout(modes[1], hub, g, ky, cap, W[1], s,
+                                                                    turned=TURNED_FREE_SIDE and v is not v_laid))
             else:
                 lays = tuple(_yoke_layout(m, hub, g, ky, cap, W[i], s) for i, m in enumerate(modes))
             uj = make_uj(v, lays, hub)
@@ -2467,13 +2469,20 @@ def _own_ends(ax: HingeAxis, bn: str) -> None:
         ax.intervals[b].append(iv)
 
 
-def _compound_yoke_layout(mode, hub, g, k, cap, W, s) -> YokeLayout:
+def _compound_yoke_layout(mode, hub, g, k, cap, W, s, turned=False) -> YokeLayout:
     """:func:`_yoke_layout` of a compound junction's second pin: one-sided, it is trimmed where
     the joint part is (ball hub to cap), not along the whole line, which may run through O's
-    slab (w_y_3_56_CD cut in two, session 51)."""
+    slab (w_y_3_56_CD cut in two, session 51).  ``turned`` (the pin turned by least_twist): a
+    one-sided yoke's plate stops at the hub on the side without a knuckle, where the other arm
+    passes; it ran half the body's width past the hub along the turned pin, out of the body's
+    slab (the Tetris robot's gate g2: both output levers' coupling junctions, their pins turned
+    to point at each other across the levers' V, met there, 1.77 mm^3; session 55)."""
     ly = _yoke_layout(mode, hub, g, k, cap, W, s)
     if ly.mode != "both":
         ly.cut = (-(hub / 2 + g), ly.caps[0][1]) if ly.mode == "+" else (ly.caps[0][0], hub / 2 + g)
+        if turned:
+            ly.plate = (max(ly.plate[0], ly.cut[0]), ly.plate[1]) if ly.mode == "+" else \
+                (ly.plate[0], min(ly.plate[1], ly.cut[1]))
     return ly
 
 
