@@ -1273,6 +1273,25 @@ def _bevel_facing_ends(asm: "Assembly", notes: list) -> None:
                      f"{max(done, key=lambda x: x[1])[0]})")
 
 
+def _cut_whole(asm: "Assembly", by: dict, cutters: dict) -> list:
+    """Subtract ``cutters[body]`` from each named part, where that removes something and leaves
+    the part in as many pieces as before; what is left of a knuckle core (``asm.cores``, for
+    the retention check) loses the same.  Returns [(body, mm^3 removed)]."""
+    done = []
+    cores = getattr(asm, "cores", None)
+    for bn, cutter in cutters.items():
+        part = by[bn]
+        new = part.solid - cutter
+        removed = part.solid.volume() - new.volume()
+        if removed <= 1e-9 or len(new.decompose()) != len(part.solid.decompose()):
+            continue
+        part.solid = new
+        if cores and bn in cores:
+            cores[bn] = cores[bn] - cutter
+        done.append((bn, removed))
+    return done
+
+
 #: compiled circuits: a compound junction's pin relieved in the stack's holes where it swings (session 55)
 PIN_RELIEF = True
 PIN_RELIEF_MARGIN = 0.01  # mm: the relief clears the posed pin by this much
@@ -1326,19 +1345,7 @@ def _relieve_host_holes(asm: "Assembly", notes: list) -> None:
                     zone = cylinder(hx.origin, hx.direction, a0 - 1e-3, a1 + 1e-3, hx.R + 0.05, n)
                     pin = cylinder(c0, d, p0 - 0.05, p1 + 0.05, uj.r_pin + e, n, cutter=True)
                     per_body.setdefault(bn, []).append(zone ^ pin)
-    done = []
-    cores = getattr(asm, "cores", None)
-    for bn, pieces in per_body.items():
-        part = by[bn]
-        cutter = union(pieces)
-        new = part.solid - cutter
-        removed = part.solid.volume() - new.volume()
-        if removed <= 1e-9 or len(new.decompose()) != len(part.solid.decompose()):
-            continue
-        part.solid = new
-        if cores and bn in cores:
-            cores[bn] = cores[bn] - cutter
-        done.append((bn, removed))
+    done = _cut_whole(asm, by, {bn: union(pieces) for bn, pieces in per_body.items()})
     if done:
         notes.append(f"compound junctions' pins relieved in their stacks' holes where they swing: {len(done)} bodies, "
                      f"{sum(r for _, r in done):.3g} mm^3 removed (largest {max(r for _, r in done):.3g} mm^3, "
@@ -1392,24 +1399,12 @@ def _clear_tipped_yokes(asm: "Assembly", notes: list) -> None:
                         continue
                     per_body.setdefault(X, []).append(cylinder(cc, v, a0 - c / 2, a1 + c / 2, uj.R + c / 2, n,
                                                                cutter=True))
-    done = []
-    cores = getattr(asm, "cores", None)
     stacks: dict = {}
     for ax in asm.axes:
         for bn in ax.bodies:
             stacks.setdefault(bn, []).append(cylinder(ax.origin, ax.direction, -ax.span / 2 - c, ax.span / 2 + c,
                                                       ax.R + c, n))
-    for bn, pieces in per_body.items():
-        part = by[bn]
-        cutter = union(pieces) - union(stacks.get(bn, []))
-        new = part.solid - cutter
-        removed = part.solid.volume() - new.volume()
-        if removed <= 1e-9 or len(new.decompose()) != len(part.solid.decompose()):
-            continue
-        part.solid = new
-        if cores and bn in cores:
-            cores[bn] = cores[bn] - cutter
-        done.append((bn, removed))
+    done = _cut_whole(asm, by, {bn: union(pieces) - union(stacks.get(bn, [])) for bn, pieces in per_body.items()})
     if done:
         notes.append(f"compound junctions' yokes tipped by the twist past their hosts' cut: {len(done)} host-hinge "
                      f"bodies trimmed, {sum(r for _, r in done):.3g} mm^3 removed (largest {max(r for _, r in done):.3g} "
