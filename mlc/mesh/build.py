@@ -1121,13 +1121,16 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
         _resolve(asm, protected, soft, state_T, asm.congruence, fat_guard)
         if motion_T:
             _clear_motion(asm, protected, soft, list(motion_poses), motion_T)
-        if reuse and BEVEL_ENDS:
-            _log("bevels of facing end knuckles")
-            _bevel_facing_ends(asm, notes)
-        if reuse and PIN_RELIEF:
-            _relieve_host_holes(asm, notes)
-        if reuse and YOKE_TIP_CLEAR:
-            _clear_tipped_yokes(asm, notes)
+        if reuse and poses and (BEVEL_ENDS or PIN_RELIEF or YOKE_TIP_CLEAR):
+            # the parts' transforms in the logic states, once for the three steps (from state_T's bodies)
+            posed_T = [asm.part_transforms(*pq, body_T=T) for pq, (_, T) in zip(poses.values(), state_T)]
+            if BEVEL_ENDS:
+                _log("bevels of facing end knuckles")
+                _bevel_facing_ends(asm, notes, posed_T)
+            if PIN_RELIEF:
+                _relieve_host_holes(asm, notes, posed_T)
+            if YOKE_TIP_CLEAR:
+                _clear_tipped_yokes(asm, notes, posed_T)
     _log("final trims done; drilling")
     # attachment holes shaped for the print's up where it is known now: the feet's (fdm's
     # orient: auto; the as_is profiles, mjp and sla, print their own support and keep round holes)
@@ -1186,7 +1189,7 @@ def _to_cylinder(p, o, n, k, R):
     return np.hypot(dz, np.maximum(r - R, 0.0))
 
 
-def _bevel_facing_ends(asm: "Assembly", notes: list) -> None:
+def _bevel_facing_ends(asm: "Assembly", notes: list, Ts: list) -> None:
     """Bevel the end knuckles of two hinges of different bodies that face each other and come
     closer than the clearance in a pose.
 
@@ -1200,7 +1203,8 @@ def _bevel_facing_ends(asm: "Assembly", notes: list) -> None:
     bisector of their planes) is found, and each knuckle loses what lies within half the
     clearance of it on its side, inside its own end knuckle only (a bevel of the far rim; the
     knuckle's inner faces, which hold the stack along the pin, are untouched).  A bevel that
-    would leave the body in pieces is not made."""
+    would leave the body in pieces is not made. ``Ts``: the parts' transforms in the logic
+    states (:meth:`Assembly.part_transforms` of ``asm.poses``)."""
     if not asm.poses:
         return
     c = asm.profile.clearance
@@ -1209,7 +1213,6 @@ def _bevel_facing_ends(asm: "Assembly", notes: list) -> None:
     if not ends:
         return
     from scipy.spatial import cKDTree
-    Ts = [asm.part_transforms(pos, quat) for pos, quat in asm.poses.values()]
     R = max(ax.R for ax, _, _, _ in ends)
     bodies_of = [set(ax.bodies) for ax, _, _, _ in ends]
     O = np.array([ax.origin + sg * ax.span / 2 * ax.direction for ax, sg, _, _ in ends])
@@ -1297,7 +1300,7 @@ PIN_RELIEF = True
 PIN_RELIEF_MARGIN = 0.01  # mm: the relief clears the posed pin by this much
 
 
-def _relieve_host_holes(asm: "Assembly", notes: list) -> None:
+def _relieve_host_holes(asm: "Assembly", notes: list, Ts: list) -> None:
     """Relieve the holes of a compound junction's host stack where the joint part's pin,
     posed in a logic state, reaches the hole's wall.
 
@@ -1307,12 +1310,12 @@ def _relieve_host_holes(asm: "Assembly", notes: list) -> None:
     hole at the far end of the stack (0.0003 mm^3, `w_b_0_60_AB` against `w_b_0_j61_hi`, row 01).
     Each knuckle of the stack whose hole the posed pin comes within ``PIN_RELIEF_MARGIN`` of
     the wall loses the posed pin grown by that margin, inside that knuckle only: a relief of a
-    few hundredths of a millimetre at the hole's mouth."""
+    few hundredths of a millimetre at the hole's mouth. ``Ts``: the parts' transforms in the logic
+    states (:meth:`Assembly.part_transforms` of ``asm.poses``)."""
     if not asm.poses:
         return
     n = asm.profile.circular_segments
     e = PIN_RELIEF_MARGIN
-    Ts = [asm.part_transforms(pos, quat) for pos, quat in asm.poses.values()]
     by = {p.name: p for p in asm.parts}
     per_body: dict = {}
     for uj in asm.ujoints:
@@ -1357,7 +1360,7 @@ def _relieve_host_holes(asm: "Assembly", notes: list) -> None:
 YOKE_TIP_CLEAR = True
 
 
-def _clear_tipped_yokes(asm: "Assembly", notes: list) -> None:
+def _clear_tipped_yokes(asm: "Assembly", notes: list, Ts: list) -> None:
     """Trim a compound junction's host-hinge bodies where the other body's yoke knuckles, posed,
     reach past the end of the cut that clears them (``layouts[0].cut``, along the first pin).
 
@@ -1367,12 +1370,12 @@ def _clear_tipped_yokes(asm: "Assembly", notes: list) -> None:
     more (``_split_twist``): in the Tetris circuit ``w_b_0_62_AB``'s yoke grazed the face of
     ``w_b_0_61_DA`` (row 11) and ``w_b_1_111_AB``'s that of ``w_b_1_110_CD`` (row 01), 2e-5 and
     8e-5 mm^3.  Each host-hinge body loses those posed knuckles grown by half the clearance,
-    outside its own stack on the host axis (radius ``R`` + clearance)."""
+    outside its own stack on the host axis (radius ``R`` + clearance). ``Ts``: the parts' transforms in the logic
+    states (:meth:`Assembly.part_transforms` of ``asm.poses``)."""
     if not asm.poses:
         return
     c = asm.profile.clearance
     n = asm.profile.circular_segments
-    Ts = [asm.part_transforms(pos, quat) for pos, quat in asm.poses.values()]
     by = {p.name: p for p in asm.parts}
     per_body: dict = {}
     for uj in asm.ujoints:
