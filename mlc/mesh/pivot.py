@@ -238,7 +238,7 @@ def teardrops(asm) -> list:
                         continue
                     ring = subtract(cylinder(ax.origin, ax.direction, a0, a1, rc + c + TEARDROP_MARGIN, n, cutter=True),
                                     [cylinder(ax.origin, ax.direction, a0 - 1, a1 + 1, ax.R, n)])
-                    if all((solids[o] ^ ring).is_empty() or (solids[o] ^ ring).volume() < 1e-9
+                    if all((x := solids[o] ^ ring).is_empty() or x.volume() < 1e-9
                            for o in ax.bodies if o != b and o in solids):
                         best = (td, float(depth))
                         break
