@@ -173,8 +173,19 @@ class CircuitOptions:
                                      # PRINT_LEANS (a robot's circuit takes mlc.robot.build.CIRCUIT_PRINT_LEANS, none)
 
 
+class _PrintContacts:
+    """``print_contacts`` of a build (``near_print``: a function listing them, once, on first call)."""
+
+    near_print: object = None
+
+    @property
+    def print_contacts(self) -> list:
+        """The chains' layers' contacts closer than ``PRINT_MARGIN`` (the print's), smallest first."""
+        return self.near_print() if self.near_print is not None else []
+
+
 @dataclass
-class Circuit:
+class Circuit(_PrintContacts):
     """The built scene plus what the builder knows about it."""
 
     scene: Scene
@@ -185,11 +196,6 @@ class Circuit:
     closest: float = float("inf")    # sigma: smallest layer-centre distance of a tight chain to another chain
     contacts: list = field(default_factory=list)   # contact.Contact of the chains' close layers, smallest first
     near_print: object = None      # () -> those closer than PRINT_MARGIN (listed on first read: print_contacts)
-
-    @property
-    def print_contacts(self) -> list:
-        """The chains' layers' contacts closer than ``PRINT_MARGIN`` (the print's), smallest first."""
-        return self.near_print() if self.near_print is not None else []
 
 
 @lru_cache(maxsize=None)
@@ -551,7 +557,7 @@ def _build_routed(netlist, spec, options: CircuitOptions, progress) -> Circuit:
 
 
 @dataclass
-class _Routed:
+class _Routed(_PrintContacts):
     """One build routed, not yet assembled: its chains left tight (``(tag, gap)``, in
     assembly order), their smallest gap (``closest``, sigma), the contacts of its chains'
     layers (:func:`_state_contacts`, smallest first), the seconds so far, and ``assemble()``,
@@ -564,10 +570,6 @@ class _Routed:
     assemble: object
     leaned: bool = False             # its branch trees' chains on pages on pages lean (BRANCH_LEAN)
     near_print: object = None        # () -> contacts closer than PRINT_MARGIN, smallest first (listed once, on first call)
-
-    @property
-    def print_contacts(self) -> list:
-        return self.near_print() if self.near_print is not None else []
 
     @property
     def print_clear(self) -> float:
