@@ -125,6 +125,7 @@ class Implicit:
         self._a = np.zeros(6)
         self._b = np.zeros(6)
         self._z = np.zeros(6)
+        self._pat = None                 # the block pattern (mlc.sim.blockchol.symbolic), made at the first step
 
     # -- the positive part of the Hessian, as rows of G -------------------------------------
     def rows(self):
@@ -196,12 +197,7 @@ class Implicit:
                         put(sq * t, s.sp_i[a_[ten]], s.sp_j[a_[ten]], nrow)
                         nrow += int(np.count_nonzero(ten))
         # rotational geometric stiffness per body
-        N = self.N
-        ga = np.einsum("si,sj->sij", grad, arm)
-        Qs = 0.5 * (ga + np.transpose(ga, (0, 2, 1))) - np.einsum("sii->s", ga)[:, None, None] * np.eye(3)[None]
-        Q = np.zeros((N, 3, 3))
-        np.add.at(Q, sb, Qs)
-        lam, vec = np.linalg.eigh(Q)
+        lam, vec = self.rot_stiffness(grad)
         pos = lam > 1e-14 * max(1.0, float(np.abs(lam).max(initial=0.0)))
         if np.any(pos):
             bi, ci = np.nonzero(pos)
@@ -243,7 +239,59 @@ class Implicit:
         else:
             R = C = np.zeros(0, np.int64)
             V = np.zeros(0)
-        return sp.csr_matrix((V, (R, C)), shape=(nrow, 6 * N))
+        return sp.csr_matrix((V, (R, C)), shape=(nrow, 6 * self.N))
+
+    def rot_stiffness(self, grad):
+        """Each body's rotational geometric stiffness ``sum_s [(g a^T + a g^T)/2 - (g.a) I]`` over
+        its sites (``grad`` dE/dp at every site, (S, 3)) as numpy's eigh gives it: (N, 3), (N, 3, 3)."""
+        ga = np.einsum("si,sj->sij", grad, self.sim.arm)
+        Qs = 0.5 * (ga + np.transpose(ga, (0, 2, 1))) - np.einsum("sii->s", ga)[:, None, None] * np.eye(3)[None]
+        Q = np.zeros((self.N, 3, 3))
+        np.add.at(Q, self.sb, Qs)
+        return np.linalg.eigh(Q)
+
+    # -- the step's linear system --------------------------------------------------------------
+    backend = "block"       # "block": mlc.sim.blockchol; "superlu": rows() and SuperLU (the reference)
+
+    def system(self, h, noisy, seed2, key, rot):
+        """The step matrix ``D/h + H+`` at the state of the last ``_eval``, factorised, and this
+        substep's row noise ``G^T (f^1/2 xi_2)`` (counter (seed2, key); without sqrt(kT)).  The
+        block factor (:mod:`mlc.sim.blockchol`) unless a WCA contact adds a row between bodies
+        the bonds do not join, or the backend is "superlu": then ``rows()`` and SuperLU, which
+        draw the same normals for the same rows."""
+        s = self.sim
+        wca = s.opt.wca_eps > 0 and bool(np.any(s.dmin < 2.0 * s.opt.wca_r0))
+        if self.backend == "block" and not wca:
+            out = self._block(h, noisy, seed2, key, rot)
+            if out is not None:
+                return out
+        G = self.rows()
+        return _LU(self, G, self.solve(G, h), seed2, key, rot)
+
+    def _block(self, h, noisy, seed2, key, rot):
+        from mlc.sim import blockchol as BC
+
+        s = self.sim
+        if self._pat is None:
+            self._pat = BC.symbolic(self.N, self.sb[s.sp_i], self.sb[s.sp_j])
+            self._diag = np.zeros((self.N, 6, 6))
+            self._blk = np.zeros((self._pat.nblk, 6, 6))
+            self._grad = np.zeros((len(self.sb), 3))
+            self._bvec = np.zeros((self.N, 6))
+            self._lam = np.zeros((self.N, 3))
+            self._vec = np.zeros((self.N, 3, 3))
+        P = self._pat
+        nrow = BC.assemble_bonds(s.ws, s.arm, self.sb, s.sp_i, s.sp_j, s.sp_k, s.sp_rest0, s.sp_rest1, s.sp_tol,
+                                 s.sp_inp, s.uval, self.iz, self.isc, P.bond_blk, P.bond_flip, P.pos, self.D / h,
+                                 self._diag, self._blk, self._grad, bool(noisy), seed2, key, bool(rot),
+                                 float(s.gamma), float(s.gamma_r), self._bvec)
+        BC.rot_eig(self._grad, s.arm, self.sb, self.N, self._lam, self._vec)
+        lam, vec = self._lam, self._vec
+        thresh = 1e-14 * max(1.0, float(np.abs(lam).max(initial=0.0)))
+        BC.assemble_rot(lam, vec, thresh, P.pos, self._diag, nrow, bool(noisy), seed2, key, bool(rot), self._bvec)
+        if BC.factor(self._diag, self._blk, P.colptr, P.rowidx, P.upd_ptr, P.upd_tgt) >= 0:
+            return None                  # not positive definite to working precision: SuperLU decides
+        return _Block(self)
 
     # -- stepping ----------------------------------------------------------------------------
     def solve(self, G, h):
@@ -275,7 +323,6 @@ class Implicit:
         wca_min = float(o.wca_min)
         a = s.arrays
         nrec = nfr = 0
-        xi2 = np.zeros(0)
         for n in range(nsteps):
             t = t_o + (k_o + n) * dt
             step = s.step + n
@@ -297,10 +344,10 @@ class Implicit:
                 ts = t + u * (dt / full)
                 if not fresh and not self._eval(ts, step):
                     return n
-                G = self.rows()
-                lu = self.solve(G, hs)
-                f = np.concatenate([s.F, s.T], axis=1).ravel()
-                dd = lu.solve(f).reshape(N, 6)
+                k = u >> (K.LMAX - lev)
+                key = np.uint64(step) * np.uint64(2147483648) + np.uint64((1 << lev) + k)
+                system = self.system(hs, noisy, seed2, key, rot)
+                dd = system.solve(np.concatenate([s.F, s.T], axis=1))
                 dmax = float(np.sqrt(np.max(np.sum(dd[:, :3] ** 2, axis=1), initial=0.0)))
                 amax = float(np.sqrt(np.max(np.sum(dd[:, 3:] ** 2, axis=1), initial=0.0)))
                 # the drift bound plus 3 times a free body's noise in this substep, as the stiff scheme's:
@@ -317,22 +364,10 @@ class Implicit:
                     continue
                 dx = dd
                 if noisy:
-                    k = u >> (K.LMAX - lev)
                     brownian_increments(seed, step, k, lev, N, rot, self.incr, self._a, self._b, self._z)
                     b = (self.D.reshape(N, 6) / hs) * amp[None, :] * self.incr
-                    if G.shape[0]:
-                        if len(xi2) < G.shape[0]:
-                            xi2 = np.zeros(G.shape[0])
-                        normals(seed2, np.uint64(step) * np.uint64(2147483648) + np.uint64((1 << lev) + k),
-                                G.shape[0], xi2)
-                        x2 = xi2[:G.shape[0]]
-                        if not rot:
-                            # each row's share of translational mobility (module doc: the noise of a
-                            # row's mode is translational only, so its exact variance is that share)
-                            G2 = G.multiply(G)
-                            x2 = x2 * np.sqrt((G2 @ self.inv_Dt) / np.maximum(G2 @ self.inv_D, 1e-300))
-                        b = b + (math.sqrt(kT) * (G.T @ x2)).reshape(N, 6)
-                    dx = dd + lu.solve(b.ravel()).reshape(N, 6)
+                    b += math.sqrt(kT) * system.noise()
+                    dx = dd + system.solve(b)
                 saved = (s.pos.copy(), s.quat.copy())
                 _apply(s.pos, s.quat, dx)
                 if not self._eval(ts + hs, step):
@@ -378,3 +413,45 @@ def _apply(pos, quat, dx):
         quat[b, 1] = q1
         quat[b, 2] = q2
         quat[b, 3] = q3
+
+
+class _Block:
+    """A factorised step matrix from :mod:`mlc.sim.blockchol` (valid until the next ``system``)."""
+
+    def __init__(self, imp):
+        self.imp = imp
+
+    def solve(self, rhs):
+        from mlc.sim import blockchol as BC
+
+        i, P = self.imp, self.imp._pat
+        out = np.empty((i.N, 6))
+        BC.solve(i._diag, i._blk, P.colptr, P.rowidx, P.order, np.ascontiguousarray(rhs, dtype=np.float64), out)
+        return out
+
+    def noise(self):
+        return self.imp._bvec
+
+
+class _LU:
+    """A step matrix factorised by SuperLU from the rows ``G`` (the reference path)."""
+
+    def __init__(self, imp, G, lu, seed2, key, rot):
+        self.imp, self.G, self.lu = imp, G, lu
+        self.seed2, self.key, self.rot = seed2, key, rot
+
+    def solve(self, rhs):
+        return self.lu.solve(np.ascontiguousarray(rhs, dtype=np.float64).ravel()).reshape(self.imp.N, 6)
+
+    def noise(self):
+        G, imp = self.G, self.imp
+        if not G.shape[0]:
+            return np.zeros((imp.N, 6))
+        x2 = np.zeros(G.shape[0])
+        normals(self.seed2, self.key, G.shape[0], x2)
+        if not self.rot:
+            # each row's share of translational mobility (module doc: the noise of a row's mode is
+            # translational only, so its exact variance is that share)
+            G2 = G.multiply(G)
+            x2 = x2 * np.sqrt((G2 @ imp.inv_Dt) / np.maximum(G2 @ imp.inv_D, 1e-300))
+        return (G.T @ x2).reshape(imp.N, 6)
