@@ -20,7 +20,11 @@ final pose gets the slab-overlap test (``clearance_end``, sigma; negative: inter
 
     python benchmarks/robot_dynamic.py OUT/robot.yaml [--rows 11] [--seeds 0 1 2]
         [--dt 0.2] [--scheme stiff] [--disp-acc 0.1] [--tau 100] [--max-time 1800]
-        [-o benchmarks/results/robot_dynamic.json]
+        [--backends block superlu] [-o benchmarks/results/robot_dynamic.json]
+
+``--backends`` (implicit scheme): the step matrix's linear algebra, ``block`` (mlc's block
+Cholesky, the default) or ``superlu`` (rows of G and SciPy's SuperLU, the reference); with
+both, each (row, seed) runs with each in turn, so their CPU times are measured side by side.
 
 A scene compiled with stiff joints (``mlc compile --joint-k K``) goes to its own file, e.g.
 ``-o benchmarks/results/robot_dynamic_jointk100.json``; every run records the scene's
@@ -42,7 +46,7 @@ import time
 
 def run_one(scene, state: str, seed: int, dt: float, tau: float, max_time: float, kT: float = 1e-5,
             every: float = 100.0, scheme: str = "stiff", min_time: float | None = None,
-            disp_acc: float | None = None) -> dict:
+            disp_acc: float | None = None, backend: str = "block") -> dict:
     from mlc.robot.verify import _shape_row, robot_meta, run_fold
     from mlc.sim.drive import Drive
     from mlc.sim.integrator import SimOptions, Simulation
@@ -51,6 +55,8 @@ def run_one(scene, state: str, seed: int, dt: float, tau: float, max_time: float
     drives = {inp: Drive.constant(int(b)) for inp, b in zip(scene.inputs, state)}
     extra = {} if disp_acc is None else {"disp_acc": disp_acc}     # the step control's drift bound (sigma)
     sim = Simulation(scene, drives, SimOptions(scheme=scheme, kT=kT, seed=seed, dt=dt, **extra))
+    if sim._imp is not None:
+        sim._imp.backend = backend        # the implicit step's linear algebra (mlc/sim/implicit.py)
     wall, cpu = time.perf_counter(), time.process_time()
     pm, t, relaxed, detail, hist = run_fold(sim, scene, state, kT, tau, max_time, every, min_time)
     sh = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy(), pm)
@@ -83,6 +89,7 @@ def run_one(scene, state: str, seed: int, dt: float, tau: float, max_time: float
 
 
 def main(argv=None) -> int:
+    from gitstate import commit
     from mlc.scene.io import load_scene
 
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -101,6 +108,8 @@ def main(argv=None) -> int:
                     help="t0: run at least this long (default 3 tau; --min-time 1800 reads every shape at the "
                          "paper's fold time, the relaxation test then only reports)")
     ap.add_argument("--kT", type=float, default=1e-5)
+    ap.add_argument("--backends", nargs="*", default=["block"], choices=("block", "superlu"),
+                    help="implicit scheme: the step's linear algebra; several: each (row, seed) with each in turn")
     ap.add_argument("-o", "--out", default="benchmarks/results/robot_dynamic.json")
     a = ap.parse_args(argv)
     sc = load_scene(a.scene)
@@ -111,27 +120,31 @@ def main(argv=None) -> int:
     if os.path.exists(a.out):
         with open(a.out) as f:
             data = json.load(f)
-    runs = {(r["row"], r["seed"]): r for r in data.get("runs", [])}
+    runs = {(r["row"], r["seed"], r.get("backend", "superlu")): r for r in data.get("runs", [])}
     for state in rows:
         for seed in a.seeds:
-            r = run_one(sc, state, seed, a.dt, a.tau, a.max_time, a.kT, a.every, scheme=a.scheme,
-                        min_time=a.min_time, disp_acc=a.disp_acc)
-            r.update({"min_time": a.min_time if a.min_time is not None else 3 * a.tau, "dt": a.dt, "tau": a.tau,
-                      "kT": a.kT, "max_time": a.max_time, "scheme": a.scheme, "disp_acc": a.disp_acc,
-                      "bodies": len(sc.bodies), "load_1min": round(os.getloadavg()[0], 2),
-                      "joint_k": joint_k})
-            runs[(state, seed)] = r
-            print(f"row {state} seed {seed}: {r['shape_read']} (expected {r['shape_expected']}) "
-                  f"turns {r['turns_read']}  relaxed {r['relaxed']} at {r['time_t0']} t0, "
-                  f"wall {r['wall_s']} s  {'ok' if r['ok'] else 'WRONG'}", flush=True)
-            data = {"what": "Tetris robot, dynamic verification per row and seed (benchmarks/robot_dynamic.py)",
-                    "scene": a.scene, "machine": f"{platform.machine()}, {os.cpu_count()} cores, shared",
-                    "units": "t0, degrees, seconds wall",
-                    "runs": sorted(runs.values(), key=lambda r: (r["row"], r["seed"]))}
-            data["all_ok"] = all(r["ok"] for r in data["runs"])
-            with open(a.out + ".tmp", "w") as f:
-                json.dump(data, f, indent=1)
-            os.replace(a.out + ".tmp", a.out)
+            for backend in a.backends:
+                r = run_one(sc, state, seed, a.dt, a.tau, a.max_time, a.kT, a.every, scheme=a.scheme,
+                            min_time=a.min_time, disp_acc=a.disp_acc, backend=backend)
+                r.update({"min_time": a.min_time if a.min_time is not None else 3 * a.tau, "dt": a.dt, "tau": a.tau,
+                          "kT": a.kT, "max_time": a.max_time, "scheme": a.scheme, "disp_acc": a.disp_acc,
+                          "bodies": len(sc.bodies), "load_1min": round(os.getloadavg()[0], 2),
+                          "joint_k": joint_k, "backend": backend if a.scheme == "implicit" else None,
+                          "commit": commit()})
+                runs[(state, seed, backend)] = r
+                print(f"row {state} seed {seed} {backend}: cpu {r['cpu_s']} s, {r['shape_read']} (expected {r['shape_expected']}) "
+                      f"turns {r['turns_read']}  relaxed {r['relaxed']} at {r['time_t0']} t0, "
+                      f"wall {r['wall_s']} s  {'ok' if r['ok'] else 'WRONG'}", flush=True)
+                data = {"what": "Tetris robot, dynamic verification per row and seed (benchmarks/robot_dynamic.py)",
+                        "scene": a.scene, "machine": f"{platform.machine()}, {os.cpu_count()} cores, shared",
+                        "units": "t0, degrees, seconds wall",
+                        "runs": sorted(runs.values(), key=lambda r: (r["row"], r["seed"], r.get("backend", "superlu")))}
+                data["all_ok"] = all(r["ok"] for r in data["runs"])
+                data["cpu_total_s"] = {b: round(sum(r["cpu_s"] for r in data["runs"] if r.get("backend", "superlu") == b), 1)
+                                       for b in sorted({r.get("backend", "superlu") for r in data["runs"]})}
+                with open(a.out + ".tmp", "w") as f:
+                    json.dump(data, f, indent=1)
+                os.replace(a.out + ".tmp", a.out)
     return 0
 
 

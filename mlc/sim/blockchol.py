@@ -45,26 +45,41 @@ class Pattern:
     the block that ``L_a L_b^T`` is subtracted from; ``bond_blk[s]`` is the block of bond s's
     two bodies (``bond_flip[s]``: stored as (j, i) rather than (i, j))."""
 
-    def __init__(self, order, pos, colptr, rowidx, upd_ptr, upd_tgt, bond_blk, bond_flip):
+    def __init__(self, order, pos, colptr, rowidx, upd_ptr, upd_tgt, bond_blk, bond_flip, where):
         self.order, self.pos = order, pos
         self.colptr, self.rowidx = colptr, rowidx
         self.upd_ptr, self.upd_tgt = upd_ptr, upd_tgt
         self.bond_blk, self.bond_flip = bond_blk, bond_flip
+        self.where = where               # (row, column) in elimination indices -> block
         self.N = len(order)
         self.nblk = len(rowidx)
 
+    def holds(self, ci, cj) -> bool:
+        """Whether the factor's pattern has a block for every body pair (ci[m], cj[m])."""
+        a, b = self.pos[ci], self.pos[cj]
+        return all((x, y) in self.where for x, y in zip(np.maximum(a, b).tolist(), np.minimum(a, b).tolist()))
 
-def symbolic(N: int, bi, bj) -> Pattern:
+    def pair_blk(self, ci, cj):
+        """The block of each body pair (ci[m], cj[m]) (``holds`` must be true)."""
+        a, b = self.pos[ci], self.pos[cj]
+        return np.array([self.where[(x, y)] for x, y in zip(np.maximum(a, b).tolist(), np.minimum(a, b).tolist())],
+                        np.int64)
+
+
+def symbolic(N: int, bi, bj, ei=(), ej=()) -> Pattern:
     """The pattern for N bodies joined by rows between bodies ``bi[s]`` and ``bj[s]`` (every
-    bond of the scene).  Minimum degree (least current degree first, ties by body index), with
+    bond of the scene) and between ``ei[m]`` and ``ej[m]`` (WCA contacts met so far; not in
+    ``bond_blk``).  Minimum degree (least current degree first, ties by body index), with
     the elimination graph kept explicitly: each eliminated body's neighbours become a clique, so
     its neighbour set is exactly its column of ``L``."""
     bi = np.asarray(bi, np.int64)
     bj = np.asarray(bj, np.int64)
-    if np.any(bi == bj):
+    ei = np.asarray(ei, np.int64)
+    ej = np.asarray(ej, np.int64)
+    if np.any(bi == bj) or np.any(ei == ej):
         raise ValueError("a row on one body twice: the block assembly assumes two bodies")
     adj = [set() for _ in range(N)]
-    for a, b in zip(bi.tolist(), bj.tolist()):
+    for a, b in zip(bi.tolist() + ei.tolist(), bj.tolist() + ej.tolist()):
         adj[a].add(b)
         adj[b].add(a)
     heap = [(len(adj[i]), i) for i in range(N)]
@@ -112,7 +127,7 @@ def symbolic(N: int, bi, bj) -> Pattern:
     pi, pj = pos[bi], pos[bj]
     flip = pi < pj                      # block (pos i, pos j) lives in column min(pi, pj)
     blk = np.array([where[(max(a, b), min(a, b))] for a, b in zip(pi.tolist(), pj.tolist())], np.int64)
-    return Pattern(order, pos, colptr, rowidx, upd_ptr, upd_tgt, blk, flip.astype(np.bool_))
+    return Pattern(order, pos, colptr, rowidx, upd_ptr, upd_tgt, blk, flip.astype(np.bool_), where)
 
 
 # -- assembly ------------------------------------------------------------------------------
@@ -144,18 +159,25 @@ def _row(p, q, gp, gq, flip, blk_e, diag, blk, pos, noisy, xi, rot, gamma, gamma
             else:
                 B[a, b] += gp[a] * gq[b]
     if noisy:
-        s = xi
-        if not rot:
-            gt = 0.0
-            ga = 0.0
-            for a in range(3):
-                gt += (gp[a] * gp[a] + gq[a] * gq[a]) / gamma
-                ga += (gp[a] * gp[a] + gq[a] * gq[a]) / gamma
-                ga += (gp[a + 3] * gp[a + 3] + gq[a + 3] * gq[a + 3]) / gamma_r
-            s = xi * math.sqrt(gt / max(ga, 1e-300))
-        for a in range(6):
-            bvec[p, a] += s * gp[a]
-            bvec[q, a] += s * gq[a]
+        _noise(p, q, gp, gq, xi, rot, gamma, gamma_r, bvec)
+
+
+@njit(cache=True)
+def _noise(p, q, gp, gq, xi, rot, gamma, gamma_r, bvec):
+    """A row's noise xi g, scaled without rotational noise by the square root of its share of
+    translational mobility (mlc.sim.implicit's module doc)."""
+    s = xi
+    if not rot:
+        gt = 0.0
+        ga = 0.0
+        for a in range(3):
+            gt += (gp[a] * gp[a] + gq[a] * gq[a]) / gamma
+            ga += (gp[a] * gp[a] + gq[a] * gq[a]) / gamma
+            ga += (gp[a + 3] * gp[a + 3] + gq[a + 3] * gq[a + 3]) / gamma_r
+        s = xi * math.sqrt(gt / max(ga, 1e-300))
+    for a in range(6):
+        bvec[p, a] += s * gp[a]
+        bvec[q, a] += s * gq[a]
 
 
 @njit(cache=True)
@@ -169,6 +191,60 @@ def _site_row(r0, r1, r2, ai, aj, gp, gq):
     gq[3] = -(aj[1] * r2 - aj[2] * r1)
     gq[4] = -(aj[2] * r0 - aj[0] * r2)
     gq[5] = -(aj[0] * r1 - aj[1] * r0)
+
+
+@njit(cache=True)
+def _zero_bond(p, q, k, ai, aj, flip, blk_e, diag, blk, pos):
+    """The three rows of a zero-length bond summed.  With X v = a x v (X^T = -X) and
+    M = [I; X] (6 x 3): k M_i M_i^T on body p, k M_j M_j^T on q and -k M_i M_j^T between
+    them, where X_i X_j^T = (a_i . a_j) I - a_j a_i^T."""
+    dp = diag[pos[p]]
+    dq = diag[pos[q]]
+    B = blk[blk_e]
+    x0, x1, x2 = ai[0], ai[1], ai[2]
+    y0, y1, y2 = aj[0], aj[1], aj[2]
+    xx = x0 * x0 + x1 * x1 + x2 * x2
+    yy = y0 * y0 + y1 * y1 + y2 * y2
+    xy = x0 * y0 + x1 * y1 + x2 * y2
+    for m in range(3):
+        dp[m, m] += k
+        dq[m, m] += k
+        dp[3 + m, 3 + m] += k * xx
+        dq[3 + m, 3 + m] += k * yy
+    # X as (row, column, entry): X[1,0] = a2, X[2,1] = a0, X[0,2] = a1 and minus their transposes
+    for (m, n, ci) in ((1, 0, 2), (2, 1, 0), (0, 2, 1)):
+        # diag blocks: [[kI, -kX], [kX, k(|a|^2 I - a a^T)]]
+        dp[3 + m, n] += k * ai[ci]
+        dp[3 + n, m] -= k * ai[ci]
+        dp[m, 3 + n] -= k * ai[ci]
+        dp[n, 3 + m] += k * ai[ci]
+        dq[3 + m, n] += k * aj[ci]
+        dq[3 + n, m] -= k * aj[ci]
+        dq[m, 3 + n] -= k * aj[ci]
+        dq[n, 3 + m] += k * aj[ci]
+    for m in range(3):
+        for n in range(3):
+            dp[3 + m, 3 + n] -= k * ai[m] * ai[n]
+            dq[3 + m, 3 + n] -= k * aj[m] * aj[n]
+    # M[p, q] = -k [[I, -X_j], [X_i, (a_i.a_j) I - a_j a_i^T]]; stored transposed when flipped
+    for m in range(3):
+        _add(B, flip, m, m, -k)
+        _add(B, flip, 3 + m, 3 + m, -k * xy)
+        for n in range(3):
+            _add(B, flip, 3 + m, 3 + n, k * aj[m] * ai[n])
+    for (m, n, ci) in ((1, 0, 2), (2, 1, 0), (0, 2, 1)):
+        _add(B, flip, m, 3 + n, k * aj[ci])          # -k (-X_j)[m, n]
+        _add(B, flip, n, 3 + m, -k * aj[ci])
+        _add(B, flip, 3 + m, n, -k * ai[ci])         # -k X_i[m, n]
+        _add(B, flip, 3 + n, m, k * ai[ci])
+
+
+@njit(cache=True, inline="always")
+def _add(B, flip, r, c, v):
+    if flip:
+        B[c, r] += v
+    else:
+        B[r, c] += v
 
 
 @njit(cache=True)
@@ -231,15 +307,16 @@ def assemble_bonds(ws, arm, sb, sp_i, sp_j, sp_k, sp_rest0, sp_rest1, sp_tol, sp
     xis = _normals(seed2, key, r0 + nact + 2 * nten if noisy else 0)
     gp = np.zeros(6)
     gq = np.zeros(6)
-    # zero-length bonds: sqrt(k) times each axis; rows c * nz + n
-    for c in range(3):
-        for n in range(nz):
-            s = iz[n]
-            i, j = sp_i[s], sp_j[s]
+    # zero-length bonds: sqrt(k) times each axis (rows c * nz + n), the three rows' sum at once
+    for n in range(nz):
+        s = iz[n]
+        i, j = sp_i[s], sp_j[s]
+        _zero_bond(sb[i], sb[j], sp_k[s], arm[i], arm[j], bond_flip[s], bond_blk[s], diag, blk, pos)
+        if noisy:
             sk = math.sqrt(sp_k[s])
-            _site_row(sk if c == 0 else 0.0, sk if c == 1 else 0.0, sk if c == 2 else 0.0, arm[i], arm[j], gp, gq)
-            xi = xis[c * nz + n] if noisy else 0.0
-            _row(sb[i], sb[j], gp, gq, bond_flip[s], bond_blk[s], diag, blk, pos, noisy, xi, rot, gamma, gamma_r, bvec)
+            for c in range(3):
+                _site_row(sk if c == 0 else 0.0, sk if c == 1 else 0.0, sk if c == 2 else 0.0, arm[i], arm[j], gp, gq)
+                _noise(sb[i], sb[j], gp, gq, xis[c * nz + n], rot, gamma, gamma_r, bvec)
     for n in range(nz):
         s = iz[n]
         i, j = sp_i[s], sp_j[s]
@@ -387,6 +464,23 @@ def assemble_rot(lam, vec, thresh, pos, diag, row0, noisy, seed2, key, rot, bvec
     return nr
 
 
+@njit(cache=True)
+def assemble_contacts(ci, cj, cv, cblk, cflip, pos, diag, blk, row0, noisy, seed2, key, bvec):
+    """The WCA contacts' rows (``cv[m]`` on body ci[m]'s translation, minus it on cj[m]'s),
+    numbered from row0 as ``Implicit.rows`` numbers them; translational only, so each row's noise
+    share is 1."""
+    n = len(ci)
+    xis = _normals(seed2, key, row0 + n) if noisy else np.zeros(0)
+    gp = np.zeros(6)
+    gq = np.zeros(6)
+    for m in range(n):
+        for a in range(3):
+            gp[a] = cv[m, a]
+            gq[a] = -cv[m, a]
+        xi = xis[row0 + m] if noisy else 0.0
+        _row(ci[m], cj[m], gp, gq, cflip[m], cblk[m], diag, blk, pos, noisy, xi, True, 1.0, 1.0, bvec)
+
+
 # -- factor and solve -----------------------------------------------------------------------
 
 @njit(cache=True)
@@ -448,10 +542,8 @@ def factor(diag, blk, colptr, rowidx, upd_ptr, upd_tgt):
                 m += 1
                 for r in range(6):
                     for c in range(6):
-                        t = 0.0
-                        for x in range(6):
-                            t += Ba[r, x] * Bb[c, x]
-                        T[r, c] -= t
+                        T[r, c] -= (Ba[r, 0] * Bb[c, 0] + Ba[r, 1] * Bb[c, 1] + Ba[r, 2] * Bb[c, 2]
+                                    + Ba[r, 3] * Bb[c, 3] + Ba[r, 4] * Bb[c, 4] + Ba[r, 5] * Bb[c, 5])
     return -1
 
 

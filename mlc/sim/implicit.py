@@ -126,6 +126,8 @@ class Implicit:
         self._b = np.zeros(6)
         self._z = np.zeros(6)
         self._pat = None                 # the block pattern (mlc.sim.blockchol.symbolic), made at the first step
+        self._extra = set()              # body pairs the pattern joins for WCA contacts (it only grows)
+        self._diag = None
 
     # -- the positive part of the Hessian, as rows of G -------------------------------------
     def rows(self):
@@ -208,38 +210,48 @@ class Implicit:
             V.append(vals.ravel())
             nrow += len(bi)
         # WCA contacts (the neighbour list of the last evaluation)
-        o = s.opt
-        if o.wca_eps > 0 and np.any(s.dmin < 2.0 * o.wca_r0):
-            eps, sg, rc = s._wca()
-            ii = np.nonzero(s.dmin < rc)[0]
-            pi, pj = [], []
-            for b in ii:
-                nb_ = s.nl[s.nl0[b]:s.nl0[b + 1]]
-                pi.extend([b] * len(nb_))
-                pj.extend(nb_.tolist())
-            pi, pj = np.array(pi, np.int64), np.array(pj, np.int64)
-            keep = pi < pj
-            pi, pj = pi[keep], pj[keep]
-            d = s.pos[pi] - s.pos[pj]
-            r = np.linalg.norm(d, axis=1)
-            near = r < rc
-            if np.any(near):
-                pi, pj, d, r = pi[near], pj[near], d[near], r[near]
-                u2 = 4.0 * eps * (156.0 * sg ** 12 / r ** 14 - 42.0 * sg ** 6 / r ** 8)
-                ok = u2 > 0
-                vals = np.sqrt(u2[ok])[:, None] * d[ok] / r[ok, None]
-                rows = nrow + np.arange(int(np.count_nonzero(ok)))
-                for body, sign in ((pi[ok], 1.0), (pj[ok], -1.0)):
-                    R.append(np.repeat(rows, 3))
-                    C.append((6 * body[:, None] + np.arange(3)[None, :]).ravel())
-                    V.append((sign * vals).ravel())
-                nrow += len(rows)
+        pi, pj, vals = self.contacts()
+        if len(pi):
+            rows = nrow + np.arange(len(pi))
+            for body, sign in ((pi, 1.0), (pj, -1.0)):
+                R.append(np.repeat(rows, 3))
+                C.append((6 * body[:, None] + np.arange(3)[None, :]).ravel())
+                V.append((sign * vals).ravel())
+            nrow += len(rows)
         if R:
             R, C, V = np.concatenate(R), np.concatenate(C), np.concatenate(V)
         else:
             R = C = np.zeros(0, np.int64)
             V = np.zeros(0)
         return sp.csr_matrix((V, (R, C)), shape=(nrow, 6 * self.N))
+
+    def contacts(self):
+        """The WCA contacts' rows at the last evaluation (from its neighbour list): bodies pi < pj
+        and ``sqrt(U'')`` times the unit vector from pj to pi, (n, 3), in the rows' order."""
+        s = self.sim
+        o = s.opt
+        none = (np.zeros(0, np.int64), np.zeros(0, np.int64), np.zeros((0, 3)))
+        if not (o.wca_eps > 0 and np.any(s.dmin < 2.0 * o.wca_r0)):
+            return none
+        eps, sg, rc = s._wca()
+        ii = np.nonzero(s.dmin < rc)[0]
+        pi, pj = [], []
+        for b in ii:
+            nb_ = s.nl[s.nl0[b]:s.nl0[b + 1]]
+            pi.extend([b] * len(nb_))
+            pj.extend(nb_.tolist())
+        pi, pj = np.array(pi, np.int64), np.array(pj, np.int64)
+        keep = pi < pj
+        pi, pj = pi[keep], pj[keep]
+        d = s.pos[pi] - s.pos[pj]
+        r = np.linalg.norm(d, axis=1)
+        near = r < rc
+        if not np.any(near):
+            return none
+        pi, pj, d, r = pi[near], pj[near], d[near], r[near]
+        u2 = 4.0 * eps * (156.0 * sg ** 12 / r ** 14 - 42.0 * sg ** 6 / r ** 8)
+        ok = u2 > 0
+        return pi[ok], pj[ok], np.sqrt(u2[ok])[:, None] * d[ok] / r[ok, None]
 
     def rot_stiffness(self, grad):
         """Each body's rotational geometric stiffness ``sum_s [(g a^T + a g^T)/2 - (g.a) I]`` over
@@ -256,12 +268,11 @@ class Implicit:
     def system(self, h, noisy, seed2, key, rot):
         """The step matrix ``D/h + H+`` at the state of the last ``_eval``, factorised, and this
         substep's row noise ``G^T (f^1/2 xi_2)`` (counter (seed2, key); without sqrt(kT)).  The
-        block factor (:mod:`mlc.sim.blockchol`) unless a WCA contact adds a row between bodies
-        the bonds do not join, or the backend is "superlu": then ``rows()`` and SuperLU, which
-        draw the same normals for the same rows."""
-        s = self.sim
-        wca = s.opt.wca_eps > 0 and bool(np.any(s.dmin < 2.0 * s.opt.wca_r0))
-        if self.backend == "block" and not wca:
+        block factor (:mod:`mlc.sim.blockchol`); if it finds the matrix not positive definite, or
+        the backend is "superlu", then ``rows()`` and SuperLU, which
+        draw the same normals for the same rows.  A WCA contact between bodies the pattern does not
+        join adds the pair to it (a new symbolic factorisation, kept for the rest of the run)."""
+        if self.backend == "block":
             out = self._block(h, noisy, seed2, key, rot)
             if out is not None:
                 return out
@@ -272,10 +283,21 @@ class Implicit:
         from mlc.sim import blockchol as BC
 
         s = self.sim
+        ci, cj, cv = self.contacts()
+        if len(ci) and self._pat is not None and not self._pat.holds(ci, cj):
+            self._pat = None             # a contact between bodies the pattern does not join
         if self._pat is None:
-            self._pat = BC.symbolic(self.N, self.sb[s.sp_i], self.sb[s.sp_j])
-            self._diag = np.zeros((self.N, 6, 6))
+            # the contact's pairs, and every pair its bodies' neighbour lists hold (within the WCA
+            # range plus the list's skin): contacts that come next are likely among them
+            self._extra |= set(zip(ci.tolist(), cj.tolist()))
+            for b in set(ci.tolist()) | set(cj.tolist()):
+                for c in s.nl[s.nl0[b]:s.nl0[b + 1]].tolist():
+                    self._extra.add((min(b, c), max(b, c)))
+            ex = np.array(sorted(self._extra), np.int64).reshape(-1, 2)
+            self._pat = BC.symbolic(self.N, self.sb[s.sp_i], self.sb[s.sp_j], ex[:, 0], ex[:, 1])
             self._blk = np.zeros((self._pat.nblk, 6, 6))
+        if self._diag is None:
+            self._diag = np.zeros((self.N, 6, 6))
             self._grad = np.zeros((len(self.sb), 3))
             self._bvec = np.zeros((self.N, 6))
             self._lam = np.zeros((self.N, 3))
@@ -288,7 +310,11 @@ class Implicit:
         BC.rot_eig(self._grad, s.arm, self.sb, self.N, self._lam, self._vec)
         lam, vec = self._lam, self._vec
         thresh = 1e-14 * max(1.0, float(np.abs(lam).max(initial=0.0)))
-        BC.assemble_rot(lam, vec, thresh, P.pos, self._diag, nrow, bool(noisy), seed2, key, bool(rot), self._bvec)
+        nrow += BC.assemble_rot(lam, vec, thresh, P.pos, self._diag, nrow, bool(noisy), seed2, key, bool(rot),
+                                self._bvec)
+        if len(ci):
+            BC.assemble_contacts(ci, cj, cv, P.pair_blk(ci, cj), P.pos[ci] < P.pos[cj], P.pos, self._diag, self._blk,
+                                 nrow, bool(noisy), seed2, key, self._bvec)
         if BC.factor(self._diag, self._blk, P.colptr, P.rowidx, P.upd_ptr, P.upd_tgt) >= 0:
             return None                  # not positive definite to working precision: SuperLU decides
         return _Block(self)
