@@ -67,8 +67,14 @@ noise in the substep (the stiff scheme's allowance), or the end state has a bond
 ``accept`` of its stability bound or centres inside ``wca_min``; it goes back up a level where
 the grid allows.  The drift test does not look at this step's noise, so it does not condition
 on it.
-Cost per (sub)step: one force evaluation, one sparse assembly and one SuperLU factorisation
-of a 6N x 6N matrix in symmetric mode (:func:`mlc.verify.static.spd_lu`).
+Cost per (sub)step: one force evaluation and one factorisation of ``D/h + H+``, assembled
+straight into 6x6 blocks, one per body, and factorised by a block Cholesky whose pattern (a
+minimum-degree order of the bond graph) is computed once per scene (:mod:`mlc.sim.blockchol`;
+a WCA contact between bodies it does not join adds the pair).  ``rows()`` (the sparse ``G``)
+with a SuperLU factorisation in symmetric mode (:func:`mlc.verify.static.spd_lu`) is the
+reference, and what a matrix the block factor finds not positive definite falls back to
+(``Implicit.backend = "superlu"`` takes it always): the same rows in the same order, so the
+same normals and, to rounding, the same trajectory (``tests/test_sim_blockchol.py``).
 """
 from __future__ import annotations
 
