@@ -359,3 +359,45 @@ def test_the_readme_robot_folds_row_10_statically_and_is_clear_as_built(tmp_path
     assert row["shape_ok"] and row["ok"], row
     assert all(e["ok"] for e in rep.entries), [e for e in rep.entries if not e["ok"]]
     assert "branch_lean" not in load_scene(tmp_path / "robot" / "circuit.yaml").meta["connector"]
+
+
+def test_dynamic_verify_reports_the_slabs_clearance_at_the_end(robot):
+    """Each seed's final pose gets the slab test: the report's value is the test of the pose
+    the run ended in (kept with keep_poses), not of the scene as built."""
+    from mlc.robot.verify import verify_robot_dynamic
+    from mlc.verify.overlap import clearance
+
+    sc = load_scene(robot / "out" / "robot.yaml")
+    rep = verify_robot_dynamic(sc, rows=["1"], seeds=1, max_time=20.0, keep_poses=True)
+    row = rep.rows[0]
+    pos, quat = rep.poses[("1", 0)]
+    end = clearance(sc, pos, quat).min_clearance
+    assert row["end"]["clearance"] == pytest.approx(end if abs(end) > 1e-12 else 0.0, abs=1e-12)
+    assert row["per_seed"][0]["clearance_end"] == row["end"]["clearance"] and row["end"]["seed"] == 0
+    assert abs(end - clearance(sc).min_clearance) > 1e-6          # it moved: not the built pose's
+
+
+def _overlap(*_a, **_k):
+    return {"clearance": -0.05, "clearance_pair": ["ua", "ub"], "overlaps": [["ua", "ub", 0.05]], "n_overlaps": 1,
+            "clearance_ok": False}
+
+
+def test_require_clearance_fails_a_robot_row_whose_slabs_meet(robot, monkeypatch, capsys):
+    """--require-clearance: a row whose slabs interpenetrate fails (static: the row's pose;
+    dynamic: a seed's final pose); without it the same report warns and passes."""
+    import mlc.robot.verify as rv
+
+    monkeypatch.setattr(rv, "_clearance_row", _overlap)
+    path = str(robot / "out" / "robot.yaml")
+    assert main(["verify", path, "--rows", "1"]) == 0
+    assert "WARNING: row 1: slabs ua and ub interpenetrate by 0.0500 sigma" in capsys.readouterr().out
+    assert main(["verify", path, "--rows", "1", "--require-clearance"]) == 1
+    out = capsys.readouterr().out
+    assert "WRONG: row 1: slabs ua and ub interpenetrate" in out and "FAILED: rows 1" in out
+    sc = load_scene(path)
+    rep = rv.verify_robot_dynamic(sc, rows=["1"], seeds=1, max_time=20.0, require_clearance=True)
+    assert not rep.ok and rep.rows[0]["shape_ok"]
+    text = rv.format_robot_report(rep)
+    assert "WRONG: row 1: slabs ua and ub end 0.0500 sigma inside each other (1 pairs, seed 0)" in text
+    rep = rv.verify_robot_dynamic(sc, rows=["1"], seeds=1, max_time=20.0)
+    assert rep.ok and "WARNING: row 1: slabs ua and ub end" in rv.format_robot_report(rep)

@@ -36,7 +36,8 @@ def register(sub):
                         "else mlc.verify.dynamic.DT (0.01 t0)")
     p.add_argument("--rows", metavar="BITS", nargs="+", help="verify only these rows (bit strings in input order)")
     p.add_argument("--require-clearance", action="store_true",
-                   help="static: also fail a row whose slabs interpenetrate (reported as a warning otherwise)")
+                   help="also fail a row whose slabs interpenetrate (reported as a warning otherwise): static, "
+                        "in the row's pose; a robot's --dynamic check, in any seed's final pose")
     add_jobs(p)
     p.add_argument("--json", action="store_true", help="print the report as JSON")
     p.set_defaults(func=run)
@@ -74,7 +75,8 @@ def verify_scene_file(scene, dynamic: bool = False, kT: float = 1e-5, seeds: int
 
     if isinstance(scene.meta, dict) and scene.meta.get("element") == "robot":     # docs/robot.md
         from mlc.robot.verify import verify_robot
-        return verify_robot(scene, dynamic, kT, seeds, scheme, rows, tau=tau, dt=dt, jobs=jobs)
+        return verify_robot(scene, dynamic, kT, seeds, scheme, rows, tau=tau, dt=dt, jobs=jobs,
+                            require_clearance=require_clearance)
     n = len(select_rows(scene, rows))
     if dynamic:
         return verify_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme or "stiff", tau=tau, dt=dt)

@@ -263,10 +263,11 @@ def _clearance_row(scene: Scene, pos=None, quat=None) -> dict:
 
 
 def verify_robot_static(scene: Scene, rows=None, steps: int = STEPS, progress=None, keep_poses: bool = False,
-                        clearance: bool = True, jobs: int = 1) -> Report:
+                        clearance: bool = True, jobs: int = 1, require_clearance: bool = False) -> Report:
     """Static check of every row (see the module doc).  With ``clearance`` each row's
     equilibrium and the scene as built also get the slab-overlap test (docs/robot.md 3):
-    reported, a warning when slabs interpenetrate, not part of a row's verdict.  ``jobs``:
+    reported, a warning when slabs interpenetrate, part of a row's verdict only with
+    ``require_clearance`` (a row whose pose interpenetrates fails).  ``jobs``:
     rows solved at once, each in a forked process (:func:`mlc.verify.circuit.map_rows`;
     the same report for any ``jobs``)."""
     from mlc.verify.circuit import map_rows
@@ -275,13 +276,15 @@ def verify_robot_static(scene: Scene, rows=None, steps: int = STEPS, progress=No
     states = select_rows(scene, rows)
     t0 = time.perf_counter()
     rep = Report(scene.name, "static", params={"tol_length": TOL_LENGTH, "tol_stretch": TOL_STRETCH, "steps": steps,
-                                               "robot": True})
+                                               "robot": True, "require_clearance": bool(require_clearance)})
     if clearance:
         rep.params["as_built"] = _clearance_row(scene)
     poses = {}
     for entries, row, pose in map_rows(lambda state: _static_row(scene, rm, state, steps, clearance), states, jobs,
                                        progress):
         rep.entries.extend(entries)
+        if require_clearance and clearance and not row["clearance_ok"]:
+            row["ok"] = False
         rep.rows.append(row)
         poses[row["state"]] = pose
     rep.seconds = time.perf_counter() - t0
@@ -318,7 +321,8 @@ def _static_row(scene: Scene, rm, state: str, steps: int, clearance: bool) -> tu
 
 def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int = 3, scheme: str | None = None,
                          max_time: float | None = None, progress=None, keep_poses: bool = False,
-                         tau: float | None = None, dt: float | None = None, first_seed: int = 0) -> Report:
+                         tau: float | None = None, dt: float | None = None, first_seed: int = 0,
+                         clearance: bool = True, require_clearance: bool = False) -> Report:
     """Brownian dynamics from rest into each row, ``seeds`` seeds, until relaxed
     (:func:`run_fold`: at least 3 tau, circuit outputs on a plateau, joint angles within
     their thermal noise) or ``max_time`` t0 (default the paper's 1800 t0); the shape is
@@ -327,7 +331,10 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
     relaxation time (default ``ROBOT_TAU``, measured on the robots' folds, docs/robot.md
     section 3; ``"compute"`` runs :func:`mlc.verify.dynamic.relaxation_time` at the rest pose,
     densely up to ``DENSE_ROBOT`` coordinates: seconds for the 524-body per-lever Tetris robot;
-    a larger one takes the sparse Lanczos, more than 8 min for a 2000-body robot).  Seeds are ``first_seed``, ``first_seed + 1``, ..."""
+    a larger one takes the sparse Lanczos, more than 8 min for a 2000-body robot).  Seeds are ``first_seed``, ``first_seed + 1``, ...
+    With ``clearance`` each seed's final pose gets the slab test (:func:`_clearance_row`): the
+    model has WCA between body centres only (the paper's), so slabs may end inside each other,
+    which a print could not do; the report warns, and ``require_clearance`` fails such a row."""
     from mlc.io.progress import Progress
     from mlc.sim.drive import Drive
     from mlc.sim.integrator import SimOptions, Simulation, check_kT
@@ -353,7 +360,8 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
                                                 "scheme": scheme, "tau": tau, "dt": dt, "robot": True,
                                                 "disp_acc": ROBOT_DISP_ACC if scheme in ("stiff", "implicit") else None,
                                                 "fold_dt": fold_step(scheme, dt, 0.0) if dt is not None else None,
-                                                "fold_time": ROBOT_FOLD_TIME if scheme == "implicit" else 0.0})
+                                                "fold_time": ROBOT_FOLD_TIME if scheme == "implicit" else 0.0,
+                                                "require_clearance": bool(require_clearance)})
     poses = {}
     total, done = len(states) * int(seeds), 0
     bar = Progress(f"dynamic check of {scene.name}", total=total, show=None if progress is None else False)
@@ -371,6 +379,8 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
                 inner = bar.within(done, TAU_FACTOR * tau if state != "0" * len(scene.inputs) else tau)
                 means, t_rel, relaxed, _, _ = run_fold(sim, scene, state, kT, tau, t_max, on_window=inner)
                 shape = _shape_row(scene, rm, state, sim.pos.copy(), sim.quat.copy(), means)
+                if clearance:                  # slab overlap in the final pose (a print's concern, not the shape's)
+                    shape["end"] = _clearance_row(scene, sim.pos, sim.quat)
                 per.append((means, t_rel, relaxed, shape))
                 poses[(state, seed)] = (sim.pos.copy(), sim.quat.copy())
                 done += 1
@@ -393,16 +403,24 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
             worst = max(shapes, key=lambda sh: (not sh["shape_ok"], sh["max_dof_error_deg"]))
             row = {"state": state, "relax_time": max(t for _, t, _, _ in per),
                    "relaxed": all(r for _, _, r, _ in per), "seeds": int(seeds)}
-            row.update(worst)
+            row.update({k: v for k, v in worst.items() if k != "end"})
+            if clearance:                      # the seed whose final pose interpenetrates deepest
+                s_end, end = min(enumerate((sh["end"] for sh in shapes), start=int(first_seed)),
+                                 key=lambda e: e[1]["clearance"])
+                row["end"] = dict(end, seed=s_end)
             row["max_dof_mean_error_deg"] = max(sh.get("max_dof_mean_error_deg", 0.0) for sh in shapes)
             row["max_dof_mean_error_rad"] = math.radians(row["max_dof_mean_error_deg"])
             row["per_seed"] = [{"seed": s, "shape_read": sh["shape_read"], "turns_read": sh["turns_read"],
                                 "max_dof_error_deg": sh["max_dof_error_deg"],
                                 "max_dof_mean_error_deg": sh.get("max_dof_mean_error_deg"), "time": t,
-                                "dof_angles": sh["dof_angles"]}
+                                "dof_angles": sh["dof_angles"],
+                                **({"clearance_end": sh["end"]["clearance"], "clearance_pair_end": sh["end"]["clearance_pair"]}
+                                   if clearance else {})}
                                for s, (_, t, _, sh) in enumerate(per, start=int(first_seed))]
             row["shape_ok"] = all(sh["shape_ok"] for sh in shapes)
             row["ok"] = bool(row_ok and row["shape_ok"])
+            if require_clearance and clearance and not row["end"]["clearance_ok"]:
+                row["ok"] = False
             rep.rows.append(row)
     rep.seconds = time.perf_counter() - t0
     if keep_poses:
@@ -411,18 +429,22 @@ def verify_robot_dynamic(scene: Scene, rows=None, kT: float = 1e-5, seeds: int =
 
 
 def verify_robot(scene: Scene, dynamic: bool = False, kT: float = 1e-5, seeds: int = 3, scheme: str | None = None,
-                 rows=None, tau: float | None = None, dt: float | None = None, jobs: int = 1) -> Report:
+                 rows=None, tau: float | None = None, dt: float | None = None, jobs: int = 1,
+                 require_clearance: bool = False) -> Report:
     """``mlc verify`` of a robot scene: static (default; ``jobs`` rows at once) or by
     Brownian dynamics (``scheme`` default ``ROBOT_SCHEME``; ``tau`` and ``dt`` in t0, defaults
-    ``ROBOT_TAU`` and ``ROBOT_DT``)."""
+    ``ROBOT_TAU`` and ``ROBOT_DT``).  ``require_clearance``: a row whose pose (static) or a
+    seed's final pose (dynamic) has slabs inside each other fails."""
     from mlc.io.progress import Progress
 
     robot_meta(scene)
     if dynamic:
-        return verify_robot_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme, tau=tau, dt=dt)
+        return verify_robot_dynamic(scene, rows, kT=kT, seeds=seeds, scheme=scheme, tau=tau, dt=dt,
+                                    require_clearance=require_clearance)
     n = len(select_rows(scene, rows))
     with Progress(f"static verification of {scene.name}", total=n) as bar:
-        return verify_robot_static(scene, rows, progress=lambda done, total: bar.update(done), jobs=jobs)
+        return verify_robot_static(scene, rows, progress=lambda done, total: bar.update(done), jobs=jobs,
+                                   require_clearance=require_clearance)
 
 
 def _steps_text(p: dict) -> str:
@@ -464,11 +486,22 @@ def format_robot_report(rep: Report) -> str:
         a, b, d = r["overlaps"][0]
         lines.append(f"WARNING: {r['state']}: slabs {a} and {b} interpenetrate by {d:.4f} sigma "
                      f"({r['n_overlaps']} pairs); smallest clearance {r['clearance']:+.4f} sigma (not printable as built)")
+    word = "WRONG" if rep.params.get("require_clearance") else "WARNING"
     for r in rep.rows:
         if r.get("overlaps"):
             a, b, d = r["overlaps"][0]
-            lines.append(f"WARNING: row {r['state']}: slabs {a} and {b} interpenetrate by {d:.4f} sigma "
+            lines.append(f"{word}: row {r['state']}: slabs {a} and {b} interpenetrate by {d:.4f} sigma "
                          f"({r['n_overlaps']} pairs) in the static pose; smallest clearance {r['clearance']:+.4f} sigma")
+    if any("end" in r for r in rep.rows):
+        lines.append("slab clearance at the end of the runs (the deepest seed): "
+                     + ", ".join(f"{r['state']} {r['end']['clearance']:+.4f}" for r in rep.rows))
+    for r in rep.rows:
+        e = r.get("end")
+        if e and e.get("overlaps"):
+            a, b, d = e["overlaps"][0]
+            lines.append(f"{word}: row {r['state']}: slabs {a} and {b} end {d:.4f} sigma inside each other "
+                         f"({e['n_overlaps']} pairs, seed {e['seed']}): the simulation's contact is between body "
+                         f"centres only (the paper's model), a print would jam there")
     for r in rep.rows:
         if not r["shape_ok"]:
             lines.append(f"WRONG: row {r['state']}: the skeleton folded into {r['shape_read']} (turns "
@@ -479,7 +512,8 @@ def format_robot_report(rep: Report) -> str:
             what = ", ".join(f"{e['output']} read {e['measured']:.3f}" for e in bad[:4])
             if rep.mode == "static" and r["joint_stretch"] > TOL_STRETCH:
                 what = (what + ", " if what else "") + f"joint stretch {r['joint_stretch']:.2e} sigma"
-            lines.append(f"WRONG: row {r['state']}: {what}")
+            if what:                           # else the slabs alone (--require-clearance: its line above)
+                lines.append(f"WRONG: row {r['state']}: {what}")
     lines.append(f"all {len(rep.rows)} rows fold correctly ({rep.seconds:.1f} s)" if rep.ok else
                  f"FAILED: rows {', '.join(r['state'] for r in rep.rows if not r['ok'])}")
     return "\n".join(lines)
