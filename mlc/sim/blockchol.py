@@ -11,14 +11,18 @@ the state.  Here that is used three ways:
 * :func:`symbolic` orders the bodies once by minimum degree on the bond graph and lists the
   factor's pattern (the elimination graph's cliques: every block of ``L``, fill included) and,
   for each column, where each of its block products goes;
-* :func:`assemble_bonds` and :func:`assemble_rot` add each row's ``g g^T`` straight into those
-  blocks (no sparse matrix is formed), and each row's noise ``g xi`` (scaled as the module doc of
+* :func:`assemble_bonds`, :func:`assemble_rot` and :func:`assemble_contacts` add each row's
+  ``g g^T`` straight into those blocks (no sparse matrix is formed; a zero-length bond's three
+  rows summed in closed form), and each row's noise ``g xi`` (scaled as the module doc of
   :mod:`mlc.sim.implicit` says) into a vector, in the row order of ``Implicit.rows``, so the same
   seed draws the same normals for the same row;
 * :func:`factor` (right-looking block Cholesky) and :func:`solve` work on those blocks.
 
-A state with a WCA contact (centres within ``2 r0``; a row between two bodies that need not be
-bonded) takes ``Implicit.rows`` and SuperLU instead, for that substep.
+A WCA contact (centres within ``2 r0``) is a row between two bodies that need not be bonded:
+``Implicit`` then computes the pattern again with that pair, and the pairs in its bodies'
+neighbour lists, added (``symbolic``'s ``ei``, ``ej``), and keeps it for the rest of the run.
+The rotational rows' eigenvectors come from Jacobi rotations (:func:`rot_eig`), not LAPACK:
+the same ``H+``; with rotational noise, the same noise in law.
 
 Cost, for a scene of N bodies in chains: the pattern's blocks and products grow with N (no
 ordering, no sparse products, no Python loop per row in a step).  ``tests/test_sim_blockchol.py``
