@@ -76,11 +76,17 @@ def _flat(asm, ax) -> bool:
     return abs(float(d[2])) / float(np.linalg.norm(d)) < np.sin(np.radians(FLAT_DEG))
 
 
+def _tangent(R: float) -> tuple:
+    """Where a teardrop's flank (:data:`FLANK_DEG` from the bed) touches a knuckle of radius
+    ``R``: (across the axis, below it: negative), in the knuckle's cross-section."""
+    th = np.radians(90.0 - FLANK_DEG)        # the tangent point's angle below the horizontal
+    return R * np.cos(th), -R * np.sin(th)
+
+
 def deepest(R: float, flat: float) -> tuple:
     """The teardrop (:func:`teardrop`) under a knuckle of radius ``R`` whose flat is ``flat``
     wide: (its depth below the axis, the radius of its lower corners)."""
-    th = np.radians(90.0 - FLANK_DEG)
-    tu, tw = R * np.cos(th), -R * np.sin(th)
+    tu, tw = _tangent(R)
     uc = min(flat / 2, tu)
     depth = -tw + (tu - uc) * np.tan(np.radians(FLANK_DEG))
     return float(depth), float(np.hypot(uc, depth))
@@ -184,9 +190,7 @@ def teardrop(ax, body_up, a0, a1, depth, segments):
     (solid, radius of its lower corners)."""
     import manifold3d as mf
     from mlc.mesh.build import _affine
-    R = ax.R
-    th = np.radians(90.0 - FLANK_DEG)        # the tangent point's angle below the horizontal
-    tu, tw = R * np.cos(th), -R * np.sin(th)
+    tu, tw = _tangent(ax.R)
     uc = tu - (depth + tw) / np.tan(np.radians(FLANK_DEG))
     if uc <= 0:
         return None, depth
