@@ -242,6 +242,10 @@ def test_nand_fdm_output_lever_pivot_chamfered_and_teardropped(nand_fdm):
     assert rep.ok, rep.text()
     assert any("out_hi's arms chamfered" in n for n in asm.notes), asm.notes
     assert any(n.startswith("out_lo: teardrops under the knuckles of pivot_out") for n in asm.notes), asm.notes
+    for n in asm.notes:                   # a hinge named once, with each knuckle's flat
+        if ": teardrops under the knuckles of " in n:
+            hinges = [h.split(" (flat")[0] for h in n.split(" of ", 1)[1].split(" mm below the axis), ")]
+            assert len(hinges) == len(set(hinges)), n
     assert asm.bed.islands == 0
     assert asm.bed.support_fraction < 0.20, asm.bed.support_fraction
     lever = sum(asm.bed.per_part[n][1] for n in ("out_lo", "out_hi"))

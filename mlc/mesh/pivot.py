@@ -254,8 +254,12 @@ def teardrops(asm) -> list:
         if p.name not in add:
             continue
         p.solid = _clean(union([p.solid] + [td for _, (td, _) in add[p.name]]))
+        flats: dict = {}                     # hinge -> its knuckles' flats (a hinge named once)
+        for a, (_, d) in add[p.name]:
+            flats.setdefault(a, []).append(f"{d:.2f}")
         notes.append(f"{p.name}: teardrops under the knuckles of "
-                     + ", ".join(f"{a} (flat {d:.2f} mm below the axis)" for a, (_, d) in add[p.name])
+                     + ", ".join(f"{a} (flat{'s' if len(ds) > 1 else ''} {', '.join(ds)} mm below the axis)"
+                                 for a, ds in flats.items())
                      + " (print-only, mlc.mesh.pivot)")
     return notes
 
