@@ -47,6 +47,7 @@ clearance.
 """
 from __future__ import annotations
 
+import copy
 import itertools
 import math
 import os
@@ -1131,6 +1132,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
                 _relieve_host_holes(asm, notes, posed_T)
             if YOKE_TIP_CLEAR:
                 _clear_tipped_yokes(asm, notes, posed_T)
+            if STROKE_CLEAR:
+                _clear_strokes(asm, protected, soft, posed_T)
     _log("final trims done; drilling")
     # attachment holes shaped for the print's up where it is known now: the feet's (fdm's
     # orient: auto; the as_is profiles, mjp and sla, print their own support and keep round holes)
@@ -3261,6 +3264,165 @@ def _clear_motion(asm: "Assembly", protected: dict, soft_protected: dict, names:
         if not changed:
             return
         only = changed
+
+
+# -- rubs on the way to a state, in a compiled circuit (session 56) -----------------------------
+#: compiled circuits: two bodies that meet on the way to a logic state (a coarse pose "st@f") but
+#: in no logic state get the motion trim (_clear_motion) in poses interpolated along that stretch
+STROKE_CLEAR = True
+#: ... the interpolated poses: no corner of either part's box moves more than this (times the
+#: clearance) relative to the other from one pose to the next
+STROKE_STEP = 0.5
+#: ... at most this many pairs are trimmed so (the cost stays bounded on a large scene; a note says
+#: how many were left)
+STROKE_MAX_PAIRS = 32
+STROKE_EPS = 1e-6          # mm^3: the states check's VOL_EPS (mlc.mesh.checks)
+
+
+def _meeting_pairs(asm: "Assembly", Ts: list, wanted=None) -> list:
+    """For each part-transform dict of ``Ts``, the pairs ``(i, j)`` of parts that share more than
+    :data:`STROKE_EPS` of volume there: the states check's own test (posed boxes, oriented boxes,
+    the triangles' proof of apartness, then the boolean; its congruence cache: the same key, so
+    the check finds the unchanged pairs measured).  ``wanted(i, j)``: which candidate pairs to test."""
+    from mlc.mesh.apart import surfaces_apart
+    parts = asm.parts
+    cong = asm.congruence
+    frames = part_frames(asm) if cong is None else cong.frames
+    llo, lhi = local_boxes([p.solid for p in parts], frames)
+    lo, hi = solid_boxes([p.solid for p in parts])
+    meshes: dict = {}
+    out = []
+    for T in Ts:
+        Tp = [T[p.name] for p in parts]
+        plo, phi = posed_boxes(lo, hi, Tp)
+        cand = obb_overlap(box_pairs(plo, phi, 0.0), [t @ f for t, f in zip(Tp, frames)], llo, lhi)
+        if wanted is not None:
+            cand = [ij for ij in cand if wanted(*ij)]
+        posed: dict = {}
+
+        def vol(i, j):
+            for k in (i, j):
+                if k not in meshes:
+                    m = parts[k].solid.to_mesh64()
+                    meshes[k] = (np.asarray(m.vert_properties, float)[:, :3], np.asarray(m.tri_verts, np.int64))
+                if k not in posed:
+                    V, F = meshes[k]
+                    posed[k] = (V @ Tp[k][:3, :3].T + Tp[k][:3, 3], F)
+            if surfaces_apart(*posed[i], *posed[j]):
+                return 0.0
+            return float((transform_solid(parts[i].solid, Tp[i]) ^ transform_solid(parts[j].solid, Tp[j])).volume())
+
+        rels = cong.rel_many(cand, Tp) if cong is not None else None
+        here = set()
+        for k, (i, j) in enumerate(cand):
+            v = (vol(i, j) if cong is None else
+                 cong.lookup(("volume", cong.key(i, parts[i].solid), cong.key(j, parts[j].solid), rels[k]),
+                             lambda: vol(i, j)))
+            if v > STROKE_EPS:
+                here.add((i, j))
+        out.append(here)
+    return out
+
+
+def _interpolated(M0, M1, step: float, corners) -> list:
+    """Transforms from ``M0`` to ``M1`` (4x4; ``M0`` left out, ``M1`` last): the rotation turned
+    about the fixed axis of ``M0^-1 M1``'s rotation at a constant rate, the translation moved on a
+    straight line, in as many equal steps as keep every point of ``corners`` (a part's box
+    corners, its own rest frame) within ``step`` of where the step before took it."""
+    from mlc.geometry.rotation import expmap
+    R0, R1 = M0[:3, :3], M1[:3, :3]
+    dR = R0.T @ R1
+    ang = float(np.arccos(np.clip((np.trace(dR) - 1) / 2, -1.0, 1.0)))
+    if ang < 1e-12:
+        w = np.zeros(3)
+    else:
+        w = np.array([dR[2, 1] - dR[1, 2], dR[0, 2] - dR[2, 0], dR[1, 0] - dR[0, 1]]) / (2 * np.sin(ang)) * ang
+    X = np.c_[corners, np.ones(len(corners))]
+    move = float(np.linalg.norm((X @ (M1 - M0).T)[:, :3], axis=1).max())
+    n = max(1, int(np.ceil(move / step)))
+    out = []
+    for k in range(1, n + 1):
+        f = k / n
+        M = np.eye(4)
+        M[:3, :3] = R0 @ expmap(w * f)
+        M[:3, 3] = (1 - f) * M0[:3, 3] + f * M1[:3, 3]
+        out.append(M)
+    return out
+
+
+def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: list) -> None:
+    """A compiled circuit is posed coarsely (its logic states and ``PATH_STEPS`` poses on the way
+    to each, ``"01@0.71"``), and gets no dense paths, so no motion trim (:func:`_clear_motion`):
+    two bodies that rub on the way to a state and clear each other at its ends were left meeting
+    (the README circuit's gate g3: the input levers' tips ran into ``out_hi`` at ``@0.71`` and
+    ``@0.86``, issue 13, as in the library gates before their motion trims).
+
+    ``Ts``: the parts' transforms in ``asm.poses`` (in order).  Every pair of two bodies that
+    shares volume in a pose on the way to a state (:func:`_meeting_pairs`) and in none of the
+    logic states is given the motion trim of :func:`_clear_motion`, for the clearance, in poses
+    of the one relative to the other interpolated (:func:`_interpolated`, steps of
+    :data:`STROKE_STEP` times the clearance) over that stretch of the path: from the coarse pose
+    before the first where they meet to the one after the last (rest and the state itself at
+    the ends).  The poses between the coarse ones are interpolated, not solved: the trim's growth
+    (at least 1.25 times the clearance) is their margin."""
+    poses = asm.poses or {}
+    names = list(poses)
+    c = asm.profile.clearance
+    on_way = [k for k, n in enumerate(names) if "@" in n]
+    if c <= 0 or not on_way:
+        return
+    parts = asm.parts
+    body = [p.kind == "body" for p in parts]
+    _log("rubs on the way to the states")
+    met = _meeting_pairs(asm, [Ts[k] for k in on_way], lambda i, j: body[i] and body[j])
+    pairs: dict = {}
+    for k, here in zip(on_way, met):
+        for ij in here:
+            pairs.setdefault(ij, []).append(k)
+    if not pairs:
+        return
+    ends = [k for k, n in enumerate(names) if "@" not in n]
+    in_state = set().union(*_meeting_pairs(asm, [Ts[k] for k in ends], lambda i, j: (i, j) in pairs))
+    pairs = {ij: ks for ij, ks in pairs.items() if ij not in in_state}
+    if len(pairs) > STROKE_MAX_PAIRS:
+        asm.notes.append(f"rubs on the way to the states: {len(pairs)} pairs of bodies, the first "
+                         f"{STROKE_MAX_PAIRS} trimmed")
+    frames = part_frames(asm) if asm.congruence is None else asm.congruence.frames
+    llo, lhi = local_boxes([p.solid for p in parts], frames)
+    for (i, j), ks in sorted(pairs.items())[:STROKE_MAX_PAIRS]:
+        A, B = parts[i], parts[j]
+        sel = np.array([[(lhi if (q >> a) & 1 else llo)[j, a] for a in range(3)] for q in range(8)])
+        corners = sel @ frames[j][:3, :3].T + frames[j][:3, 3]     # B's box corners, rest world
+        step = STROKE_STEP * c
+        dense_names, dense_T = [], []
+        for st in sorted({names[k].split("@")[0] for k in ks}):
+            rest = "0" * len(st)
+            path = sorted((float(n.split("@")[1]), k) for k, n in enumerate(names) if n.split("@")[0] == st and "@" in n)
+            seq = ([names.index(rest)] if rest in poses else []) + [k for _, k in path] + [names.index(st)]
+            hit = [n for n, k in enumerate(seq) if k in ks]
+            seq = seq[max(0, hit[0] - 1):hit[-1] + 2]
+            rel = [np.linalg.solve(Ts[k][A.name], Ts[k][B.name]) for k in seq]
+            dense_names.append(names[seq[0]])
+            dense_T.append({A.name: np.eye(4), B.name: rel[0]})
+            for (k0, M0), (k1, M1) in zip(zip(seq, rel), zip(seq[1:], rel[1:])):
+                mid = _interpolated(M0, M1, step, corners)
+                for q, M in enumerate(mid):
+                    dense_names.append(names[k1] if q == len(mid) - 1 else f"{names[k0]}~{names[k1]}#{q + 1}")
+                    dense_T.append({A.name: np.eye(4), B.name: M})
+        _log(f"  {A.name} / {B.name}: meet in {', '.join(names[k] for k in ks)}; "
+             f"{len(dense_T)} poses on the way")
+        view = copy.copy(asm)
+        view.parts = [A, B]
+        view.congruence = None
+        before, n_notes = len(asm.motion_trims), len(asm.notes)
+        _clear_motion(view, protected, soft_protected, dense_names, dense_T)
+        for t in asm.motion_trims[before:]:
+            t["stroke"] = True
+        asm.notes[n_notes:] = [x.replace("of the dense paths", "interpolated on the way to the states")
+                               for x in asm.notes[n_notes:]]
+        if asm.congruence is not None:
+            asm.congruence._keys.pop(i, None)
+            asm.congruence._keys.pop(j, None)
 
 
 def _posed_gap(A: "Part", B: "Part", T: dict, search: float) -> float:
