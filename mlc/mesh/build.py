@@ -3270,8 +3270,8 @@ def _clear_motion(asm: "Assembly", protected: dict, soft_protected: dict, names:
 #: compiled circuits: two bodies that meet on the way to a logic state (a coarse pose "st@f") but
 #: in no logic state get the motion trim (_clear_motion) in poses interpolated along that stretch
 STROKE_CLEAR = True
-#: ... the interpolated poses: no corner of either part's box moves more than this (times the
-#: clearance) relative to the other from one pose to the next
+#: ... the interpolated poses: no corner of the second part's box moves more than this (times the
+#: clearance) relative to the first from one pose to the next
 STROKE_STEP = 0.5
 #: ... at most this many pairs are trimmed so (the cost stays bounded on a large scene; a note says
 #: how many were left)
@@ -3398,7 +3398,8 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
         for st in sorted({names[k].split("@")[0] for k in ks}):
             rest = "0" * len(st)
             path = sorted((float(n.split("@")[1]), k) for k, n in enumerate(names) if n.split("@")[0] == st and "@" in n)
-            seq = ([names.index(rest)] if rest in poses else []) + [k for _, k in path] + [names.index(st)]
+            seq = (([names.index(rest)] if rest in poses else []) + [k for _, k in path]
+                   + ([names.index(st)] if st in poses else []))
             hit = [n for n, k in enumerate(seq) if k in ks]
             seq = seq[max(0, hit[0] - 1):hit[-1] + 2]
             rel = [np.linalg.solve(Ts[k][A.name], Ts[k][B.name]) for k in seq]
@@ -3420,9 +3421,6 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
             t["stroke"] = True
         asm.notes[n_notes:] = [x.replace("of the dense paths", "interpolated on the way to the states")
                                for x in asm.notes[n_notes:]]
-        if asm.congruence is not None:
-            asm.congruence._keys.pop(i, None)
-            asm.congruence._keys.pop(j, None)
 
 
 def _posed_gap(A: "Part", B: "Part", T: dict, search: float) -> float:
