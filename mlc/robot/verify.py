@@ -501,7 +501,7 @@ def format_robot_report(rep: Report) -> str:
             a, b, d = e["overlaps"][0]
             lines.append(f"{word}: row {r['state']}: slabs {a} and {b} end {d:.4f} sigma inside each other "
                          f"({e['n_overlaps']} pairs, seed {e['seed']}): the simulation's contact is between body "
-                         f"centres only (the paper's model), a print would jam there")
+                         f"centres only (the paper's model); printed parts could not pass there")
     for r in rep.rows:
         if not r["shape_ok"]:
             lines.append(f"WRONG: row {r['state']}: the skeleton folded into {r['shape_read']} (turns "
