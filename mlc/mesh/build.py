@@ -1301,6 +1301,7 @@ def _cut_whole(asm: "Assembly", by: dict, cutters: dict) -> list:
 #: compiled circuits: a compound junction's pin relieved in the stack's holes where it swings (session 55)
 PIN_RELIEF = True
 PIN_RELIEF_MARGIN = 0.01  # mm: the relief clears the posed pin by this much
+RELIEF_RETAINED = True    # ... only as far as every part of the hinge stays retained (session 56)
 
 
 def _relieve_host_holes(asm: "Assembly", notes: list, Ts: list) -> None:
@@ -1350,12 +1351,58 @@ def _relieve_host_holes(asm: "Assembly", notes: list, Ts: list) -> None:
                         continue
                     zone = cylinder(hx.origin, hx.direction, a0 - 1e-3, a1 + 1e-3, hx.R + 0.05, n)
                     pin = cylinder(c0, d, p0 - 0.05, p1 + 0.05, uj.r_pin + e, n, cutter=True)
-                    per_body.setdefault(bn, []).append(zone ^ pin)
-    done = _cut_whole(asm, by, {bn: union(pieces) for bn, pieces in per_body.items()})
+                    depth = float(off.max()) + uj.r_pin - hx.r_hole
+                    per_body.setdefault((bn, hx.name), (hx, []))[1].append((depth, zone ^ pin))
+    done, kept = [], []
+    for (bn, _), (hx, pieces) in per_body.items():
+        cutter, skipped = _retained_relief(asm, by, bn, hx, pieces)
+        if skipped:
+            kept.append((bn, hx.name, skipped, max(dp for dp, _ in pieces)))
+        if cutter is not None:
+            done += _cut_whole(asm, by, {bn: cutter})
     if done:
         notes.append(f"compound junctions' pins relieved in their stacks' holes where they swing: {len(done)} bodies, "
                      f"{sum(r for _, r in done):.3g} mm^3 removed (largest {max(r for _, r in done):.3g} mm^3, "
                      f"{max(done, key=lambda x: x[1])[0]})")
+    if kept:
+        notes.append(f"pin reliefs left out where they would free a part of the hinge (retention): {len(kept)} knuckle "
+                     f"groups, {sum(k[2] for k in kept)} posed pins (deepest {max(k[3] for k in kept):.3g} mm past the "
+                     f"hole; {', '.join(f'{b} at {h}' for b, h, _, _ in kept[:6])}{', ...' if len(kept) > 6 else ''})")
+
+
+def _retained_relief(asm: "Assembly", by: dict, bn: str, hx: "HingeAxis", pieces: list):
+    """The part of a pin relief (``pieces``: [(depth past the hole's wall, posed pin's cutter)])
+    that body ``bn`` can lose while every part of its host hinge ``hx`` stays retained: the
+    retention check's moves (:func:`mlc.mesh.checks.axis_free`) freed by no cut.  All pieces
+    if that holds; else the shallowest ones, one at a time, up to the first that would free a
+    part (session 56: the robot's poses put some joint parts' pins up to 0.75 mm past the wall of
+    a 0.6 mm knuckle ring, and their relief opened the hole).  Returns (cutter or None, how many
+    pieces were left out)."""
+    from mlc.mesh.checks import axis_free
+    if not RELIEF_RETAINED:
+        return union([pc for _, pc in pieces]), 0
+    c = asm.profile.clearance
+    empty = mf.Manifold()
+
+    def free(cut):
+        new = by[bn].solid - cut if cut is not None else by[bn].solid
+        return axis_free(hx, lambda o: new if o == bn else (by[o].solid if o in by else empty), c)
+
+    base = free(None)
+
+    def holds(cut):
+        return not any(f and not b for f, b in zip(free(cut), base))
+
+    pieces = sorted(pieces, key=lambda x: x[0])
+    whole = union([pc for _, pc in pieces])
+    if holds(whole):
+        return whole, 0
+    ok = []
+    for dp, pc in pieces:
+        if not holds(union(ok + [pc])):
+            break
+        ok.append(pc)
+    return (union(ok) if ok else None), len(pieces) - len(ok)
 
 
 #: compiled circuits: a compound junction's host hinge bodies cleared of the yoke where the posed

@@ -457,19 +457,49 @@ def _closed(tri) -> bool:
     return bool(np.array_equal(fs, np.sort(rev)))
 
 
+def axis_tests(ax, c: float) -> list:
+    """The retention tests of one hinge axis: (part, partners, axis direction, joint, crop box:
+    centre, frame, size) for each body of its stack and, on a compound junction's host hinge, its
+    joint part."""
+    F = _perp_frame(ax.direction)
+    size = [2 * (ax.R + 3 * c)] * 2 + [ax.span + 6 * c]
+    tests = [(bn, [o for o in ax.bodies if o != bn] + ([ax.joint] if ax.joint else []), ax.direction,
+              ax.name, ax.origin, F, size) for bn in ax.bodies]
+    if ax.joint:      # compound junction: the joint part holds this stack's pin, held by its knuckles
+        tests.append((ax.joint, list(ax.bodies), ax.direction, ax.name, ax.origin, F, size))
+    return tests
+
+
+def _free_moves(solid, name, partners, d, centre, Fc, size, step) -> list:
+    """Which of the six moves of ``step`` (+-axis, +-radial, +-radial2 of ``d``'s frame) leave part
+    ``name`` (``solid(name)``) clear of its partners, both cropped to the joint's box."""
+    F = _perp_frame(d)
+    # only the joint's neighbourhood can stop a part: crop both sides there (much faster)
+    other = union([solid(o) for o in partners]) ^ box(centre, Fc, size)
+    mine = solid(name) ^ box(centre, Fc, [x + 4 * step for x in size])
+    out = []
+    for k, v in enumerate((F[:, 2], -F[:, 2], F[:, 0], -F[:, 0], F[:, 1], -F[:, 1])):
+        moved = mine.translate((step * v).tolist())
+        out.append(float((moved ^ other).volume()) <= VOL_EPS)
+    return out
+
+
+def axis_free(ax, solid, c: float) -> list:
+    """The retention check's moves (1.5 x clearance ``c``) of hinge ``ax``'s parts, with the parts'
+    solids ``solid(name)``: a list of booleans, True where a part moves freely."""
+    out = []
+    for name, partners, d, _, centre, Fc, size in axis_tests(ax, c):
+        out += _free_moves(solid, name, partners, d, centre, Fc, size, 1.5 * c)
+    return out
+
+
 def _retention(asm: Assembly) -> Check:
     c = asm.profile.clearance
     step = 1.5 * c
     by = {p.name: p for p in asm.parts}
     tests = []   # (part, partners, axis direction, joint, crop box: centre, frame, size)
     for ax in asm.axes:
-        F = _perp_frame(ax.direction)
-        size = [2 * (ax.R + 3 * c)] * 2 + [ax.span + 6 * c]
-        for bn in ax.bodies:
-            tests.append((bn, [o for o in ax.bodies if o != bn] + ([ax.joint] if ax.joint else []), ax.direction,
-                          ax.name, ax.origin, F, size))
-        if ax.joint:      # compound junction: the joint part holds this stack's pin, held by its knuckles
-            tests.append((ax.joint, list(ax.bodies), ax.direction, ax.name, ax.origin, F, size))
+        tests += axis_tests(ax, c)
     for uj in asm.ujoints:
         C, O = uj.bodies
         half = max(max(lay.extent, abs(lay.pin[0]), abs(lay.pin[1])) for lay in uj.layouts) + uj.R + 3 * c
@@ -493,16 +523,8 @@ def _retention(asm: Assembly) -> Check:
     axis_cores = getattr(asm, "axis_cores", None) or {}
     axis_names = {ax.name for ax in asm.axes}
 
-    def free_moves(name, partners, d, centre, Fc, size, solid=lambda o: by[o].solid):
-        F = _perp_frame(d)
-        # only the joint's neighbourhood can stop a part: crop both sides there (much faster)
-        other = union([solid(o) for o in partners]) ^ box(centre, Fc, size)
-        mine = solid(name) ^ box(centre, Fc, [x + 4 * step for x in size])
-        out = []
-        for k, v in enumerate((F[:, 2], -F[:, 2], F[:, 0], -F[:, 0], F[:, 1], -F[:, 1])):
-            moved = mine.translate((step * v).tolist())
-            out.append(float((moved ^ other).volume()) <= VOL_EPS)
-        return out
+    def free_moves(name, partners, d, centre, Fc, size):
+        return _free_moves(lambda o: by[o].solid, name, partners, d, centre, Fc, size, step)
 
     def core_first(name, partners, d, centre, Fc, size, on_axis=False):
         # large assemblies: the joint material alone (a subset of each part, which no trim
