@@ -3326,17 +3326,26 @@ STROKE_MAX_PAIRS = 32
 STROKE_EPS = 1e-6          # mm^3: the states check's VOL_EPS (mlc.mesh.checks)
 
 
-def _meeting_pairs(asm: "Assembly", Ts: list, wanted=None) -> list:
+def _part_boxes(asm: "Assembly") -> tuple:
+    """The parts' frames, their boxes in those frames and their world boxes: (frames, llo, lhi,
+    lo, hi), as the states check takes them."""
+    parts = asm.parts
+    frames = part_frames(asm) if asm.congruence is None else asm.congruence.frames
+    llo, lhi = local_boxes([p.solid for p in parts], frames)
+    lo, hi = solid_boxes([p.solid for p in parts])
+    return frames, llo, lhi, lo, hi
+
+
+def _meeting_pairs(asm: "Assembly", Ts: list, wanted=None, boxes=None) -> list:
     """For each part-transform dict of ``Ts``, the pairs ``(i, j)`` of parts that share more than
     :data:`STROKE_EPS` of volume there: the states check's own test (posed boxes, oriented boxes,
     the triangles' proof of apartness, then the boolean; its congruence cache: the same key, so
-    the check finds the unchanged pairs measured).  ``wanted(i, j)``: which candidate pairs to test."""
+    the check finds the unchanged pairs measured).  ``wanted(i, j)``: which candidate pairs to test;
+    ``boxes``: :func:`_part_boxes` of the parts as they are (computed here when not given)."""
     from mlc.mesh.apart import surfaces_apart
     parts = asm.parts
     cong = asm.congruence
-    frames = part_frames(asm) if cong is None else cong.frames
-    llo, lhi = local_boxes([p.solid for p in parts], frames)
-    lo, hi = solid_boxes([p.solid for p in parts])
+    frames, llo, lhi, lo, hi = _part_boxes(asm) if boxes is None else boxes
     meshes: dict = {}
     out = []
     for T in Ts:
@@ -3421,7 +3430,8 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
     parts = asm.parts
     body = [p.kind == "body" for p in parts]
     _log("rubs on the way to the states")
-    met = _meeting_pairs(asm, [Ts[k] for k in on_way], lambda i, j: body[i] and body[j])
+    boxes = _part_boxes(asm)         # the parts are not trimmed until every pair is found
+    met = _meeting_pairs(asm, [Ts[k] for k in on_way], lambda i, j: body[i] and body[j], boxes)
     pairs: dict = {}
     for k, here in zip(on_way, met):
         for ij in here:
@@ -3429,13 +3439,12 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
     if not pairs:
         return
     ends = [k for k, n in enumerate(names) if "@" not in n]
-    in_state = set().union(*_meeting_pairs(asm, [Ts[k] for k in ends], lambda i, j: (i, j) in pairs))
+    in_state = set().union(*_meeting_pairs(asm, [Ts[k] for k in ends], lambda i, j: (i, j) in pairs, boxes))
     pairs = {ij: ks for ij, ks in pairs.items() if ij not in in_state}
     if len(pairs) > STROKE_MAX_PAIRS:
         asm.notes.append(f"rubs on the way to the states: {len(pairs)} pairs of bodies, the first "
                          f"{STROKE_MAX_PAIRS} trimmed")
-    frames = part_frames(asm) if asm.congruence is None else asm.congruence.frames
-    llo, lhi = local_boxes([p.solid for p in parts], frames)
+    frames, llo, lhi = boxes[:3]
     for (i, j), ks in sorted(pairs.items())[:STROKE_MAX_PAIRS]:
         A, B = parts[i], parts[j]
         sel = np.array([[(lhi if (q >> a) & 1 else llo)[j, a] for a in range(3)] for q in range(8)])
