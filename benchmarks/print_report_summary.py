@@ -1,6 +1,7 @@
 """The blocking checks of ``mlc stl`` printability reports side by side, from the report files
 that ``mlc stl --report`` wrote (for example the README's main job's ``out/circuit_print.json``
-in two sessions): each check's result, failure count and detail.
+in two sessions): each check's result, failure count, value, detail and the failures the report
+lists (it lists at most 20).
 
     python benchmarks/print_report_summary.py LABEL=COMMIT=REPORT.json [...] --out RESULTS.json
 
@@ -17,7 +18,8 @@ def summary(path: Path) -> dict:
     r = json.loads(Path(path).read_text())
     by = {c["name"]: c for c in r["checks"]}
     return {name: {"ok": by[name]["ok"], "failure_count": by[name].get("failure_count", 0),
-                   "detail": by[name]["detail"]} for name in CHECKS if name in by}
+                   "value": by[name].get("value"), "detail": by[name]["detail"],
+                   "failures": by[name].get("failures", [])} for name in CHECKS if name in by}
 
 
 def main() -> int:
