@@ -1,7 +1,8 @@
-"""The blocking checks of ``mlc stl`` printability reports side by side, from the report files
-that ``mlc stl --report`` wrote (for example the README's main job's ``out/circuit_print.json``
-in two sessions): each check's result, failure count, value, detail and the failures the report
-lists (it lists at most 20).
+"""The checks of ``mlc stl`` printability reports side by side, from the report files that
+``mlc stl --report`` wrote (for example the README's main job's ``out/circuit_print.json`` in two
+sessions): each check's result, failure count, value, detail and the failures the report lists
+(it lists at most 20); the blocking checks, and with ``--goals`` the goals too (``motion_clearance``,
+``wall_thickness``, ``bed_contact``, ``supports``: their ``blocking`` field says which they are).
 
     python benchmarks/print_report_summary.py LABEL=COMMIT=REPORT.json [...] --out RESULTS.json
 
@@ -12,25 +13,29 @@ import json
 from pathlib import Path
 
 CHECKS = ("watertight", "part_count", "min_gap", "states", "retention", "features")
+GOALS = ("motion_clearance", "wall_thickness", "bed_contact", "supports")
 
 
-def summary(path: Path) -> dict:
+def summary(path: Path, goals: bool = False) -> dict:
     r = json.loads(Path(path).read_text())
     by = {c["name"]: c for c in r["checks"]}
-    return {name: {"ok": by[name]["ok"], "failure_count": by[name].get("failure_count", 0),
+    return {name: {"ok": by[name]["ok"], "blocking": by[name].get("blocking", True),
+                   "failure_count": by[name].get("failure_count", 0),
                    "value": by[name].get("value"), "detail": by[name]["detail"],
-                   "failures": by[name].get("failures", [])} for name in CHECKS if name in by}
+                   "failures": by[name].get("failures", [])}
+            for name in CHECKS + (GOALS if goals else ()) if name in by}
 
 
 def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("reports", nargs="+", metavar="LABEL=COMMIT=REPORT.json")
     ap.add_argument("--out", required=True)
+    ap.add_argument("--goals", action="store_true", help="the goals' checks too, not only the blocking ones")
     a = ap.parse_args()
     rows = []
     for arg in a.reports:
         label, commit, path = arg.split("=", 2)
-        rows.append({"label": label, "commit": commit, "report": Path(path).name, "checks": summary(Path(path))})
+        rows.append({"label": label, "commit": commit, "report": Path(path).name, "checks": summary(Path(path), a.goals)})
     Path(a.out).write_text(json.dumps({"benchmark": "print_report_summary", "rows": rows}, indent=1) + "\n")
     return 0
 

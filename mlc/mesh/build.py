@@ -87,6 +87,7 @@ ONE_SIDED_GAIN = 1.0     # degrees: ... and the one-sided yoke's twist less by a
 TURNED_FREE_SIDE = True  # a turned one-sided compound yoke: no plate past the hub on its free side (session 55)
 CLIP_UJ_PLATES = True    # a yoke plate past the end of another hinge of its body stops at its trim radius (session 55)
 UNTWIST_SPLIT = True     # ... not to a pin that cuts the other body in pieces (built again; session 52)
+GROW_STACKS = True       # a compound junction's stack: knuckles of the minimum wall, grown on its far side (session 57)
 
 
 # --------------------------------------------------------------------------- primitives
@@ -412,8 +413,8 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
             except _Untwist as e:
                 # a compound junction's turned pin left its other body in pieces: built again,
                 # those joints' pins chosen among the ones that leave it whole (session 52, below)
-                _log(f"universal joints {', '.join(sorted(e.joints))}: the turned pin cut the other body "
-                     "in pieces; built again with pins that leave it whole")
+                _log(f"universal joints {', '.join(sorted(map(str, e.joints)))}: the turned pin (or a "
+                     "grown stack) cut the other body in pieces; built again with pins that leave it whole")
                 untwist |= e.joints
     finally:
         _LOCAL[0] = None     # primitives are built in the world again, whatever happened
@@ -428,7 +429,7 @@ class _Untwist(Exception):
     that leave their other body whole (``least_twist``'s ``severs``; else as laid out)."""
 
     def __init__(self, joints: set):
-        super().__init__(", ".join(sorted(joints)))
+        super().__init__(", ".join(sorted(map(str, joints))))
         self.joints = set(joints)
 
 
@@ -472,12 +473,11 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
     R = max(R, t / 2 + prof.min_wall / 2)
     # a knuckle's length is a wall of the ring: at least the minimum wall as well as the
     # minimum feature (mjp's 0.5 mm knuckles measured 0.37 mm walls against 0.6, issue 13).
-    # Only for a mechanism of its own (not reuse: compiled circuits are unchanged) without
-    # connector branches: the longer stacks of a branch junction met its pages in every state,
-    # and the trims of that ran out of memory
-    own_mech = not (reuse if reuse is not None else reuses(scene))
-    kmin = (max(prof.min_feature, prof.min_wall) if own_mech and not _branch_groups(scene.joints(), scene)
-            else prof.min_feature)
+    # Until session 57 only in a mechanism of its own: compiled circuits kept minimum-feature
+    # knuckles, because stacks lengthened on both sides met the next half unit or a branch's
+    # pages in every state.  A compound junction's stack now grows on its far side only, where
+    # no other stack comes near in any pose (``far_ok`` below, :func:`_compound`)
+    kmin = max(prof.min_feature, prof.min_wall)
     cones = prof.pin == "cone"
     r_cone = h_cone = 0.0
     if cones:
@@ -567,6 +567,13 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
                          f"the slabs are widened to the knuckle span there")
 
     state_T = _state_transforms(scene, prof, poses)
+
+    grown: dict = {}      # id(axis) -> joint: compound stacks grown to the minimum wall (far side)
+    posed_mid: list = []  # every hinge's midpoint in every pose, made on first use (_far_clear)
+
+    def far_ok(ax, side, a0, a1):
+        return _far_clear(ax, side, a0, a1, axes, slabs, state_T, t, c, posed_mid)
+
     if reuse is None:
         reuse = reuses(scene)
     memo: dict | None = {} if reuse else None      # sampled trim radii of congruent joints
@@ -593,13 +600,17 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
         if jname in groups:
             S, members = groups[jname]
             made = _branch(members, S, joints, scene, bodies, axes, slabs, s, prof, R, r_pin, r_hole, kmin, t,
-                           base_samples, reach, memo, state_T, h, notes)
+                           base_samples, reach, memo, state_T, h, notes,
+                           far_ok if GROW_STACKS and ("short", jname) not in untwist else _never)
             if made is not None:
                 br_uj, comp = made
                 ujoints += br_uj
                 done.update(members)
                 hx = comp["axis"]
                 hx.span, hx.knuckle, hx.intervals = comp["span"], comp["k"], comp["intervals"]
+                hx.origin = comp["origin"]
+                if comp["grown"]:
+                    grown[id(hx)] = jname
                 hx.layout = [x if x is not None else br_uj[0].part for x in comp["stack"]]
                 hx.joint, hx.joint_iv = br_uj[0].part, comp["joint_iv"]
                 if comp["o_axis"] is not None:
@@ -609,7 +620,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
                         if u_.bodies[1] in ax_.bodies:
                             _own_lines(u_.bodies[1], u_.center, ax_.direction, [ax_], s)
                 features.append((f"knuckle length ({hx.name}, with joint {br_uj[0].part})", hx.knuckle,
-                                 kmin))
+                                 prof.min_feature))
                 features.append((f"hub wall ({br_uj[0].part})", br_uj[0].hub_r - r_pin, prof.min_wall))
                 ks = [iv[1] - iv[0] for uj in br_uj for iv in uj.layouts[1].own]
                 features.append((f"yoke knuckle length ({br_uj[0].part})", min(ks), kmin))
@@ -624,15 +635,17 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
         center = 0.5 * (scene.site_world(bd.a) + scene.site_world(bd.b)) * s
         # compound junction: the joint point lies on the line of a hinge of one body, past the
         # end of its knuckles (connector chains): the hub's first pin IS that hinge's pin
-        # Its stack keeps knuckles of the minimum feature: stacks lengthened to the minimum wall
-        # met the next half unit in every logic state (chain_scene(1) at mjp: 12 conflicting
-        # pairs, trims that did not settle and one boolean of 20 GB, where there were none)
+        # Its stack grows to knuckles of the minimum wall on its far side only (:func:`_compound`):
+        # stacks lengthened on both sides met the next half unit in every logic state
+        # (chain_scene(1) at mjp: 12 conflicting pairs, trims that did not settle and one boolean
+        # of 20 GB, where there were none)
         compound = None
-        kc = prof.min_feature
+        kc = kmin
         for side_b, other_b in ((cb, ob), (ob, cb)):
             hx = _host_axis(side_b, axes, center, s, g)
             if hx is not None:
-                compound = _compound(hx, center, side_b, other_b, axes, s, prof, R, r_pin, kc)
+                compound = _compound(hx, center, side_b, other_b, axes, s, prof, R, r_pin, kc,
+                                     far_ok=far_ok if GROW_STACKS and ("short", jname) not in untwist else _never)
                 if compound is not None:
                     cb, ob = side_b, other_b
                     break
@@ -713,12 +726,15 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
         if compound is not None:
             hx = compound["axis"]
             hx.span, hx.knuckle, hx.intervals = compound["span"], compound["k"], compound["intervals"]
+            hx.origin = compound["origin"]
+            if compound["grown"]:
+                grown[id(hx)] = jname
             hx.layout = [x if x is not None else uj.part for x in compound["stack"]]
             hx.joint, hx.joint_iv = uj.part, compound["joint_iv"]
             if compound["o_axis"] is not None:
                 _own_ends(compound["o_axis"], ob)
             _own_lines(ob, center, uj.axes[1], axes, s)
-            features.append((f"knuckle length ({hx.name}, with joint {jname})", hx.knuckle, kc))
+            features.append((f"knuckle length ({hx.name}, with joint {jname})", hx.knuckle, prof.min_feature))
             features.append((f"hub wall ({jname})", uj.hub_r - r_pin, prof.min_wall))
             notes.append(f"universal joint {jname}: compound junction on hinge {hx.name} (its pin is the joint's)")
         if uj.layouts[0].mode not in ("both", "host") or uj.layouts[1].mode != "both":
@@ -729,6 +745,13 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
         if compound is None:
             features.append((f"hub length ({jname})", hub, prof.min_feature))
 
+    stacks = [ax for ax in axes if ax.joint is not None]
+    if stacks and kmin > prof.min_feature + 1e-9:
+        short = [ax for ax in stacks if id(ax) not in grown]
+        notes.append(f"compound junctions: {len(grown)} of {len(stacks)} stacks with knuckles of the minimum wall "
+                     f"{kmin:g} mm (grown on the side away from the joint)"
+                     + (f"; {len(short)} with {min(ax.knuckle for ax in short):.3g} mm knuckles, where a longer "
+                        "stack would come near another hinge's in some pose or leave a body in pieces" if short else ""))
     if memo is not None:
         _share_ujoint_radii(ujoints, base_samples, slabs)
 
@@ -1065,6 +1088,9 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
         parts.append(Part(bn, "body", solid, partners))
         if UNTWIST_SPLIT and len(solid.decompose()) > 1:
             split_by.update(uj.name for uj, side in my_uj if side == 1 and uj.turned and uj.name not in untwist)
+        if len(solid.decompose()) > 1:      # a grown stack left a knuckle apart: built again, short
+            split_by.update(("short", grown[id(ax)]) for ax in my_axes
+                            if id(ax) in grown and ("short", grown[id(ax)]) not in untwist)
     if split_by:
         raise _Untwist(split_by)
 
@@ -2295,7 +2321,57 @@ def _host_axis(bn, axes, center, s, g):
     return None
 
 
-def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, kmin, others=None, o_cos=0.5):
+def _never(*_) -> bool:
+    return False
+
+
+def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mid: list) -> bool:
+    """Whether the knuckle stack of ``ax`` may grow on its ``side`` (+-1 along its direction)
+    from ``a0`` to ``a1`` (mm from its origin): its bodies' slabs lie along the axis (a hinge in
+    their plane, not across a plate), and no other hinge's stack (of bodies other than
+    ``ax``'s) comes within both knuckle radii plus the clearance of that stretch, at rest or in
+    any pose of ``state_T`` (both stacks sampled every quarter clearance along their axes).
+    ``posed_mid``: an empty list the first time, then every hinge's midpoint in every pose (a
+    prefilter, computed once per build)."""
+    for bn in ax.bodies:
+        if not any(e1 - e0 >= 0.9 * ax.scene_span for e0, e1 in _slab_extents_along(slabs[bn], ax, t)):
+            return False
+    Ts = [None] + [T for _, T in state_T]
+    if not posed_mid:
+        mids = np.array([bx.origin for bx in axes], float)
+        hosts = [bx.bodies[0] for bx in axes]
+        posed_mid.append(np.stack([mids] + [np.einsum("nij,nj->ni", np.array([T[h][:3, :3] for h in hosts]), mids)
+                                            + np.array([T[h][:3, 3] for h in hosts]) for T in Ts[1:]]))
+    d = np.asarray(ax.direction, float)
+    p0 = np.asarray(ax.origin, float) + side * a0 * d
+    p1 = np.asarray(ax.origin, float) + side * a1 * d
+    step = 0.25 * c if c > 0 else 0.05
+    P = p0 + np.linspace(0.0, 1.0, int(np.ceil(abs(a1 - a0) / step)) + 2)[:, None] * (p1 - p0)
+    host = ax.bodies[0]
+    pm = 0.5 * (p0 + p1)
+    reach = 0.5 * abs(a1 - a0) + 2 * max(bx.R for bx in axes) + c + 0.5 * np.array([bx.span for bx in axes])
+    near = set()
+    for k, T in enumerate(Ts):
+        q = pm if T is None else T[host][:3, :3] @ pm + T[host][:3, 3]
+        near.update(np.nonzero(np.linalg.norm(posed_mid[0][k] - q, axis=1) < reach)[0].tolist())
+    for i in sorted(near):
+        bx = axes[i]
+        if bx is ax or set(bx.bodies) & set(ax.bodies):
+            continue
+        e = np.asarray(bx.direction, float)
+        Q = np.asarray(bx.origin, float) + np.linspace(-bx.span / 2, bx.span / 2,
+                                                        int(np.ceil(bx.span / step)) + 2)[:, None] * e
+        lim = ax.R + bx.R + c
+        for T in Ts:
+            M = np.eye(4) if T is None else np.linalg.solve(T[host], T[bx.bodies[0]])
+            Qm = Q @ M[:3, :3].T + M[:3, 3]
+            if np.min(np.linalg.norm(P[:, None, :] - Qm[None, :, :], axis=2)) < lim:
+                return False
+    return True
+
+
+def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, kmin, others=None, o_cos=0.5,
+              far_ok=None):
     """A compound junction on hinge axis ``ax``: the universal joint part holds the pin of the
     whole knuckle stack and has one knuckle in it (next to the end knuckle of the pin owner,
     on the joint's side, so the stack is captive), a ball hub at the joint point with a collar
@@ -2310,7 +2386,15 @@ def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, 
     ``others``, through the joint point within ``o_cos`` (cosine) of the axis; a branch page
     whose hinge leaves the joint point 30 degrees off the axis is not one, session 49).
     Returns None when the ball would be
-    thinner than the pin plus a minimum wall."""
+    thinner than the pin plus a minimum wall.
+
+    Knuckles: ``kmin`` long (the minimum wall) when ``far_ok(ax, side, a0, a1)`` lets the stack
+    grow on its far side from ``a0`` to ``a1`` (mm from ``ax.origin``); its end on the joint's side
+    then stays where a stack of minimum-feature knuckles ends, so the collar, the ball and the
+    yokes are that stack's, and the axis's origin moves by half the growth (``"origin"``,
+    ``"grown"``).  Else (``far_ok`` None or false) knuckles of the minimum feature, as before
+    session 57: four knuckles and three gaps in a 2.5 mm slab leave 0.5 mm at mjp, under its
+    0.6 mm wall."""
     c, g = prof.clearance, prof.knuckle_gap
     a = float(np.dot(center - ax.origin, ax.direction))
     sg = 1.0 if a > 0 else -1.0
@@ -2318,8 +2402,18 @@ def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, 
     stack = ([blist[0]] + blist[1:] + [None] + [blist[0]]) if sg > 0 else ([blist[0], None] + blist[1:] + [blist[0]])
     nk = len(stack)
     L = ax.scene_span
+    # knuckles of ``kmin`` (the minimum wall) where the stack may grow away from the joint: its
+    # end on the joint's side stays where a stack of minimum-feature knuckles ends (so the collar,
+    # the ball and the yokes are those of that stack) and the far end moves out, if no other
+    # hinge's stack comes near that stretch in any pose (``far_ok``); else minimum-feature knuckles
+    S0 = max(L, nk * min(kmin, prof.min_feature) + (nk - 1) * g)
     S = max(L, nk * kmin + (nk - 1) * g)
+    if S > S0 + 1e-9 and (far_ok is None or not far_ok(ax, -sg, S0 / 2, S - S0 / 2)):
+        S = S0
     k = (S - (nk - 1) * g) / nk
+    shift = 0.5 * (S - S0)
+    origin = ax.origin - sg * shift * ax.direction
+    a = a + sg * shift
     intervals: dict = {bn: [] for bn in blist}
     joint_iv = ()
     for i, bn in enumerate(stack):
@@ -2352,7 +2446,7 @@ def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, 
     u = ax.direction * sg
     lay = YokeLayout("host", [], [], (-(d0 + S), 0.0), (-(R + c), R + c), (0.0, 0.0), reach=max(d0 - g, hub_r))
     lay_c = lay
-    return {"axis": ax, "u": u.copy(), "span": S, "k": k, "intervals": intervals, "stack": stack,
+    return {"axis": ax, "origin": origin, "grown": shift > 0, "u": u.copy(), "span": S, "k": k, "intervals": intervals, "stack": stack,
             "joint_iv": joint_iv, "hub_r": hub_r, "collar": d0 - g, "hub_v": 2 * (v0 - g), "layout": lay,
             "o_axis": o_axis, "dO": dO, "layout_c": lay_c, "o_body": o_body}
 
@@ -2379,7 +2473,7 @@ def _branch_groups(joints, scene) -> dict:
 
 
 def _branch(members, S, joints, scene, bodies, axes, slabs, s, prof, R, r_pin, r_hole, kmin, t,
-            base_samples, reach, memo, state_T, h, notes):
+            base_samples, reach, memo, state_T, h, notes, far_ok=None):
     """A branch junction: the universal joints ``members`` of the pages of a connector branch,
     all at one point of the source body ``S``, as ONE joint part (their relative turns about
     the source's hinge line are the same: a page turns about that line with the source's
@@ -2405,7 +2499,8 @@ def _branch(members, S, joints, scene, bodies, axes, slabs, s, prof, R, r_pin, r
     hx = _host_axis(S, axes, center, s, g)
     if hx is None or len(set(pages)) != len(pages):
         return None
-    comp = _compound(hx, center, S, pages[0], axes, s, prof, R, r_pin, kmin, others=pages, o_cos=O_COS)
+    comp = _compound(hx, center, S, pages[0], axes, s, prof, R, r_pin, kmin, others=pages, o_cos=O_COS,
+                     far_ok=far_ok)
     if comp is None:
         return None
     u = comp["u"]
@@ -3888,6 +3983,12 @@ def _knuckles_off_slab(sbs, ax: HingeAxis, bn: str, t) -> bool:
     ivs = ax.intervals.get(bn, [])
     if not ivs:
         return False
+    ext = _slab_extents_along(sbs, ax, t)
+    return any(not any(e0 < a1 and e1 > a0 for e0, e1 in ext) for a0, a1 in ivs)
+
+
+def _slab_extents_along(sbs, ax: HingeAxis, t) -> list:
+    """The intervals along ``ax`` (mm from its origin) of the slabs of ``sbs`` that reach its axis."""
     ext = []
     for sb in sbs:
         rel = sb.center - ax.origin
@@ -3900,7 +4001,7 @@ def _knuckles_off_slab(sbs, ax: HingeAxis, bn: str, t) -> bool:
                 continue        # this slab does not reach the axis
         half = 0.5 * float(np.sum(np.abs(sb.R.T @ ax.direction) * sb.size))
         ext.append((mid - half, mid + half))
-    return any(not any(e0 < a1 and e1 > a0 for e0, e1 in ext) for a0, a1 in ivs)
+    return ext
 
 
 def _is_rod(sb: SlabBox, t) -> bool:
