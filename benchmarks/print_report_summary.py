@@ -4,7 +4,7 @@ sessions): each check's result, failure count, value, detail and the failures th
 (it lists at most 20); the blocking checks, and with ``--goals`` the goals too (``motion_clearance``,
 ``wall_thickness``, ``bed_contact``, ``supports``: their ``blocking`` field says which they are).
 
-    python benchmarks/print_report_summary.py LABEL=COMMIT=REPORT.json [...] --out RESULTS.json
+    python benchmarks/print_report_summary.py [--goals] [--notes TEXT] LABEL=COMMIT=REPORT.json [...] --out RESULTS.json
 
 Nothing is measured here: the figures are the reports' own, and the results file names the
 commit each report was made at (as its LABEL=COMMIT=PATH argument says)."""
@@ -31,11 +31,16 @@ def main() -> int:
     ap.add_argument("reports", nargs="+", metavar="LABEL=COMMIT=REPORT.json")
     ap.add_argument("--out", required=True)
     ap.add_argument("--goals", action="store_true", help="the goals' checks too, not only the blocking ones")
+    ap.add_argument("--notes", action="append", default=[], metavar="TEXT",
+                    help="also the report's notes that contain this text (repeatable)")
     a = ap.parse_args()
     rows = []
     for arg in a.reports:
         label, commit, path = arg.split("=", 2)
-        rows.append({"label": label, "commit": commit, "report": Path(path).name, "checks": summary(Path(path), a.goals)})
+        row = {"label": label, "commit": commit, "report": Path(path).name, "checks": summary(Path(path), a.goals)}
+        if a.notes:
+            row["notes"] = [n for n in json.loads(Path(path).read_text()).get("notes", []) if any(t in n for t in a.notes)]
+        rows.append(row)
     Path(a.out).write_text(json.dumps({"benchmark": "print_report_summary", "rows": rows}, indent=1) + "\n")
     return 0
 

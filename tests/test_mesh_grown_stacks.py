@@ -3,10 +3,10 @@ minimum wall where their stacks can grow.
 
 A compound junction's stack on a chain's hinge is four knuckles and three gaps (owner, the other
 half unit, the joint part, owner) in the slab's 2.5 mm at mjp: knuckles of the minimum feature,
-0.5 mm, under mjp's 0.6 mm wall.  Those were most of the README circuit's 3170 thin regions
-(``wall_thickness``, measured on the finished parts).  The stack now grows to knuckles of the
+0.5 mm, under mjp's 0.6 mm wall: thin regions (``wall_thickness``, measured on the finished
+parts) on every half unit and joint part of such a stack.  The stack now grows to knuckles of the
 minimum wall on its far side only, where no other hinge's stack comes near in any pose
-(``far_ok`` in ``_build_assembly``); its end on the joint's side stays, so the joint's collar,
+(``mlc.mesh.build._far_clear``); its end on the joint's side stays, so the joint's collar,
 ball and yokes are those of the short stack.  A body that a grown stack leaves in pieces is
 built again with that stack short.
 
@@ -103,7 +103,7 @@ def test_fewer_walls_under_the_minimum(grown, short):
 
 
 def test_stacks_grown_regardless_of_the_poses_meet(grown, monkeypatch):
-    # without the pose test every stack grows, and the far ends of two of them meet their
+    # without the pose test every stack grows, and far ends meet their
     # neighbours' parts in logic states (the guard is what keeps the blocking checks passing)
     monkeypatch.setattr(B, "_far_clear", lambda *a, **k: True)
     sc, poses = _piece("circuit_junction")
