@@ -1086,9 +1086,10 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
             if bn in fat_guard:
                 fat_guard[bn] = tuple(None if x is None else transform_solid(x, Fb) for x in fat_guard[bn])
         parts.append(Part(bn, "body", solid, partners))
-        if UNTWIST_SPLIT and len(solid.decompose()) > 1:
-            split_by.update(uj.name for uj, side in my_uj if side == 1 and uj.turned and uj.name not in untwist)
-        if len(solid.decompose()) > 1:      # a grown stack left a knuckle apart: built again, short
+        if len(solid.decompose()) > 1:
+            if UNTWIST_SPLIT:
+                split_by.update(uj.name for uj, side in my_uj if side == 1 and uj.turned and uj.name not in untwist)
+            # a grown stack left a knuckle apart: built again, short
             split_by.update(("short", grown[id(ax)]) for ax in my_axes
                             if id(ax) in grown and ("short", grown[id(ax)]) not in untwist)
     if split_by:
