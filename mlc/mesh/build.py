@@ -2364,8 +2364,8 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
                                                         int(np.ceil(bx.span / step)) + 2)[:, None] * e
         lim = ax.R + bx.R + c
         for T in Ts:
-            M = np.eye(4) if T is None else np.linalg.solve(T[host], T[bx.bodies[0]])
-            Qm = Q @ M[:3, :3].T + M[:3, 3]
+            M = _relative(host, bx.bodies[0], T)
+            Qm = Q if M is None else Q @ M[:3, :3].T + M[:3, 3]
             if np.min(np.linalg.norm(P[:, None, :] - Qm[None, :, :], axis=2)) < lim:
                 return False
     return True
