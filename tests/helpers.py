@@ -61,3 +61,37 @@ def downward_faces(solid):
     nz = n[:, 2] / np.maximum(2 * area, 1e-12)
     keep = (nz < -1e-9) & (area > 1e-9)
     return nz[keep], area[keep], ((A + B + C) / 3)[keep]
+
+
+def web_sections(asm, min_wall, owner=None):
+    """The webs of the owner of a three-body hinge (a gate's hinge c; ``owner``: that body's name
+    when the assembly holds several gates): every piece of a section normal to the axis in the
+    middle of the other bodies' knuckles, near the axis and not the pin, with the diameter of the
+    largest disc in it (manifold3d slices, Clipper2 offsets to 0.001 mm; as
+    benchmarks/mesh_gates.py's section_webs), independent of mlc.mesh.walls."""
+    import manifold3d as mf
+    import numpy as np
+
+    from mlc.mesh.build import _perp_frame
+    (c,) = [ax for ax in asm.axes if len(ax.bodies) == 3 and owner in (None, ax.owner)]
+    E = np.asarray(c.direction, float)
+    R = _perp_frame(E).T
+    M = np.hstack([R, (-R @ np.asarray(c.origin, float))[:, None]])
+    local = asm.part(c.owner).solid.transform(M.tolist())
+    out = []
+    for bn, ivs in c.intervals.items():
+        if bn == c.owner:
+            continue
+        for a0, a1 in ivs:
+            for piece in local.slice(0.5 * (a0 + a1)).decompose():
+                x0, y0, x1, y1 = piece.bounds()
+                if x0 <= 0 <= x1 and y0 <= 0 <= y1:
+                    continue
+                if np.hypot(max(x0, 0, -x1), max(y0, 0, -y1)) > c.rho + 2 * min_wall:
+                    continue
+                lo, hi = 0.0, 2.0
+                while hi - lo > 5e-4:
+                    r = 0.5 * (lo + hi)
+                    lo, hi = (lo, r) if piece.offset(-r, mf.JoinType.Round).is_empty() else (r, hi)
+                out.append(2 * lo)
+    return out

@@ -11,6 +11,8 @@ from mlc.mesh.examples import gate_poses
 from mlc.mesh.export import part_meshes, read_3mf, read_parts, stl_bytes, threemf_bytes
 from mlc.mesh.profiles import load_profile
 
+from helpers import web_sections
+
 # 8 slabs + the universal joint at d; 7 hinge axes (the one at c joins three slabs)
 GOLDEN = {"parts": 9, "bodies": 8, "joint_parts": 1, "hinge_axes": 7, "three_body_axes": 1}
 
@@ -223,35 +225,6 @@ def test_no_sheet_past_the_pivot_cut():
     assert thin_walls("out_hi", out_hi, prof.min_wall) == []
 
 
-def _web_sections(asm, min_wall):
-    """The webs of the hinge owner at hinge c: every piece of a section normal to the axis in the
-    middle of the other bodies' knuckles, near the axis and not the pin, with the diameter of the
-    largest disc in it (Clipper2 offsets, 0.001 mm; as benchmarks/mesh_gates.py's section_webs)."""
-    (c,) = [ax for ax in asm.axes if len(ax.bodies) == 3]
-    E = np.asarray(c.direction, float)
-    from mlc.mesh.build import _perp_frame
-    R = _perp_frame(E).T
-    M = np.hstack([R, (-R @ np.asarray(c.origin, float))[:, None]])
-    local = asm.part(c.owner).solid.transform(M.tolist())
-    out = []
-    for bn, ivs in c.intervals.items():
-        if bn == c.owner:
-            continue
-        for a0, a1 in ivs:
-            for piece in local.slice(0.5 * (a0 + a1)).decompose():
-                x0, y0, x1, y1 = piece.bounds()
-                if x0 <= 0 <= x1 and y0 <= 0 <= y1:
-                    continue
-                if np.hypot(max(x0, 0, -x1), max(y0, 0, -y1)) > c.rho + 2 * min_wall:
-                    continue
-                lo, hi = 0.0, 2.0
-                while hi - lo > 5e-4:
-                    r = 0.5 * (lo + hi)
-                    lo, hi = (lo, r) if piece.offset(-r, mf.JoinType.Round).is_empty() else (r, hi)
-                out.append(2 * lo)
-    return out
-
-
 def test_a_web_that_is_not_the_only_link_is_measured_and_bridged():
     """core_cd of the contracting AND at mjp (issue 13, session 37): between hinge c's trim (1.3 mm)
     and the universal joint's (3.87 mm, 5.79 mm away) a web 0.593 mm across was left, against the
@@ -264,7 +237,7 @@ def test_a_web_that_is_not_the_only_link_is_measured_and_bridged():
     scene, poses = gate_scene("AND", "contract"), gate_poses("AND", "contract")
     asm = build_assembly(scene, prof, poses, resolve=False)
     assert any("core_cd bridges" in n and "thinner than the minimum wall" in n for n in asm.notes), asm.notes
-    webs = _web_sections(asm, prof.min_wall)
+    webs = web_sections(asm, prof.min_wall)
     assert webs and min(webs) >= prof.min_wall - 1e-3, webs
     assert len(asm.part("core_cd").solid.decompose()) == 1
     # the same build with the split test alone: the web is left, thinner than the wall
@@ -275,7 +248,7 @@ def test_a_web_that_is_not_the_only_link_is_measured_and_bridged():
     finally:
         B._web_thinner = orig
     assert not any("core_cd bridges" in n for n in old.notes)
-    assert min(_web_sections(old, prof.min_wall)) < prof.min_wall - 1e-3
+    assert min(web_sections(old, prof.min_wall)) < prof.min_wall - 1e-3
 
 
 def test_web_thinner_measures_a_web_beside_another_link():

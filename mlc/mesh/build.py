@@ -68,6 +68,9 @@ from mlc.scene.model import Scene
 _TOL = 1e-3  # sigma: tolerance for "same point / same line"
 #: assemblies with at least this many parts reuse results across congruent parts by default
 REUSE_MIN_PARTS = 64
+#: large assemblies (compiled circuits) too: a body's web thinner than the minimum wall where its
+#: hinge's trim meets another trim (a gate's core_cd at hinge c) is bridged (issue 13, session 58)
+WEB_BRIDGES = True
 APART_GAP = True      # large assemblies: min_gap of pairs proven farther apart than the search skips manifold3d
 GUARD_PAD = 0.005  # mm: protected material grown by this much for the final trims of large assemblies
 #: branch junction: a page counts as stacked on the source's hinge line (the compound junction's
@@ -947,7 +950,10 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
             for ax in my_axes:
                 if cut_n > base_n and len(_clean(subtract(solid, axis_cuts(ax))).decompose()) > base_n:
                     need[ax.name] = "severed"
-                elif not reuse and thin_at(ax):
+                elif (not reuse or (WEB_BRIDGES and len(ax.bodies) == 3)) and thin_at(ax):
+                    # (compiled circuits: the three-body hinges only, a gate's hinge c; a chain's
+                    # two-body hinges bridged this way met the next chain's half unit in the logic
+                    # states: tests/test_mesh_bent_ends.py's leaf piece, session 58)
                     # first the plates at the axis, carried along it as far as the body's slabs go
                     # (a slab beside the knuckle stack joins it there, clear of the other knuckles)
                     ext = _axis_extension(slabs[bn], ax, reach, t)
@@ -969,8 +975,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
                 mine = []
                 for a0, a1 in _complement(own, -ax.span / 2, ax.span / 2):
                     if any(o1 <= a0 + 1e-9 for _, o1 in own) and any(o0 >= a1 - 1e-9 for o0, _ in own):
-                        # (compiled circuits, reuse: as before, meshes unchanged); a bridge over a
-                        # thin web must keep clear of the other bodies in the dense paths too
+                        # a bridge over a thin web must keep clear of the other bodies in the dense
+                        # paths too (bridge_T; a compiled circuit has none: its print poses only)
                         if need[ax.name] == "thin":
                             # the web's bridge may run into the universal joint's trim of this body
                             # (core_cd towards d: its trim radius is set by out_hi's slab in the logic
