@@ -71,6 +71,9 @@ REUSE_MIN_PARTS = 64
 #: large assemblies (compiled circuits) too: a body's web thinner than the minimum wall where its
 #: hinge's trim meets another trim (a gate's core_cd at hinge c) is bridged (issue 13, session 58)
 WEB_BRIDGES = True
+#: a slab box with two thin sides (a rod: the post under a circuit gate's input lever that carries a
+#: chain's end joint, a branch page's arm) is printed at least the slab thickness both ways (session 58)
+ROD_WALL = True
 APART_GAP = True      # large assemblies: min_gap of pairs proven farther apart than the search skips manifold3d
 GUARD_PAD = 0.005  # mm: protected material grown by this much for the final trims of large assemblies
 #: branch junction: a page counts as stacked on the source's hinge line (the compound junction's
@@ -467,6 +470,12 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
             size = np.asarray(bx.size, float) * s
             k = int(np.argmin(size))
             size[k] = max(size[k], t)
+            if ROD_WALL:
+                # a rod (a post carrying a joint site, a branch page's arm) has a second thin side:
+                # printed at least as thick as the slab too (POST_WIDTH 0.08 sigma is 0.4 mm at mjp)
+                j = [i for i in np.argsort(size) if i != k][0]
+                if size[j] < t:
+                    size[j] = t
             lst.append(SlabBox(s * (np.asarray(b.position, float) + Rb @ np.asarray(bx.center, float)), R, size, k))
         slabs[b.name] = lst
 
