@@ -1,0 +1,141 @@
+"""Session 58 (issue 13, "meets the profile's minimum wall everywhere", compiled circuits): two
+walls of a circuit gate that were thinner than mjp's 0.6 mm minimum.
+
+*core_cd's web at hinge c* (``WEB_BRIDGES``).  In a library gate ``core_cd`` is cut twice round
+hinge c's middle (the trim for ``a_hi``'s and ``b_hi``'s knuckles and the universal joint's trim
+towards d), and the web left between the two cuts is bridged where no other body swings
+(``_bridge``, session 36).  Compiled circuits (``reuse``) were built without that step, and every
+gate of the README's Tetris circuit kept a web of 0.21-0.24 mm (its report: ``g1_core_cd: wall
+0.24 mm ... 0.23 mm at its thinnest``).  The step now runs for a circuit's three-body hinges too,
+the bridge kept clear of the other bodies in the circuit's print poses.
+
+*The posts under the input levers* (``ROD_WALL``).  A chain hangs its end joint under a gate's input
+lever on a post, a rod of ``POST_WIDTH`` (0.08 sigma) square (mlc.circuit.build).  The print raised
+a slab box's thinnest side to the profile's slab thickness; the rod's second thin side stayed 0.4 mm
+at mjp (sigma 5 mm): every input lever had a region of 0.40 mm over 1.5-1.8 mm^3 along its post.
+Both thin sides of a rod are now printed at the slab thickness.
+
+``circuit_g3`` (tests/data_mesh) is gate g3 of that circuit with the chains' last half units around
+it and the whole circuit's 22 poses (see tests/test_mesh_circuit_gate_stroke.py)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import manifold3d as mf
+import numpy as np
+import pytest
+
+from mlc.geometry.rotation import quat_to_matrix
+from mlc.mesh import build as B
+from mlc.mesh.build import build_assembly
+from mlc.mesh.checks import check_assembly
+from mlc.mesh.profiles import load_profile
+from mlc.mesh.walls import thin_walls
+from mlc.scene.io import load_scene
+
+from helpers import web_sections
+
+DATA = Path(__file__).parent / "data_mesh"
+LEVERS = ("g3_a_lo", "g3_a_hi", "g3_b_lo", "g3_b_hi")
+BLOCKING = ("watertight", "part_count", "min_gap", "states", "retention", "features")
+
+
+@pytest.fixture(scope="module")
+def piece():
+    z = np.load(DATA / "circuit_g3_poses.npz")
+    return load_scene(DATA / "circuit_g3.yaml"), {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
+
+
+def _build(piece, **flags):
+    """The piece at mjp, with mlc.mesh.build's flags (``WEB_BRIDGES``, ``ROD_WALL``) set as given."""
+    sc, poses = piece
+    old = {k: getattr(B, k) for k in flags}
+    try:
+        for k, v in flags.items():
+            setattr(B, k, v)
+        return build_assembly(sc, load_profile("mjp"), poses, reuse=True)
+    finally:
+        for k, v in old.items():
+            setattr(B, k, v)
+
+
+@pytest.fixture(scope="module")
+def built(piece):
+    return _build(piece)
+
+
+def test_a_circuit_gates_web_at_hinge_c_is_bridged_to_the_full_wall(built):
+    asm = built
+    prof = asm.profile
+    assert any(n.startswith("hinge g3_hinge_c") and "g3_core_cd bridges" in n
+               and "thinner than the minimum wall" in n for n in asm.notes), asm.notes
+    # outside mlc.mesh.walls: sections across the other knuckles, the largest disc in each web
+    webs = web_sections(asm, prof.min_wall, owner="g3_core_cd")
+    assert webs and min(webs) >= prof.min_wall - 1e-3, webs
+    # and the report's own measure of the finished part
+    assert thin_walls("g3_core_cd", asm.part("g3_core_cd").solid, prof.min_wall) == []
+    assert len(asm.part("g3_core_cd").solid.decompose()) == 1
+
+
+def test_the_bridged_piece_passes_every_blocking_check_in_the_circuits_poses(built):
+    rep = check_assembly(built, walls=False)
+    by = {c.name: c for c in rep.checks}
+    for name in BLOCKING:
+        assert by[name].ok, (name, by[name].detail, by[name].failures)
+
+
+def test_without_the_bridge_the_web_is_thinner_than_the_wall(piece):
+    """The same piece as compiled circuits were built before: the web is under the minimum wall,
+    by the sections and by the report's wall measure (so the test above can fail)."""
+    old = _build(piece, WEB_BRIDGES=False)
+    prof = old.profile
+    assert not any("g3_core_cd bridges" in n for n in old.notes)
+    webs = web_sections(old, prof.min_wall, owner="g3_core_cd")
+    assert webs and min(webs) < 0.5 * prof.min_wall, webs
+    thin = thin_walls("g3_core_cd", old.part("g3_core_cd").solid, prof.min_wall)
+    assert thin and min(w.thickness_mm for w in thin) < 0.5 * prof.min_wall, thin
+
+
+def _post_sections(asm, sc):
+    """For each input lever, the post's cross-section half-way along it (the lever's box with two
+    sides under 0.1 sigma, from the scene, not from the mesher): the diameter of the largest disc
+    in it (manifold3d slice, Clipper2 offsets, 0.001 mm) and its two side lengths (mm)."""
+    s = asm.profile.sigma_mm
+    out = {}
+    for b in sc.bodies:
+        if b.name not in LEVERS:
+            continue
+        (bx,) = [bx for bx in b.boxes if sorted(bx.size)[1] < 0.1]
+        Rb = quat_to_matrix(b.orientation)
+        R = Rb @ quat_to_matrix(bx.orientation)
+        c = s * (np.asarray(b.position, float) + Rb @ np.asarray(bx.center, float))
+        ia = int(np.argmax(bx.size))
+        others = [i for i in range(3) if i != ia]
+        # a frame with the post's length along z, its two thin sides along x and y
+        F = np.vstack([R[:, others[0]], R[:, others[1]], R[:, ia]])
+        M = np.hstack([F, (-F @ c)[:, None]])
+        cs = asm.part(b.name).solid.transform(M.tolist()).slice(0.0)
+        (piece,) = [p for p in cs.decompose() if p.bounds()[0] <= 0 <= p.bounds()[2] and p.bounds()[1] <= 0 <= p.bounds()[3]]
+        lo, hi = 0.0, 2.0
+        while hi - lo > 5e-4:
+            r = 0.5 * (lo + hi)
+            lo, hi = (lo, r) if piece.offset(-r, mf.JoinType.Round).is_empty() else (r, hi)
+        x0, y0, x1, y1 = piece.bounds()
+        out[b.name] = (2 * lo, x1 - x0, y1 - y0)
+    return out
+
+
+def test_posts_are_printed_at_the_slab_thickness_both_ways(built, piece):
+    prof = built.profile
+    posts = _post_sections(built, piece[0])
+    assert set(posts) == set(LEVERS)
+    for name, (disc, a, b) in posts.items():
+        assert disc >= prof.min_wall - 2e-3 and min(a, b) >= prof.slab_thickness - 2e-3, (name, posts)
+
+
+def test_without_rod_walls_the_posts_are_thinner_than_the_wall(piece):
+    old = _build(piece, ROD_WALL=False)
+    posts = _post_sections(old, piece[0])
+    for name, (disc, a, b) in posts.items():
+        assert disc < old.profile.min_wall - 0.1, (name, posts)      # 0.4 mm: POST_WIDTH at sigma 5 mm
+        assert abs(min(a, b) - 0.08 * old.profile.sigma_mm) < 0.01, (name, posts)
