@@ -113,3 +113,29 @@ def test_stacks_grown_regardless_of_the_poses_meet(grown, monkeypatch):
     assert not (rep.check("states").ok and rep.check("min_gap").ok)
     short = {ax.name for ax in _stacks(grown[0]) if ax.knuckle < 0.6 - 1e-9}
     assert short
+
+
+def test_stacks_measured_as_cylinders_grow_where_their_axes_alone_kept_them_short(monkeypatch):
+    """Session 58: ``_far_clear`` kept a stack short wherever another hinge's axis came within both
+    knuckle radii and the clearance of the stretch it grows into, which in a chain is the previous
+    half unit's stack, end to end with it (the README circuit: 574 of the 615 short stacks so
+    blocked already at rest).  The two solid cylinders are now measured where the axes come that
+    near (``STACK_CYLINDERS``): on the branch piece ``circuit_leaf`` every stack grows, every
+    blocking check still passes, and fewer walls are thinner than the minimum."""
+    sc, poses = _piece("circuit_leaf")
+    prof = load_profile("mjp")
+
+    def build(cyl):
+        monkeypatch.setattr(B, "STACK_CYLINDERS", cyl)
+        asm = build_assembly(sc, prof, poses, reuse=True)
+        return asm, check_assembly(asm)
+    new, old = build(True), build(False)
+    k_new = [ax.knuckle for ax in _stacks(new[0])]
+    k_old = [ax.knuckle for ax in _stacks(old[0])]
+    assert len(k_new) == len(k_old) == 14
+    assert all(k >= prof.min_wall - 1e-9 for k in k_new), k_new
+    assert sum(k >= prof.min_wall - 1e-9 for k in k_old) < 12, k_old
+    for name in BLOCKING:
+        assert new[1].check(name).ok, (name, new[1].check(name).detail, new[1].check(name).failures)
+    n_new, n_old = (len(r.check("wall_thickness").failures) for r in (new[1], old[1]))
+    assert n_new < n_old - 10, (n_new, n_old)

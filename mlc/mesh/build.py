@@ -94,6 +94,9 @@ TURNED_FREE_SIDE = True  # a turned one-sided compound yoke: no plate past the h
 CLIP_UJ_PLATES = True    # a yoke plate past the end of another hinge of its body stops at its trim radius (session 55)
 UNTWIST_SPLIT = True     # ... not to a pin that cuts the other body in pieces (built again; session 52)
 GROW_STACKS = True       # a compound junction's stack: knuckles of the minimum wall, grown on its far side (session 57)
+#: _far_clear: where two stacks' axes come within both radii and the clearance, the solid knuckle
+#: cylinders themselves are measured (session 58; before: such a stack never grew)
+STACK_CYLINDERS = True
 
 
 # --------------------------------------------------------------------------- primitives
@@ -2346,7 +2349,10 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
     from ``a0`` to ``a1`` (mm from its origin): its bodies' slabs lie along the axis (a hinge in
     their plane, not across a plate), and no other hinge's stack (of bodies other than
     ``ax``'s) comes within both knuckle radii plus the clearance of that stretch, at rest or in
-    any pose of ``state_T`` (both stacks sampled every quarter clearance along their axes).
+    any pose of ``state_T`` (both stacks sampled every quarter clearance along their axes); where
+    the axes do come that near (in a chain, the previous half unit's stack, end to end with this
+    one), with ``STACK_CYLINDERS`` the two solid knuckle cylinders themselves must keep the
+    clearance (:func:`_cylinder_points` of each against :func:`_cylinder_distance` to the other).
     ``posed_mid``: an empty list the first time, then every hinge's midpoint in every pose (a
     prefilter, computed once per build)."""
     for bn in ax.bodies:
@@ -2370,6 +2376,8 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
     for k, T in enumerate(Ts):
         q = pm if T is None else T[host][:3, :3] @ pm + T[host][:3, 3]
         near.update(np.nonzero(np.linalg.norm(posed_mid[0][k] - q, axis=1) < reach)[0].tolist())
+    if STACK_CYLINDERS:
+        S_own = _cylinder_points(p0, p1, ax.R, step)
     for i in sorted(near):
         bx = axes[i]
         if bx is ax or set(bx.bodies) & set(ax.bodies):
@@ -2378,12 +2386,58 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
         Q = np.asarray(bx.origin, float) + np.linspace(-bx.span / 2, bx.span / 2,
                                                         int(np.ceil(bx.span / step)) + 2)[:, None] * e
         lim = ax.R + bx.R + c
+        if STACK_CYLINDERS:
+            o = np.asarray(bx.origin, float)
+            S_other = _cylinder_points(o - 0.5 * bx.span * e, o + 0.5 * bx.span * e, bx.R, step)
         for T in Ts:
             M = _relative(host, bx.bodies[0], T)
             Qm = Q if M is None else Q @ M[:3, :3].T + M[:3, 3]
-            if np.min(np.linalg.norm(P[:, None, :] - Qm[None, :, :], axis=2)) < lim:
+            if np.min(np.linalg.norm(P[:, None, :] - Qm[None, :, :], axis=2)) >= lim:
+                continue            # the axes farther apart than both radii and the clearance
+            if not STACK_CYLINDERS:
+                return False
+            # the two solid cylinders (the grown stretch, the other stack), each one's surface
+            # points against the other: at least the clearance apart, plus the sampling's reach
+            # (a surface point is within step / sqrt(2) of a sample)
+            Mi = None if M is None else np.linalg.inv(M)
+            mine = S_own if Mi is None else S_own @ Mi[:3, :3].T + Mi[:3, 3]
+            theirs = S_other if M is None else S_other @ M[:3, :3].T + M[:3, 3]
+            need = c + step / np.sqrt(2)
+            if (_cylinder_distance(mine, o - 0.5 * bx.span * e, o + 0.5 * bx.span * e, bx.R).min() < need
+                    or _cylinder_distance(theirs, p0, p1, ax.R).min() < need):
                 return False
     return True
+
+
+def _cylinder_points(p0, p1, R: float, step: float) -> np.ndarray:
+    """Points on the surface of the solid cylinder of radius ``R`` (mm) about the segment
+    ``p0``-``p1``: rings every ``step`` along it and across both end faces, points every ``step``
+    round each ring."""
+    p0, p1 = np.asarray(p0, float), np.asarray(p1, float)
+    d = p1 - p0
+    L = float(np.linalg.norm(d))
+    d = d / L
+    U = _perp_frame(d)[:, :2]
+    out = []
+    for r, ts in [(R, np.linspace(0.0, 1.0, int(np.ceil(L / step)) + 1))] + \
+            [(r, np.array([0.0, 1.0])) for r in np.arange(0.0, R, step)]:
+        n = max(int(np.ceil(2 * np.pi * r / step)), 1)
+        a = 2 * np.pi * np.arange(n) / n
+        ring = r * (np.cos(a)[:, None] * U[:, 0] + np.sin(a)[:, None] * U[:, 1])
+        out.append((p0[None, None] + ts[:, None, None] * (p1 - p0)[None, None] + ring[None]).reshape(-1, 3))
+    return np.concatenate(out)
+
+
+def _cylinder_distance(X, p0, p1, R: float) -> np.ndarray:
+    """Distance (mm) of the points ``X`` from the solid cylinder of radius ``R`` about the
+    segment ``p0``-``p1`` (0 inside)."""
+    p0, p1 = np.asarray(p0, float), np.asarray(p1, float)
+    d = p1 - p0
+    L = float(np.linalg.norm(d))
+    d = d / L
+    a = (X - p0) @ d
+    r = np.linalg.norm((X - p0) - a[:, None] * d, axis=1)
+    return np.hypot(np.maximum(r - R, 0.0), np.maximum(np.maximum(-a, a - L), 0.0))
 
 
 def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, kmin, others=None, o_cos=0.5,
