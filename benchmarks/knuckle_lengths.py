@@ -1,14 +1,18 @@
 """The knuckle lengths of compound junctions' stacks measured on the finished meshes, outside
 mlc's own layout (issue 13, session 57: stacks grown to knuckles of the minimum wall).
 
-Builds a piece of the README circuit (``tests/data_mesh/circuit_junction``: five half units of
-chain ``w_b_0`` and their four junctions, with the circuit's 22 print poses) at mjp with
-``GROW_STACKS`` on and off, and for each compound stack measures, on each joint part's finished
+Builds a piece of the README circuit (``--piece``, default ``tests/data_mesh/circuit_junction``:
+five half units of chain ``w_b_0`` and their four junctions; ``circuit_leaf``: a branch tree's
+leaf pages; each with the circuit's 22 print poses) at mjp with ``GROW_STACKS`` on and off, and
+on with ``STACK_CYLINDERS`` off (session 58: grown only where no other stack's axis comes within
+both radii and the clearance, session 57's test), and for each compound stack measures, on each joint part's finished
 mesh (trimesh, its vertices), the length along the stack's axis of the joint's knuckle: the
 axial extent of the vertices on the knuckle's outer cylinder (radius R within 1 %, away from
 the collar, which is thinner).  mlc gives only the axis line and R; the length is the mesh's.
 
     python benchmarks/knuckle_lengths.py -o benchmarks/results/knuckle_lengths_s57.json
+    python benchmarks/knuckle_lengths.py --piece circuit_junction --piece circuit_leaf \
+        -o benchmarks/results/knuckle_lengths_s58.json
 
 Units: mm."""
 from __future__ import annotations
@@ -35,16 +39,24 @@ from mlc.scene.io import load_scene  # noqa: E402
 DATA = HERE.parent / "tests" / "data_mesh"
 
 
-def measure(grow: bool) -> list[dict]:
-    z = np.load(DATA / "circuit_junction_poses.npz")
-    sc = load_scene(DATA / "circuit_junction.yaml")
+#: the builds compared: mlc.mesh.build's flags for each
+VARIANTS = {"grown": {"GROW_STACKS": True, "STACK_CYLINDERS": True},
+            "grown_axes_only": {"GROW_STACKS": True, "STACK_CYLINDERS": False},
+            "short": {"GROW_STACKS": False}}
+
+
+def measure(piece: str, flags: dict) -> list[dict]:
+    z = np.load(DATA / f"{piece}_poses.npz")
+    sc = load_scene(DATA / f"{piece}.yaml")
     poses = {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
-    old = B.GROW_STACKS
-    B.GROW_STACKS = grow
+    old = {k: getattr(B, k) for k in flags}
     try:
+        for k, v in flags.items():
+            setattr(B, k, v)
         asm = B.build_assembly(sc, load_profile("mjp"), poses, reuse=True)
     finally:
-        B.GROW_STACKS = old
+        for k, v in old.items():
+            setattr(B, k, v)
     rows = []
     for ax in asm.axes:
         if ax.joint is None:
@@ -66,15 +78,19 @@ def measure(grow: bool) -> list[dict]:
 
 def main() -> int:
     ap = argparse.ArgumentParser()
+    ap.add_argument("--piece", action="append", help="tests/data_mesh piece (repeatable; default circuit_junction)")
     ap.add_argument("-o", "--out", required=True)
     a = ap.parse_args()
-    out = {"benchmark": "knuckle_lengths", "commit": commit(), "piece": "tests/data_mesh/circuit_junction",
-           "profile": "mjp", "grown": measure(True), "short": measure(False)}
-    for k in ("grown", "short"):
-        ks = [r["mesh_knuckle_mm"] for r in out[k] if r["mesh_knuckle_mm"] is not None]
-        out[f"{k}_summary"] = {"stacks": len(out[k]), "at_least_0.6_mm": sum(x >= 0.6 - 1e-3 for x in ks),
-                               "min_mm": min(ks), "max_mm": max(ks)}
-        print(k, out[f"{k}_summary"])
+    out = {"benchmark": "knuckle_lengths", "commit": commit(), "profile": "mjp", "variants": VARIANTS, "pieces": {}}
+    for piece in a.piece or ["circuit_junction"]:
+        res = {"piece": f"tests/data_mesh/{piece}"}
+        for k, flags in VARIANTS.items():
+            res[k] = measure(piece, flags)
+            ks = [r["mesh_knuckle_mm"] for r in res[k] if r["mesh_knuckle_mm"] is not None]
+            res[f"{k}_summary"] = {"stacks": len(res[k]), "at_least_0.6_mm": sum(x >= 0.6 - 1e-3 for x in ks),
+                                   "min_mm": min(ks), "max_mm": max(ks)}
+            print(piece, k, res[f"{k}_summary"])
+        out["pieces"][piece] = res
     with atomic_path(a.out) as tmp:
         Path(tmp).write_text(json.dumps(out, indent=1) + "\n")
     return 0
