@@ -103,9 +103,11 @@ def test_fewer_walls_under_the_minimum(grown, short):
 
 
 def test_stacks_grown_regardless_of_the_poses_meet(grown, monkeypatch):
-    # without the pose test every stack grows, and far ends meet their
-    # neighbours' parts in logic states (the guard is what keeps the blocking checks passing)
+    # without the pose tests (_far_clear as laid out, GROWN_CLEAR once every plate is) every
+    # stack grows, and far ends meet their neighbours' parts in logic states (the guards are what
+    # keep the blocking checks passing)
     monkeypatch.setattr(B, "_far_clear", lambda *a, **k: True)
+    monkeypatch.setattr(B, "GROWN_CLEAR", False)
     sc, poses = _piece("circuit_junction")
     asm = build_assembly(sc, load_profile("mjp"), poses, reuse=True)
     assert all(ax.knuckle >= 0.6 - 1e-9 for ax in _stacks(asm))
@@ -139,3 +141,71 @@ def test_stacks_measured_as_cylinders_grow_where_their_axes_alone_kept_them_shor
         assert new[1].check(name).ok, (name, new[1].check(name).detail, new[1].check(name).failures)
     n_new, n_old = (len(r.check("wall_thickness").failures) for r in (new[1], old[1]))
     assert n_new < n_old - 10, (n_new, n_old)
+
+
+def _sampled_gap(a, b, n=300_000):
+    """The gap (mm) between two finished parts measured outside mlc and manifold3d: trimesh's
+    surface samples of each, nearest pairs by a k-d tree (an upper bound of the true gap)."""
+    import trimesh
+    from scipy.spatial import cKDTree
+
+    def surf(part, seed):
+        m = part.solid.to_mesh()
+        tm = trimesh.Trimesh(np.asarray(m.vert_properties)[:, :3], np.asarray(m.tri_verts), process=False)
+        return trimesh.sample.sample_surface(tm, n, seed=seed)[0]
+    pa, pb = surf(a, 1), surf(b, 2)
+    return float(cKDTree(pb).query(pa)[0].min())
+
+
+def test_grown_plates_stop_short_of_the_bodys_other_hinges(monkeypatch):
+    """Session 59: with ``STACK_CYLINDERS`` the whole README circuit grew 721 of 866 stacks, but
+    60 pairs of a half unit's two slabs came 0.10-0.16 mm apart (min_gap).  ``circuit_chain_y``
+    (five half units of the chain ``w_y_0``, 19 to 23, cut from that circuit with its 22 poses)
+    shows it: each half unit's stacks B and D grow on the same side; the plates widening AB to
+    its grown stack B and DA to D ran the slabs' whole length and met past hinge A's span, where
+    no trim clears them.  The plates over the grown stretch now reach only as far as the knuckles
+    need, only on a body with a knuckle there (``_grown_plates``), and a stack whose new
+    material still comes near another body is built short (``GROWN_CLEAR``)."""
+    sc, poses = _piece("circuit_chain_y")
+    prof = load_profile("mjp")
+    monkeypatch.setattr(B, "STACK_CYLINDERS", True)
+
+    def build(clear):
+        monkeypatch.setattr(B, "GROWN_CLEAR", clear)
+        asm = build_assembly(sc, prof, poses, reuse=True)
+        return asm, check_assembly(asm)
+    new, old = build(True), build(False)
+    # as built in session 58: every stack grows and the two slabs of half unit 21 meet at hinge A
+    assert all(ax.knuckle >= prof.min_wall - 1e-9 for ax in _stacks(old[0]))
+    mg = old[1].check("min_gap")
+    assert not mg.ok and any("w_y_0_21_AB - w_y_0_21_DA" in f for f in mg.failures), mg.failures
+    parts = {p.name: p for p in old[0].parts}
+    assert _sampled_gap(parts["w_y_0_21_AB"], parts["w_y_0_21_DA"]) < prof.clearance
+    # now: every stack still grows, every blocking check passes, the pair keeps the clearance
+    k_new = [ax.knuckle for ax in _stacks(new[0])]
+    assert len(k_new) == 8 and all(k >= prof.min_wall - 1e-9 for k in k_new), k_new
+    for name in BLOCKING:
+        assert new[1].check(name).ok, (name, new[1].check(name).detail, new[1].check(name).failures)
+    parts = {p.name: p for p in new[0].parts}
+    # (hinge partners: their knuckles at hinge A sit at the clearance itself)
+    assert _sampled_gap(parts["w_y_0_21_AB"], parts["w_y_0_21_DA"]) >= prof.clearance - 1e-4
+    # and fewer walls under the minimum than with the stacks short (session 57's build)
+    monkeypatch.setattr(B, "STACK_CYLINDERS", False)
+    short = check_assembly(build_assembly(sc, prof, poses, reuse=True))
+    assert len(new[1].check("wall_thickness").failures) < len(short.check("wall_thickness").failures) - 10
+
+
+def test_a_grown_stack_near_another_body_is_built_short(monkeypatch):
+    """``GROWN_CLEAR``'s own failing case: the grown stretch's plates as long as the slab again
+    (the session-58 plates) come near the hinge-A partner in every half unit, so every such stack
+    is built short (the pair then keeps the clearance)."""
+    sc, poses = _piece("circuit_chain_y")
+    prof = load_profile("mjp")
+    monkeypatch.setattr(B, "STACK_CYLINDERS", True)
+    monkeypatch.setattr(B, "_grown_plates", lambda bn, sbs, ax, far, reach, t:
+                        B._yoke_plates(sbs, ax.origin, ax.direction, [far], reach, t))
+    asm = build_assembly(sc, prof, poses, reuse=True)
+    ks = [ax.knuckle for ax in _stacks(asm)]
+    assert len(ks) == 8 and all(k < prof.min_wall - 1e-9 for k in ks), ks
+    assert any("0 of 8 stacks" in n for n in asm.notes), [n for n in asm.notes if "compound" in n]
+    assert check_assembly(asm, walls=False).check("min_gap").ok

@@ -95,11 +95,16 @@ CLIP_UJ_PLATES = True    # a yoke plate past the end of another hinge of its bod
 UNTWIST_SPLIT = True     # ... not to a pin that cuts the other body in pieces (built again; session 52)
 GROW_STACKS = True       # a compound junction's stack: knuckles of the minimum wall, grown on its far side (session 57)
 #: _far_clear: where two stacks' axes come within both radii and the clearance, the solid knuckle
-#: cylinders themselves are measured (session 58; off: such a stack never grows).  Off: on the whole
-#: README circuit 721 of 866 stacks grew with it (251 without) and the thin regions halved, but 60
-#: pairs of one half unit's two slabs at another of its hinges came 0.10-0.16 mm apart as printed
-#: (min_gap; not seen on the pieces of tests/data_mesh): not understood yet (docs/printing.md)
-STACK_CYLINDERS = False
+#: cylinders themselves are measured (session 58; off: such a stack never grows).  Off in session 58:
+#: on the whole README circuit 721 of 866 stacks grew with it (251 without) and the thin regions
+#: halved, but 60 pairs of a half unit's two slabs came 0.10-0.16 mm apart (min_gap): each slab
+#: widened to its grown stack over the slab's whole length, the two met past their common hinge's
+#: span.  On again with GROWN_CLEAR (session 59)
+STACK_CYLINDERS = True
+#: a grown stack's new stretch, knuckles and plates, must keep the clearance from every body but the
+#: stack's own in every pose (:func:`_grown_near`), else the stack is built short (session 59): the
+#: plates met a half unit's hinge partner's yoke past that hinge's span, where no trim clears them
+GROWN_CLEAR = True
 
 
 # --------------------------------------------------------------------------- primitives
@@ -587,6 +592,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
     state_T = _state_transforms(scene, prof, poses)
 
     grown: dict = {}      # id(axis) -> joint: compound stacks grown to the minimum wall (far side)
+    grown_far: dict = {}  # id(axis) -> the stretch it grew into (mm from its origin; _compound's "far")
     posed_mid: list = []  # every hinge's midpoint in every pose, made on first use (_far_clear)
 
     def far_ok(ax, side, a0, a1):
@@ -629,6 +635,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
                 hx.origin = comp["origin"]
                 if comp["grown"]:
                     grown[id(hx)] = jname
+                    grown_far[id(hx)] = comp["far"]
                 hx.layout = [x if x is not None else br_uj[0].part for x in comp["stack"]]
                 hx.joint, hx.joint_iv = br_uj[0].part, comp["joint_iv"]
                 if comp["o_axis"] is not None:
@@ -747,6 +754,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
             hx.origin = compound["origin"]
             if compound["grown"]:
                 grown[id(hx)] = jname
+                grown_far[id(hx)] = compound["far"]
             hx.layout = [x if x is not None else uj.part for x in compound["stack"]]
             hx.joint, hx.joint_iv = uj.part, compound["joint_iv"]
             if compound["o_axis"] is not None:
@@ -800,8 +808,16 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
     for ax in axes:
         if ax.span > ax.scene_span + 1e-9:
             for bn in ax.bodies:
-                plates[bn] += _yoke_plates(slabs[bn], ax.origin, ax.direction, [(-ax.span / 2, ax.span / 2)],
-                                           reach, t)
+                if GROWN_CLEAR and id(ax) in grown_far:
+                    # a grown stack: over the stretch it grew into, plates only as long as its
+                    # knuckles need (_grown_plates); over the rest of the span, as before
+                    a0, a1 = grown_far[id(ax)]
+                    rest = (a1, ax.span / 2) if a0 <= -ax.span / 2 + 1e-9 else (-ax.span / 2, a0)
+                    plates[bn] += _yoke_plates(slabs[bn], ax.origin, ax.direction, [rest], reach, t)
+                    plates[bn] += _grown_plates(bn, slabs[bn], ax, (a0, a1), reach, t)
+                else:
+                    plates[bn] += _yoke_plates(slabs[bn], ax.origin, ax.direction, [(-ax.span / 2, ax.span / 2)],
+                                               reach, t)
         elif reuse and OFF_SLAB_FINS:
             # an axis across a body's slab, longer than the slab is thick (the robot's skeleton: a
             # hinge normal to the unit plates, 2.5 mm of knuckles on a 1 mm plate): the body's own
@@ -820,6 +836,14 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
                 uj_plates.append((bn, uj, sb))
     shapes = {bn: slabs[bn] + plates[bn] for bn in slabs}
     samples = {bn: _slab_samples(shapes[bn], h) for bn in shapes}
+    if GROWN_CLEAR and grown:
+        # a grown stack's new stretch (its knuckles and the plates widening its bodies' slabs to
+        # them) clear of every other body in every pose; else built again with that stack short
+        near = _grown_near([ax for ax in axes if id(ax) in grown], grown_far, shapes, axes, ujoints, slabs,
+                           state_T, reach, t, c)
+        _log(f"grown stacks: {len(near)} of {len(grown)} near another body's material (built again, short)")
+        if near:
+            raise _Untwist({("short", grown[id(ax)]) for ax in near})
 
     # -- trim radii: in every logic state, slabs of the bodies at an axis clear each other
     #    outside the radius inside which only the knuckle's own body has material
@@ -2389,9 +2413,9 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
         Q = np.asarray(bx.origin, float) + np.linspace(-bx.span / 2, bx.span / 2,
                                                         int(np.ceil(bx.span / step)) + 2)[:, None] * e
         lim = ax.R + bx.R + c
-        if STACK_CYLINDERS:
-            o = np.asarray(bx.origin, float)
-            S_other = _cylinder_points(o - 0.5 * bx.span * e, o + 0.5 * bx.span * e, bx.R, step)
+        o = np.asarray(bx.origin, float)
+        q0, q1 = o - 0.5 * bx.span * e, o + 0.5 * bx.span * e
+        S_other = None      # its cylinder's surface points, made when first needed
         for T in Ts:
             M = _relative(host, bx.bodies[0], T)
             Qm = Q if M is None else Q @ M[:3, :3].T + M[:3, 3]
@@ -2402,14 +2426,118 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
             # the two solid cylinders (the grown stretch, the other stack), each one's surface
             # points against the other: at least the clearance apart, plus the sampling's reach
             # (a surface point is within step / sqrt(2) of a sample)
+            if S_other is None:
+                S_other = _cylinder_points(q0, q1, bx.R, step)
             Mi = None if M is None else np.linalg.inv(M)
             mine = S_own if Mi is None else S_own @ Mi[:3, :3].T + Mi[:3, 3]
             theirs = S_other if M is None else S_other @ M[:3, :3].T + M[:3, 3]
             need = c + step / np.sqrt(2)
-            if (_cylinder_distance(mine, o - 0.5 * bx.span * e, o + 0.5 * bx.span * e, bx.R).min() < need
+            if (_cylinder_distance(mine, q0, q1, bx.R).min() < need
                     or _cylinder_distance(theirs, p0, p1, ax.R).min() < need):
                 return False
     return True
+
+
+def _grown_near(grown_axes, far, shapes, axes, ujoints, slabs, state_T, reach, t, c) -> list:
+    """The grown stacks (of ``grown_axes``; ``far``: ``{id(axis): (a0, a1)}``, the stretch each
+    grew into, mm from its origin) whose new material comes nearer than the clearance ``c`` to a
+    body other than the stack's own, at rest or in a pose of ``state_T``.  The new material: the
+    knuckle cylinders over that stretch and the plates widening each body's slabs over it
+    (:func:`_yoke_plates`), as surface points every ``c / 2`` (a surface point within
+    ``c / (2 sqrt 2)`` of one).  The other bodies: their slab boxes and yoke plates (``shapes``,
+    before any trim, so on the safe side) and their knuckles (hinges' and universal joints'
+    yokes), as solids measured exactly.  A stack's growth is tested against other stacks' axes
+    as it is laid out (:func:`_far_clear`); the plates come after every junction is laid out,
+    and past the span of another hinge of the same body no trim clears them (the README circuit
+    with ``STACK_CYLINDERS``: a half unit's slab DA widened to its grown stack D came 0.10-0.16
+    mm from the yoke that its hinge-A partner AB carries for the previous junction, 60 such
+    pairs; session 59).  Not tested: the universal joints' own parts (ball hubs, collars)."""
+    step = 0.5 * c if c > 0 else 0.05
+    need = c + step / np.sqrt(2)
+    cyl: dict = {bn: [] for bn in shapes}
+    for ax in axes:
+        for bn, ivs in ax.intervals.items():
+            cyl[bn] += [(ax.origin + a0 * ax.direction, ax.origin + a1 * ax.direction, ax.R) for a0, a1 in ivs]
+    for uj in ujoints:
+        for side, bn in enumerate(uj.bodies):
+            lay = uj.layouts[side]
+            cyl[bn] += [(uj.center + a0 * uj.axes[side], uj.center + a1 * uj.axes[side], lay.r_own or uj.R)
+                        for a0, a1 in lay.own]
+    names = list(shapes)
+    # each body's bounding sphere (rest, mm): a prefilter in every pose
+    ctr, rad = np.zeros((len(names), 3)), np.zeros(len(names))
+    for i, bn in enumerate(names):
+        P = [_box_corners(sb) for sb in shapes[bn]] + [np.array([p0, p1]) for p0, p1, _ in cyl[bn]]
+        P = np.concatenate(P) if P else np.zeros((1, 3))
+        ctr[i] = 0.5 * (P.min(axis=0) + P.max(axis=0))
+        rad[i] = np.linalg.norm(P - ctr[i], axis=1).max() + max([r for *_, r in cyl[bn]], default=0.0)
+    Ts = [None] + [T for _, T in state_T]
+    posed = [ctr if T is None else np.einsum("nij,nj->ni", np.array([T[b][:3, :3] for b in names]), ctr)
+             + np.array([T[b][:3, 3] for b in names]) for T in Ts]
+    out = []
+    for ax in grown_axes:
+        a0, a1 = far[id(ax)]
+        p0, p1 = ax.origin + a0 * ax.direction, ax.origin + a1 * ax.direction
+        hit = False
+        for bn in ax.bodies:
+            X = [_cylinder_points(p0, p1, ax.R, step)]
+            X += [_box_points(sb, step) for sb in _grown_plates(bn, slabs[bn], ax, (a0, a1), reach, t)]
+            X = np.concatenate(X)
+            xc = 0.5 * (X.min(axis=0) + X.max(axis=0))
+            xr = float(np.linalg.norm(X - xc, axis=1).max())
+            for k, T in enumerate(Ts):
+                q = xc if T is None else T[bn][:3, :3] @ xc + T[bn][:3, 3]
+                for i in np.nonzero(np.linalg.norm(posed[k] - q, axis=1) < rad + xr + need)[0]:
+                    ob = names[i]
+                    if ob in ax.bodies:
+                        continue
+                    M = _relative(ob, bn, T)
+                    Y = X if M is None else X @ M[:3, :3].T + M[:3, 3]
+                    dmin = min([_box_distance(Y, sb).min() for sb in shapes[ob]]
+                               + [_cylinder_distance(Y, q0, q1, r).min() for q0, q1, r in cyl[ob]], default=np.inf)
+                    if dmin < need:
+                        hit = True
+                        break
+                if hit:
+                    break
+            if hit:
+                break
+        if hit:
+            out.append(ax)
+    return out
+
+
+def _grown_plates(bn, sbs, ax: HingeAxis, far, reach, t) -> list:
+    """The plates (:func:`_yoke_plates`) widening the slabs ``sbs`` of body ``bn`` over the stretch
+    ``far`` (mm from its origin) that the stack of ``ax`` grew into, if a knuckle of ``bn`` lies
+    there: out from the axis to the knuckles' radius and a slab thickness, no farther.  Plates as long as the slab there (before session
+    59) ran past the body's other hinges, beside the other plates of the same stretch: a half
+    unit's slabs AB and DA, each widened to its grown stack (B, D), met at hinge A past its span."""
+    if not any(k0 < far[1] and k1 > far[0] for k0, k1 in ax.intervals.get(bn, [])):
+        return []       # none of its knuckles there: the plate would be a tab beside the other's knuckle
+    return _yoke_plates(sbs, ax.origin, ax.direction, [far], min(reach, ax.R + t), t)
+
+
+def _box_points(sb: SlabBox, step: float) -> np.ndarray:
+    """Points on the surface of a slab box, at most ``step`` (mm) apart on each face."""
+    out = []
+    for i in range(3):
+        j, k = [x for x in range(3) if x != i]
+        u = np.linspace(-0.5, 0.5, max(2, int(np.ceil(sb.size[j] / step)) + 1)) * sb.size[j]
+        v = np.linspace(-0.5, 0.5, max(2, int(np.ceil(sb.size[k] / step)) + 1)) * sb.size[k]
+        a, b = np.meshgrid(u, v, indexing="ij")
+        for sgn in (-0.5, 0.5):
+            loc = np.zeros((a.size, 3))
+            loc[:, i] = sgn * sb.size[i]
+            loc[:, j], loc[:, k] = a.ravel(), b.ravel()
+            out.append(sb.center + loc @ sb.R.T)
+    return np.concatenate(out)
+
+
+def _box_distance(X, sb: SlabBox) -> np.ndarray:
+    """Distance (mm) of the points ``X`` from the solid slab box (0 inside)."""
+    q = np.abs((X - sb.center) @ sb.R) - 0.5 * sb.size
+    return np.linalg.norm(np.maximum(q, 0.0), axis=1)
 
 
 def _cylinder_points(p0, p1, R: float, step: float) -> np.ndarray:
@@ -2519,7 +2647,11 @@ def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, 
     u = ax.direction * sg
     lay = YokeLayout("host", [], [], (-(d0 + S), 0.0), (-(R + c), R + c), (0.0, 0.0), reach=max(d0 - g, hub_r))
     lay_c = lay
-    return {"axis": ax, "origin": origin, "grown": shift > 0, "u": u.copy(), "span": S, "k": k, "intervals": intervals, "stack": stack,
+    # the stretch the stack grew into (mm from the new origin along the axis): past the far end
+    # of the short stack, out to the grown stack's far end
+    far = tuple(sorted((-sg * (S0 - S / 2), -sg * S / 2)))
+    return {"axis": ax, "origin": origin, "grown": shift > 0, "far": far, "u": u.copy(), "span": S, "k": k,
+            "intervals": intervals, "stack": stack,
             "joint_iv": joint_iv, "hub_r": hub_r, "collar": d0 - g, "hub_v": 2 * (v0 - g), "layout": lay,
             "o_axis": o_axis, "dO": dO, "layout_c": lay_c, "o_body": o_body}
 
