@@ -3,9 +3,11 @@ mlc's own layout (issue 13, session 57: stacks grown to knuckles of the minimum 
 
 Builds a piece of the README circuit (``--piece``, default ``tests/data_mesh/circuit_junction``:
 five half units of chain ``w_b_0`` and their four junctions; ``circuit_leaf``: a branch tree's
-leaf pages; each with the circuit's 22 print poses) at mjp with ``GROW_STACKS`` on and off, and
-on with ``STACK_CYLINDERS`` off (session 58: grown only where no other stack's axis comes within
-both radii and the clearance, session 57's test), and for each compound stack measures, on each joint part's finished
+leaf pages; ``circuit_chain_y``: five half units of chain ``w_y_0``; each with the circuit's 22
+print poses) at mjp with ``GROW_STACKS`` on and off, and on with ``STACK_CYLINDERS`` off (session
+58: grown only where no other stack's axis comes within both radii and the clearance, session
+57's test); ``GROWN_CLEAR`` (session 59) on in both grown builds.  For each compound stack it
+measures, on each joint part's finished
 mesh (trimesh, its vertices), the length along the stack's axis of the joint's knuckle: the
 axial extent of the vertices on the knuckle's outer cylinder (radius R within 1 %, away from
 the collar, which is thinner).  mlc gives only the axis line and R; the length is the mesh's.
@@ -13,6 +15,8 @@ the collar, which is thinner).  mlc gives only the axis line and R; the length i
     python benchmarks/knuckle_lengths.py -o benchmarks/results/knuckle_lengths_s57.json
     python benchmarks/knuckle_lengths.py --piece circuit_junction --piece circuit_leaf \
         -o benchmarks/results/knuckle_lengths_s58.json
+    python benchmarks/knuckle_lengths.py --piece circuit_junction --piece circuit_leaf \
+        --piece circuit_chain_y -o benchmarks/results/knuckle_lengths_s59.json
 
 Units: mm."""
 from __future__ import annotations
@@ -40,8 +44,8 @@ DATA = HERE.parent / "tests" / "data_mesh"
 
 
 #: the builds compared: mlc.mesh.build's flags for each
-VARIANTS = {"grown": {"GROW_STACKS": True, "STACK_CYLINDERS": True},
-            "grown_axes_only": {"GROW_STACKS": True, "STACK_CYLINDERS": False},
+VARIANTS = {"grown": {"GROW_STACKS": True, "STACK_CYLINDERS": True, "GROWN_CLEAR": True},
+            "grown_axes_only": {"GROW_STACKS": True, "STACK_CYLINDERS": False, "GROWN_CLEAR": True},
             "short": {"GROW_STACKS": False}}
 
 
