@@ -1,0 +1,92 @@
+"""The gap between each connector half unit's two slab pairs that share no hinge of their own
+there, AB-DA and BC-CD, in a 3MF written by ``mlc stl``, measured outside mlc and manifold3d
+(issue 13, session 59: with grown compound stacks, 60 such pairs of the README circuit came
+0.10-0.16 mm apart as printed).
+
+The 3MF is read with the standard library alone (zip, the core 3MF mesh XML, and PrusaSlicer's
+``Metadata/Slic3r_PE_model.config`` for each named part's triangle range); each part's surface is
+sampled by trimesh (``N`` points, seeded) and the nearest pairs found with a SciPy k-d tree.
+A sampled gap is an upper bound of the true gap, so a pair under the clearance is under it
+for sure.  The 3MF's coordinates carry six significant digits (0.001 mm at 100 mm): hinge
+partners that sit at the clearance read a few tenths of a micrometre either side of it.
+
+    python benchmarks/half_unit_gaps.py OUT/circuit.3mf --label "README job" -o RESULTS.json
+
+Units: mm.  Rerun for the same numbers (the samples' seeds are fixed)."""
+from __future__ import annotations
+
+import argparse
+import json
+import re
+import sys
+import zipfile
+import xml.etree.ElementTree as ET
+from pathlib import Path
+
+import mlc  # noqa: F401 -- before numpy (mlc/__init__.py)
+
+import numpy as np
+import trimesh
+from scipy.spatial import cKDTree
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from gitstate import commit  # noqa: E402  (benchmarks/gitstate.py)
+
+from mlc.io.atomic import atomic_path  # noqa: E402
+
+CORE = "{http://schemas.microsoft.com/3dmanufacturing/core/2015/02}"
+UNIT = re.compile(r"^(.*_\d+)_(AB|BC|CD|DA)$")
+
+
+def read_parts(path) -> dict:
+    """``{part name: (vertices (n, 3), triangles (m, 3))}`` of a 3MF with named volumes."""
+    z = zipfile.ZipFile(path)
+    V, T = [], []
+    for _, el in ET.iterparse(z.open("3D/3dmodel.model")):
+        if el.tag == CORE + "vertex":
+            V.append((float(el.get("x")), float(el.get("y")), float(el.get("z"))))
+            el.clear()
+        elif el.tag == CORE + "triangle":
+            T.append((int(el.get("v1")), int(el.get("v2")), int(el.get("v3"))))
+            el.clear()
+    V, T = np.array(V), np.array(T)
+    out = {}
+    for vol in ET.fromstring(z.read("Metadata/Slic3r_PE_model.config")).iter("volume"):
+        name = next(m.get("value") for m in vol.iter("metadata") if m.get("key") == "name")
+        u, inv = np.unique(T[int(vol.get("firstid")):int(vol.get("lastid")) + 1], return_inverse=True)
+        out[name] = (V[u], inv.reshape(-1, 3))
+    return out
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("mf3", help="3MF written by mlc stl")
+    ap.add_argument("--label", default="")
+    ap.add_argument("-n", type=int, default=60000, help="surface samples per part")
+    ap.add_argument("--clearance", type=float, default=0.2, help="mm (mjp: 0.2)")
+    ap.add_argument("-o", "--out", required=True)
+    a = ap.parse_args()
+    parts = read_parts(a.mf3)
+    units = sorted({m.group(1) for n in parts if (m := UNIT.match(n))})
+    rows = []
+    for u in units:
+        for x, y in (("AB", "DA"), ("BC", "CD")):
+            if f"{u}_{x}" not in parts or f"{u}_{y}" not in parts:
+                continue
+            pa, pb = (trimesh.sample.sample_surface(trimesh.Trimesh(*parts[f"{u}_{s}"], process=False), a.n,
+                                                    seed=k)[0] for k, s in ((1, x), (2, y)))
+            rows.append({"a": f"{u}_{x}", "b": f"{u}_{y}", "gap_mm": round(float(cKDTree(pb).query(pa)[0].min()), 5)})
+    g = np.array([r["gap_mm"] for r in rows])
+    out = {"benchmark": "half_unit_gaps", "commit": commit(), "label": a.label, "file": str(a.mf3),
+           "samples_per_part": a.n, "clearance_mm": a.clearance, "pairs": len(rows),
+           "min_mm": float(g.min()), "under_clearance_by_0.01_mm_or_more": int((g < a.clearance - 0.01).sum()),
+           "smallest": sorted(rows, key=lambda r: r["gap_mm"])[:20]}
+    print(json.dumps({k: v for k, v in out.items() if k != "smallest"}))
+    with atomic_path(a.out) as tmp:
+        Path(tmp).write_text(json.dumps(out, indent=1) + "\n")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
