@@ -161,9 +161,9 @@ def test_grown_plates_stop_short_of_the_bodys_other_hinges(monkeypatch):
     """Session 59: with ``STACK_CYLINDERS`` the whole README circuit grew 721 of 866 stacks, but
     60 pairs of a half unit's two slabs came 0.10-0.16 mm apart (min_gap).  ``circuit_chain_y``
     (five half units of the chain ``w_y_0``, 19 to 23, cut from that circuit with its 22 poses)
-    shows it: each half unit's stacks B and D grow on the same side; the plates widening AB to
-    its grown stack B and DA to D ran the slabs' whole length and met past hinge A's span, where
-    no trim clears them.  The plates over the grown stretch now reach only as far as the knuckles
+    shows it: each half unit's stacks B and D grow on the same side; the plate widening DA to its
+    grown stack D ran the slab's whole length, past hinge A's span, where no trim clears it from
+    AB (its plate to stack B and its yoke for the previous junction lie there).  The plates over the grown stretch now reach only as far as the knuckles
     need, only on a body with a knuckle there (``_grown_plates``), and a stack whose new
     material still comes near another body is built short (``GROWN_CLEAR``)."""
     sc, poses = _piece("circuit_chain_y")

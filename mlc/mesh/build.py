@@ -2450,8 +2450,8 @@ def _grown_near(grown_axes, far, shapes, axes, ujoints, slabs, state_T, reach, t
     as it is laid out (:func:`_far_clear`); the plates come after every junction is laid out,
     and past the span of another hinge of the same body no trim clears them (the README circuit
     with ``STACK_CYLINDERS``: a half unit's slab DA widened to its grown stack D came 0.10-0.16
-    mm from the yoke that its hinge-A partner AB carries for the previous junction, 60 such
-    pairs; session 59).  Not tested: the universal joints' own parts (ball hubs, collars)."""
+    mm from its hinge-A partner AB past that hinge's span, 60 such pairs; session 59).  Not
+    tested: the universal joints' own parts (ball hubs, collars)."""
     step = 0.5 * c if c > 0 else 0.05
     need = c + step / np.sqrt(2)
     cyl: dict = {bn: [] for bn in shapes}
@@ -2510,9 +2510,10 @@ def _grown_near(grown_axes, far, shapes, axes, ujoints, slabs, state_T, reach, t
 def _grown_plates(bn, sbs, ax: HingeAxis, far, reach, t) -> list:
     """The plates (:func:`_yoke_plates`) widening the slabs ``sbs`` of body ``bn`` over the stretch
     ``far`` (mm from its origin) that the stack of ``ax`` grew into, if a knuckle of ``bn`` lies
-    there: out from the axis to the knuckles' radius and a slab thickness, no farther.  Plates as long as the slab there (before session
-    59) ran past the body's other hinges, beside the other plates of the same stretch: a half
-    unit's slabs AB and DA, each widened to its grown stack (B, D), met at hinge A past its span."""
+    there: out from the axis to the knuckles' radius and a slab thickness, no farther.  Plates as
+    long as the slab (before session 59) ran past the body's other hinges' spans, where no trim
+    clears them: a half unit's DA, widened to its grown stack D, came 0.16 mm from AB's material
+    past hinge A (AB's own plate to its grown stack B lies over the same stretch)."""
     if not any(k0 < far[1] and k1 > far[0] for k0, k1 in ax.intervals.get(bn, [])):
         return []       # none of its knuckles there: the plate would be a tab beside the other's knuckle
     return _yoke_plates(sbs, ax.origin, ax.direction, [far], min(reach, ax.R + t), t)
