@@ -102,8 +102,8 @@ GROW_STACKS = True       # a compound junction's stack: knuckles of the minimum 
 #: span.  On again with GROWN_CLEAR (session 59)
 STACK_CYLINDERS = True
 #: a grown stack's new stretch, knuckles and plates, must keep the clearance from every body but the
-#: stack's own in every pose (:func:`_grown_near`), else the stack is built short (session 59): the
-#: plates met a half unit's hinge partner's yoke past that hinge's span, where no trim clears them
+#: stack's own in every pose (:func:`_grown_near`), else the stack is built short (session 59): a
+#: grown stack's plates met a half unit's hinge partner past that hinge's span, where no trim clears them
 GROWN_CLEAR = True
 
 
@@ -2474,35 +2474,31 @@ def _grown_near(grown_axes, far, shapes, axes, ujoints, slabs, state_T, reach, t
     Ts = [None] + [T for _, T in state_T]
     posed = [ctr if T is None else np.einsum("nij,nj->ni", np.array([T[b][:3, :3] for b in names]), ctr)
              + np.array([T[b][:3, 3] for b in names]) for T in Ts]
+    def near(ax, bn, X) -> bool:
+        """Whether the points ``X`` (body ``bn``'s rest frame) come within ``need`` of a body
+        other than those of ``ax``, at rest or in a pose."""
+        xc = 0.5 * (X.min(axis=0) + X.max(axis=0))
+        xr = float(np.linalg.norm(X - xc, axis=1).max())
+        for k, T in enumerate(Ts):
+            q = xc if T is None else T[bn][:3, :3] @ xc + T[bn][:3, 3]
+            for i in np.nonzero(np.linalg.norm(posed[k] - q, axis=1) < rad + xr + need)[0]:
+                ob = names[i]
+                if ob in ax.bodies:
+                    continue
+                M = _relative(ob, bn, T)
+                Y = X if M is None else X @ M[:3, :3].T + M[:3, 3]
+                if min([_box_distance(Y, sb).min() for sb in shapes[ob]]
+                       + [_cylinder_distance(Y, q0, q1, r).min() for q0, q1, r in cyl[ob]], default=np.inf) < need:
+                    return True
+        return False
+
     out = []
     for ax in grown_axes:
         a0, a1 = far[id(ax)]
-        p0, p1 = ax.origin + a0 * ax.direction, ax.origin + a1 * ax.direction
-        hit = False
-        for bn in ax.bodies:
-            X = [_cylinder_points(p0, p1, ax.R, step)]
-            X += [_box_points(sb, step) for sb in _grown_plates(bn, slabs[bn], ax, (a0, a1), reach, t)]
-            X = np.concatenate(X)
-            xc = 0.5 * (X.min(axis=0) + X.max(axis=0))
-            xr = float(np.linalg.norm(X - xc, axis=1).max())
-            for k, T in enumerate(Ts):
-                q = xc if T is None else T[bn][:3, :3] @ xc + T[bn][:3, 3]
-                for i in np.nonzero(np.linalg.norm(posed[k] - q, axis=1) < rad + xr + need)[0]:
-                    ob = names[i]
-                    if ob in ax.bodies:
-                        continue
-                    M = _relative(ob, bn, T)
-                    Y = X if M is None else X @ M[:3, :3].T + M[:3, 3]
-                    dmin = min([_box_distance(Y, sb).min() for sb in shapes[ob]]
-                               + [_cylinder_distance(Y, q0, q1, r).min() for q0, q1, r in cyl[ob]], default=np.inf)
-                    if dmin < need:
-                        hit = True
-                        break
-                if hit:
-                    break
-            if hit:
-                break
-        if hit:
+        knuckles = _cylinder_points(ax.origin + a0 * ax.direction, ax.origin + a1 * ax.direction, ax.R, step)
+        if any(near(ax, bn, np.concatenate([knuckles] + [_box_points(sb, step) for sb in
+                                                         _grown_plates(bn, slabs[bn], ax, (a0, a1), reach, t)]))
+               for bn in ax.bodies):
             out.append(ax)
     return out
 
