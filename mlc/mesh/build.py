@@ -105,6 +105,7 @@ STACK_CYLINDERS = True
 #: stack's own in every pose (:func:`_grown_near`), else the stack is built short (session 59): a
 #: grown stack's plates met a half unit's hinge partner past that hinge's span, where no trim clears them
 GROWN_CLEAR = True
+SHAVE_THIN = True        # the thin webs the trims leave away from a body's joints, taken away (mlc.mesh.shave; session 60)
 
 
 # --------------------------------------------------------------------------- primitives
@@ -1206,6 +1207,10 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
                 _clear_tipped_yokes(asm, notes, posed_T)
             if STROKE_CLEAR:
                 _clear_strokes(asm, protected, soft, posed_T)
+        if SHAVE_THIN:
+            from mlc.mesh.shave import shave_thin
+            _log("thin regions off the bodies' joints")
+            shave_thin(asm, _log)
     _log("final trims done; drilling")
     # attachment holes shaped for the print's up where it is known now: the feet's (fdm's
     # orient: auto; the as_is profiles, mjp and sla, print their own support and keep round holes)

@@ -53,7 +53,7 @@ parts at mjp 3.74 -> 0.69 s, every tenth part of the Tetris circuit 195 -> 45 s)
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 from numba import njit, prange
@@ -70,6 +70,11 @@ class ThinWall:
     volume_mm3: float        # material in the thin region
     where_mm: tuple          # the thinnest spot of the region: the middle of its shortest chord (print frame)
     thinnest_mm: float | None = None     # that chord's length: the wall's thickness at its thinnest
+    # the centres (mm, (N, 3)) of its cells farther from the thick part than a ball's rounding at an
+    # edge (those that make it a thin wall; its cells nearer the thick part can be a skin along a
+    # face the grid's cells sit on), and the cell size (mm)
+    cells: np.ndarray | None = field(default=None, repr=False, compare=False)
+    h: float = 0.0
 
     def text(self, min_wall: float) -> str:
         x, y, z = self.where_mm
@@ -104,6 +109,8 @@ def voxelize(solid, h: float):
     nxt_same[:-1] = key[:-1] == key[1:]
     start = np.nonzero(enter & nxt_same)[0]
     start = start[sgn[start + 1] > 0]
+    if len(start) == 0:       # a sliver no column centre crosses
+        return grid, lo
     z0, z1 = z[start], z[start + 1]
     k0 = np.ceil((z0 - lo[2]) / h).astype(int)
     k1 = np.floor((z1 - lo[2]) / h).astype(int)
@@ -547,6 +554,7 @@ def thin_walls(name: str, solid, min_wall: float, h: float | None = None) -> lis
         # its thinnest spot: the shortest chord through a cell farther from the thick part than
         # a ball's rounding (the cells that make it a thin wall, not an edge of a thick one)
         far = cells[away[tuple(cells.T)] > edge]
+        core = lo + h * far
         # (from a cell near the surface, the direction to its nearest sample is not the normal)
         d0, _ = surf.query(lo + h * far)
         far = far[d0 >= 0.4 * min(D.max(), r)] if (d0 >= 0.4 * min(D.max(), r)).any() else far
@@ -558,7 +566,7 @@ def thin_walls(name: str, solid, min_wall: float, h: float | None = None) -> lis
             where, thin = mid[j], float(min(w[j], thickness))
         else:
             where, thin = lo + h * cells[len(cells) // 2], None
-        out.append(ThinWall(name, thickness, float(v), tuple(float(x) for x in where), thin))
+        out.append(ThinWall(name, thickness, float(v), tuple(float(x) for x in where), thin, core, h))
     return out
 
 

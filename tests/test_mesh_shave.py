@@ -1,0 +1,145 @@
+"""mlc.mesh.shave (issue 13, "meets the profile's minimum wall everywhere"): thin webs the trims
+leave away from a body's joints are taken off, unless the body would lose a piece or joint
+material.
+
+Synthetic bodies (two blocks and the webs between them) test each of the module's three rules;
+``circuit_leaf`` (tests/data_mesh: the README circuit's leaf pages with the circuit's 22 poses)
+tests it on a compiled circuit: some regions go, every blocking check still passes, and the
+0.16 mm strip that is the only link of a half unit's far yoke knuckle stays (taking it would drop
+the knuckle)."""
+from __future__ import annotations
+
+from pathlib import Path
+from types import SimpleNamespace
+
+import manifold3d as mf
+import numpy as np
+import pytest
+
+from mlc.mesh import build as B
+from mlc.mesh import shave as S
+from mlc.mesh.build import HingeAxis, Part
+from mlc.mesh.walls import thin_walls
+
+MW = 0.6
+DATA = Path(__file__).parent / "data_mesh"
+BLOCKING = ("watertight", "part_count", "min_gap", "states", "retention", "features")
+
+
+def _box(lo, hi):
+    lo, hi = np.asarray(lo, float), np.asarray(hi, float)
+    return mf.Manifold.cube(tuple(hi - lo)).translate(tuple(lo))
+
+
+def _blocks(bar: bool, web: float = 0.2):
+    """Two 3 mm blocks 3 mm apart along x, joined by a 0.2 mm web (z from 1 to 1 + web) and,
+    with ``bar``, by a 1.5 mm bar too (y from 1.5 to 3)."""
+    parts = [_box((0, 0, 0), (3, 3, 3)), _box((6, 0, 0), (9, 3, 3)), _box((2.5, 0, 1), (6.5, 1.2, 1 + web))]
+    if bar:
+        parts.append(_box((2.5, 1.5, 0.75), (6.5, 3, 2.25)))
+    return mf.Manifold.batch_boolean(parts, mf.OpType.Add)
+
+
+def _asm(solid, axes=()):
+    return SimpleNamespace(parts=[Part("body", "body", solid)], axes=list(axes), ujoints=[],
+                           profile=SimpleNamespace(min_wall=MW), notes=[], cores={}, congruence=None)
+
+
+def test_a_web_beside_a_bar_is_taken():
+    solid = _blocks(bar=True)
+    assert len(thin_walls("body", solid, MW)) == 1
+    asm = _asm(solid)
+    S.shave_thin(asm)
+    after = asm.parts[0].solid
+    assert thin_walls("body", after, MW) == []
+    assert len(after.decompose()) == 1
+    # the web's 4 x 1.2 x 0.2 mm is what went (with at most a cell's skin of the blocks)
+    lost = solid.volume() - after.volume()
+    assert 0.8 * 3 * 1.2 * 0.2 < lost < 4 * 1.2 * 0.2 + 2 * 1.2 * 0.3 * 2 * 0.075 + 0.05
+    assert any("1 thin region" in n for n in asm.notes)
+
+
+def test_a_web_that_is_the_only_link_stays():
+    solid = _blocks(bar=False)
+    asm = _asm(solid)
+    S.shave_thin(asm)
+    assert asm.parts[0].solid is solid
+    assert len(thin_walls("body", asm.parts[0].solid, MW)) == 1
+    assert asm.notes == []
+
+
+def test_a_web_in_a_hinge_cylinder_stays():
+    solid = _blocks(bar=True)
+    # a hinge of the body along x through the web: its cylinder (R 1 mm) holds the web's cells
+    ax = HingeAxis("h", [], np.array([4.5, 0.6, 1.1]), np.array([1.0, 0.0, 0.0]), 5.0, ["body", "other"],
+                   {"body": [(-2.5, 2.5)]}, 5.0, 1.0, 0.3, 0.35)
+    asm = _asm(solid, [ax])
+    S.shave_thin(asm)
+    assert asm.parts[0].solid is solid
+    # ... and a hinge elsewhere protects nothing here
+    far = HingeAxis("h", [], np.array([4.5, 10.0, 10.0]), np.array([1.0, 0.0, 0.0]), 5.0, ["body", "other"],
+                    {"body": [(-2.5, 2.5)]}, 5.0, 1.0, 0.3, 0.35)
+    asm = _asm(solid, [far])
+    S.shave_thin(asm)
+    assert asm.parts[0].solid is not solid
+
+
+def test_joint_cores_are_kept():
+    solid = _blocks(bar=True)
+    asm = _asm(solid)
+    asm.cores = {"body": _box((3.5, 0.2, 1.02), (5.5, 1.0, 1.18))}    # a "core" inside the web
+    S.shave_thin(asm)
+    assert asm.parts[0].solid is solid
+
+
+def _leaf(shave: bool):
+    from mlc.mesh.checks import check_assembly
+    from mlc.mesh.profiles import load_profile
+    from mlc.scene.io import load_scene
+    z = np.load(DATA / "circuit_leaf_poses.npz")
+    sc = load_scene(DATA / "circuit_leaf.yaml")
+    poses = {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
+    old = B.SHAVE_THIN
+    B.SHAVE_THIN = shave
+    try:
+        asm = B.build_assembly(sc, load_profile("mjp"), poses, reuse=True)
+    finally:
+        B.SHAVE_THIN = old
+    return asm, check_assembly(asm, walls=True)
+
+
+@pytest.fixture(scope="module")
+def leaf():
+    return _leaf(False), _leaf(True)
+
+
+def _walls(rep):
+    return next(c for c in rep.checks if c.name == "wall_thickness").failures
+
+
+def test_leaf_shaved_passes_and_has_fewer_thin_regions(leaf):
+    (a0, r0), (a1, r1) = leaf
+    for c in r1.checks:
+        if c.name in BLOCKING:
+            assert c.ok, (c.name, c.detail)
+    assert len(_walls(r1)) < len(_walls(r0))
+    assert any(n.startswith("walls:") for n in a1.notes)
+    assert not any(n.startswith("walls:") for n in a0.notes)
+    v0 = {p.name: p.solid.volume() for p in a0.parts}
+    for p in a1.parts:      # only ever material taken away
+        assert p.solid.volume() <= v0[p.name] + 1e-6
+
+
+def test_leaf_far_yoke_knuckle_strip_stays(leaf):
+    """The 0.16 mm strip on w_y_0_0_AB (its compound junction's fin, cut by the trim about the
+    second pin) holds the yoke knuckle on the far side from the half unit's end knuckle: taken,
+    the body falls in two."""
+    (_, _), (a1, r1) = leaf
+    p = a1.part("w_y_0_0_AB")
+    strips = [w for w in thin_walls(p.name, p.solid, MW) if w.thinnest_mm is not None and w.thinnest_mm < 0.2]
+    assert len(strips) == 1
+    w = strips[0]
+    keep = S._joint_cells(a1, p.name, w.cells, S.JOINT_MARGIN * w.h)
+    cut = p.solid - S._cubes(w.cells[~keep], S.CUT_CELLS * w.h)
+    big = sorted(x.volume() for x in cut.decompose() if x.volume() >= MW ** 3)
+    assert len(big) == 2 and big[0] > 1.0       # the yoke knuckle and its fin, a few mm^3
