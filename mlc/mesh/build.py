@@ -105,6 +105,9 @@ STACK_CYLINDERS = True
 #: stack's own in every pose (:func:`_grown_near`), else the stack is built short (session 59): a
 #: grown stack's plates met a half unit's hinge partner past that hinge's span, where no trim clears them
 GROWN_CLEAR = True
+#: a compound junction's fin kept past the joint part's ball, clear of O's trim about the second pin, where
+#: the collar never turns round to it (:func:`_fin_keep`; session 60)
+FIN_KEPT = True
 SHAVE_THIN = True        # the thin webs the trims leave away from a body's joints, taken away (mlc.mesh.shave; session 60)
 
 
@@ -921,6 +924,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
     cone_cores: dict[str, mf.Manifold] = {}  # pin: cone: what the trims never touch (knuckles, cones, rings)
     pages = {uj.bodies[1] for uj in ujoints if uj.layouts[1].holes is not None}   # branch junctions' pages
     split_by: set = set()      # turned junctions whose other body came out in pieces (_Untwist)
+    fin_free = {id(uj) for uj in ujoints if FIN_KEPT and _fin_free(uj, state_T, c, t)}
     for b in scene.bodies:
         bn = b.name
         # large assemblies: every primitive and boolean of the body in its own frame (its first
@@ -958,8 +962,11 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
                 # the rest of uj.rho is for the other body's slabs in the logic states (_ujoint_trim)
                 sweep = float(np.hypot(uj.layouts[1 - side].extent, uj.R)) + c
                 rho_s = _toward(sweep, uj.rho[side], f)
+                # (built here: in a large assembly the primitives are in the body's frame)
+                keep = _fin_keep(uj, c, t, n) if side == 1 and id(uj) in fin_free else None
                 for a0, a1 in _complement(lay.own, *lay.cut):
-                    other_cuts.append(cylinder(uj.center, uj.axes[side], a0, a1, rho_s, n, cutter=True))
+                    cyl_cut = cylinder(uj.center, uj.axes[side], a0, a1, rho_s, n, cutter=True)
+                    other_cuts.append(cyl_cut if keep is None else subtract(cyl_cut, [keep]))
                     avoid.append((uj.center, uj.axes[side], a0, a1, rho_s))
                     avoid_sweep.append((uj.center, uj.axes[side], a0, a1, min(sweep, rho_s)))
             for uj in ujoints:      # compound junction: the other bodies of its hinge clear the yoke too
@@ -4148,6 +4155,38 @@ def _uj_samples(uj: UJoint, base_samples, slabs, reach, t, h) -> dict:
     (``base_samples``) and the yoke plates that widen them to its knuckles (:func:`_uj_plates`)."""
     return {bn: np.concatenate([base_samples[bn], _slab_samples(_uj_plates(uj, k, slabs[bn], uj.rho[k] + reach, t), h)])
             for k, bn in enumerate(uj.bodies)}
+
+
+def _fin_free(uj: UJoint, state_T, c, t) -> bool:
+    """(FIN_KEPT) Whether a compound junction's fin (O's yoke plate along the host's line,
+    :func:`_uj_plates`) can stay past the joint part's ball inside O's trim about the second pin
+    (:func:`_fin_keep`).  That trim's full radius is the sweep of the host's collar all the way
+    about the pin (``hypot(reach, R) + c``), and it took all but the fin's last 0.16 mm between
+    the knuckles: the one link of the yoke knuckle away from O's end knuckle (session 60).  On
+    the fin's side (+u) the joint part has nothing but its ball (its collar, pin and knuckle lie
+    along -u), and relative to O it turns about v only, by the angle between the host's line in C
+    and in O: free when that angle in every pose, plus the fin's half thickness seen from the
+    ball and 10 degrees, stays under 90 degrees (the collar stays on its own side)."""
+    if uj.host is None or uj.fin <= 0:
+        return False
+    u, v = uj.axes
+    C, O = uj.bodies
+    th = 0.0
+    for _, Ts in state_T:
+        if Ts is None:
+            continue
+        w = (np.linalg.inv(Ts[O]) @ Ts[C])[:3, :3] @ u
+        th = max(th, abs(float(np.degrees(np.arctan2(np.cross(u, w) @ v, u @ w)))))
+    return th + float(np.degrees(np.arctan2(t / 2, uj.hub_r + c))) + 10.0 < 90.0
+
+
+def _fin_keep(uj: UJoint, c, t, n) -> mf.Manifold:
+    """The part of a compound junction's fin that O's trim about the second pin leaves where
+    :func:`_fin_free`: past the joint part's ball and the clearance."""
+    fin = _uj_plates(uj, 1, [], 0.0, t)[0]
+    r_keep = uj.hub_r + c
+    big = 2 * float(np.max(fin.size)) + 4 * r_keep
+    return subtract(box(fin.center, fin.R, fin.size), [cylinder(uj.center, uj.axes[1], -big, big, r_keep, n, cutter=True)])
 
 
 def _uj_plates(uj: UJoint, side: int, sbs, reach, t):
