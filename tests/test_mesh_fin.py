@@ -83,8 +83,9 @@ def test_the_fin_is_a_full_wall_between_the_knuckles(kept, cut):
     fins = _fins(a1)
     assert len(fins) == 8          # the leaf piece's four chains' first junctions, lo and hi
     mw = a1.profile.min_wall
+    state_T = B._state_transforms(a1.scene, a1.profile, a1.poses)
     for uj in fins:
-        assert B._fin_free(uj, [], a1.profile.clearance, a1.slab_thickness)
+        assert B._fin_free(uj, state_T, a1.profile.clearance, a1.slab_thickness)
         assert _fin_width(a1, uj) >= mw, uj.name
         assert _fin_width(a0, uj) < 0.5 * mw, uj.name      # the strip, as before
 
@@ -115,3 +116,27 @@ def test_the_strip_was_the_one_link_of_the_far_yoke_knuckle(cut):
         left = p.solid - S._cubes(w.cells[~keep], S.CUT_CELLS * w.h)
         big = sorted(x.volume() for x in left.decompose() if x.volume() >= mw ** 3)
         assert len(big) == 2 and big[0] > 1.0, (p.name, big)
+
+
+def _turned(uj, deg):
+    """A pose with C turned about v (through the joint point) by ``deg`` degrees against O."""
+    C, O = uj.bodies
+    v = uj.axes[1]
+    a = np.radians(deg)
+    K = np.array([[0, -v[2], v[1]], [v[2], 0, -v[0]], [-v[1], v[0], 0]])
+    T = np.eye(4)
+    T[:3, :3] = np.eye(3) + np.sin(a) * K + (1 - np.cos(a)) * K @ K
+    T[:3, 3] = uj.center - T[:3, :3] @ uj.center
+    return [("turned", {C: T, O: np.eye(4)})]
+
+
+def test_a_fin_is_not_kept_where_the_collar_turns_round_to_it(kept):
+    """_fin_free measures the turn about v: 60 degrees leaves the fin, 80 (the collar's side
+    within the fin's half thickness and 10 degrees of it) does not."""
+    asm, _ = kept
+    uj = _fins(asm)[0]
+    c, t = asm.profile.clearance, asm.slab_thickness
+    assert B._fin_free(uj, _turned(uj, 60.0), c, t)
+    assert B._fin_free(uj, _turned(uj, -60.0), c, t)
+    assert not B._fin_free(uj, _turned(uj, 80.0), c, t)
+    assert not B._fin_free(uj, _turned(uj, -80.0), c, t)
