@@ -554,7 +554,7 @@ def thin_walls(name: str, solid, min_wall: float, h: float | None = None) -> lis
         # its thinnest spot: the shortest chord through a cell farther from the thick part than
         # a ball's rounding (the cells that make it a thin wall, not an edge of a thick one)
         far = cells[away[tuple(cells.T)] > edge]
-        core = lo + h * far
+        far_mm = lo + h * far
         # (from a cell near the surface, the direction to its nearest sample is not the normal)
         d0, _ = surf.query(lo + h * far)
         far = far[d0 >= 0.4 * min(D.max(), r)] if (d0 >= 0.4 * min(D.max(), r)).any() else far
@@ -566,7 +566,7 @@ def thin_walls(name: str, solid, min_wall: float, h: float | None = None) -> lis
             where, thin = mid[j], float(min(w[j], thickness))
         else:
             where, thin = lo + h * cells[len(cells) // 2], None
-        out.append(ThinWall(name, thickness, float(v), tuple(float(x) for x in where), thin, core, h))
+        out.append(ThinWall(name, thickness, float(v), tuple(float(x) for x in where), thin, far_mm, h))
     return out
 
 
