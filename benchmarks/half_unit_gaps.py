@@ -12,6 +12,10 @@ partners that sit at the clearance read a few tenths of a micrometre either side
 
     python benchmarks/half_unit_gaps.py OUT/circuit.3mf --label "README job" -o RESULTS.json
 
+``--joint-parts`` measures instead every junction's joint part against each part whose bounding
+box comes within 1 mm of its own (session 60: a half unit's fin now reaches to the ball's
+clearance, ``FIN_KEPT``).
+
 Units: mm.  Rerun for the same numbers (the samples' seeds are fixed)."""
 from __future__ import annotations
 
@@ -59,6 +63,33 @@ def read_parts(path) -> dict:
     return out
 
 
+JOINT = re.compile(r"_j\d*_(hi|lo)$|_j_(hi|lo)$")
+
+
+def joint_part_gaps(parts: dict, n: int) -> list:
+    """Each compound or branch junction's joint part (named ``..._j<k>_lo/hi``) against every
+    other part whose bounding box comes within 1 mm of its own: the sampled gap of each pair
+    (session 60: the fin kept past the joint part's ball, ``FIN_KEPT``)."""
+    box = {k: (V.min(0), V.max(0)) for k, (V, _) in parts.items()}
+    names = list(parts)
+    lo = np.array([box[k][0] for k in names])
+    hi = np.array([box[k][1] for k in names])
+
+    def pts(k, seed):
+        return trimesh.sample.sample_surface(trimesh.Trimesh(*parts[k], process=False), n, seed=seed)[0]
+    rows = []
+    for i, j in enumerate(names):
+        if not JOINT.search(j):
+            continue
+        near = np.all((lo <= hi[i] + 1.0) & (hi >= lo[i] - 1.0), axis=1)
+        tree = cKDTree(pts(j, 1))
+        for k in np.nonzero(near)[0]:
+            if names[k] == j:
+                continue
+            rows.append({"a": j, "b": names[k], "gap_mm": round(float(tree.query(pts(names[k], 2))[0].min()), 5)})
+    return rows
+
+
 def main() -> int:
     ap = argparse.ArgumentParser()
     ap.add_argument("mf3", help="3MF written by mlc stl")
@@ -66,10 +97,15 @@ def main() -> int:
     ap.add_argument("-n", type=int, default=60000, help="surface samples per part")
     ap.add_argument("--clearance", type=float, default=0.2, help="mm (mjp: 0.2)")
     ap.add_argument("-o", "--out", required=True)
+    ap.add_argument("--joint-parts", action="store_true",
+                    help="instead: every joint part against every body whose box comes within 1 mm of its own")
     a = ap.parse_args()
     parts = read_parts(a.mf3)
     units = sorted({m.group(1) for n in parts if (m := UNIT.match(n))})
     rows = []
+    if a.joint_parts:
+        rows = joint_part_gaps(parts, a.n)
+        units = []
     for u in units:
         for x, y in (("AB", "DA"), ("BC", "CD")):
             if f"{u}_{x}" not in parts or f"{u}_{y}" not in parts:
@@ -78,7 +114,7 @@ def main() -> int:
                                                     seed=k)[0] for k, s in ((1, x), (2, y)))
             rows.append({"a": f"{u}_{x}", "b": f"{u}_{y}", "gap_mm": round(float(cKDTree(pb).query(pa)[0].min()), 5)})
     g = np.array([r["gap_mm"] for r in rows])
-    out = {"benchmark": "half_unit_gaps", "commit": commit(), "label": a.label, "file": str(a.mf3),
+    out = {"benchmark": "half_unit_gaps" + (" (joint parts)" if a.joint_parts else ""), "commit": commit(), "label": a.label, "file": str(a.mf3),
            "samples_per_part": a.n, "clearance_mm": a.clearance, "pairs": len(rows),
            "min_mm": float(g.min()), "under_clearance_by_0.01_mm_or_more": int((g < a.clearance - 0.01).sum()),
            "smallest": sorted(rows, key=lambda r: r["gap_mm"])[:20]}
