@@ -95,3 +95,29 @@ def web_sections(asm, min_wall, owner=None):
                     lo, hi = (lo, r) if piece.offset(-r, mf.JoinType.Round).is_empty() else (r, hi)
                 out.append(2 * lo)
     return out
+
+
+def mesh_piece(name: str, walls: bool = True, **flags):
+    """A piece of a compiled circuit or robot (tests/data_mesh: NAME.yaml and NAME_poses.npz),
+    built at mjp with mlc.mesh.build's flags set as given (restored after), and its report:
+    ``(assembly, report)``."""
+    import numpy as np
+
+    from mlc.mesh import build as B
+    from mlc.mesh.checks import check_assembly
+    from mlc.mesh.profiles import load_profile
+    from mlc.scene.io import load_scene
+
+    data = ROOT / "tests" / "data_mesh"
+    z = np.load(data / f"{name}_poses.npz")
+    sc = load_scene(data / f"{name}.yaml")
+    poses = {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
+    old = {k: getattr(B, k) for k in flags}
+    try:
+        for k, v in flags.items():
+            setattr(B, k, v)
+        asm = B.build_assembly(sc, load_profile("mjp"), poses, reuse=True)
+    finally:
+        for k, v in old.items():
+            setattr(B, k, v)
+    return asm, check_assembly(asm, walls=walls)

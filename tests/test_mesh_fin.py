@@ -14,7 +14,6 @@ clearance out (``mlc.mesh.build._fin_free``, ``_fin_keep``).
 ``circuit_leaf`` (tests/data_mesh): the README circuit's leaf pages with the circuit's 22 poses."""
 from __future__ import annotations
 
-from pathlib import Path
 
 import manifold3d as mf
 import numpy as np
@@ -25,24 +24,13 @@ from mlc.mesh import shave as S
 from mlc.mesh.build import transform_solid
 from mlc.mesh.walls import thin_walls
 
-DATA = Path(__file__).parent / "data_mesh"
+from helpers import mesh_piece
+
 BLOCKING = ("watertight", "part_count", "min_gap", "states", "retention", "features")
 
 
 def _leaf(kept: bool):
-    from mlc.mesh.checks import check_assembly
-    from mlc.mesh.profiles import load_profile
-    from mlc.scene.io import load_scene
-    z = np.load(DATA / "circuit_leaf_poses.npz")
-    sc = load_scene(DATA / "circuit_leaf.yaml")
-    poses = {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
-    old = B.FIN_KEPT
-    B.FIN_KEPT = kept
-    try:
-        asm = B.build_assembly(sc, load_profile("mjp"), poses, reuse=True)
-    finally:
-        B.FIN_KEPT = old
-    return asm, check_assembly(asm, walls=True)
+    return mesh_piece("circuit_leaf", FIN_KEPT=kept)
 
 
 @pytest.fixture(scope="module")

@@ -9,20 +9,19 @@ tests it on a compiled circuit: some regions go and every blocking check still p
 knuckle, which this pass must leave, and how it is mended at its source.)"""
 from __future__ import annotations
 
-from pathlib import Path
 from types import SimpleNamespace
 
 import manifold3d as mf
 import numpy as np
 import pytest
 
-from mlc.mesh import build as B
 from mlc.mesh import shave as S
 from mlc.mesh.build import HingeAxis, Part
 from mlc.mesh.walls import thin_walls
 
+from helpers import mesh_piece
+
 MW = 0.6
-DATA = Path(__file__).parent / "data_mesh"
 BLOCKING = ("watertight", "part_count", "min_gap", "states", "retention", "features")
 
 
@@ -93,19 +92,7 @@ def test_joint_cores_are_kept():
 
 
 def _leaf(shave: bool):
-    from mlc.mesh.checks import check_assembly
-    from mlc.mesh.profiles import load_profile
-    from mlc.scene.io import load_scene
-    z = np.load(DATA / "circuit_leaf_poses.npz")
-    sc = load_scene(DATA / "circuit_leaf.yaml")
-    poses = {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
-    old = B.SHAVE_THIN
-    B.SHAVE_THIN = shave
-    try:
-        asm = B.build_assembly(sc, load_profile("mjp"), poses, reuse=True)
-    finally:
-        B.SHAVE_THIN = old
-    return asm, check_assembly(asm, walls=True)
+    return mesh_piece("circuit_leaf", SHAVE_THIN=shave)
 
 
 @pytest.fixture(scope="module")
