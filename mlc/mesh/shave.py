@@ -137,5 +137,5 @@ def shave_thin(asm, log=None) -> None:
         if log:
             log(f"shaved {p.name}: {taken} thin region(s)")
     if n_regions:
-        asm.notes.append(f"walls: {n_regions} thin region(s) off {n_parts} bodies' joints taken away "
-                         f"({removed:.3g} mm^3; mlc.mesh.shave)")
+        asm.notes.append(f"walls: {n_regions} thin region(s) that hold nothing, away from the joints, taken off "
+                         f"{n_parts} bodies ({removed:.3g} mm^3; mlc.mesh.shave)")
