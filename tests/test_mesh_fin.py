@@ -14,7 +14,6 @@ clearance out (``mlc.mesh.build._fin_free``, ``_fin_keep``).
 ``circuit_leaf`` (tests/data_mesh): the README circuit's leaf pages with the circuit's 22 poses."""
 from __future__ import annotations
 
-
 import manifold3d as mf
 import numpy as np
 import pytest
