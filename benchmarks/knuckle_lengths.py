@@ -53,14 +53,8 @@ def measure(piece: str, flags: dict) -> list[dict]:
     z = np.load(DATA / f"{piece}_poses.npz")
     sc = load_scene(DATA / f"{piece}.yaml")
     poses = {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
-    old = {k: getattr(B, k) for k in flags}
-    try:
-        for k, v in flags.items():
-            setattr(B, k, v)
+    with B.flags(**flags):
         asm = B.build_assembly(sc, load_profile("mjp"), poses, reuse=True)
-    finally:
-        for k, v in old.items():
-            setattr(B, k, v)
     rows = []
     for ax in asm.axes:
         if ax.joint is None:

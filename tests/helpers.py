@@ -112,12 +112,6 @@ def mesh_piece(name: str, walls: bool = True, **flags):
     z = np.load(data / f"{name}_poses.npz")
     sc = load_scene(data / f"{name}.yaml")
     poses = {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
-    old = {k: getattr(B, k) for k in flags}
-    try:
-        for k, v in flags.items():
-            setattr(B, k, v)
+    with B.flags(**flags):
         asm = B.build_assembly(sc, load_profile("mjp"), poses, reuse=True)
-    finally:
-        for k, v in old.items():
-            setattr(B, k, v)
     return asm, check_assembly(asm, walls=walls)

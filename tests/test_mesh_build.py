@@ -314,3 +314,20 @@ def test_a_final_trim_that_splits_a_part_is_not_kept(monkeypatch):
     assert len(build_assembly(sc, load_profile("mjp"), poses, reuse=True).part("j").solid.decompose()) == 1
     monkeypatch.setattr(B, "KEEP_WHOLE", False)
     assert len(build_assembly(sc, load_profile("mjp"), poses, reuse=True).part("j").solid.decompose()) == 2
+
+
+def test_flags_are_set_inside_the_block_and_restored_after_it_even_when_it_raises():
+    from mlc.mesh import build as B
+
+    before = (B.GROW_STACKS, B.SHAVE_THIN)
+    with B.flags(GROW_STACKS=not before[0], SHAVE_THIN=not before[1]):
+        assert (B.GROW_STACKS, B.SHAVE_THIN) == (not before[0], not before[1])
+    assert (B.GROW_STACKS, B.SHAVE_THIN) == before
+    with pytest.raises(RuntimeError):
+        with B.flags(FIN_KEPT=not B.FIN_KEPT):
+            raise RuntimeError("inside")
+    assert B.FIN_KEPT is True
+    with pytest.raises(AttributeError, match="NO_SUCH_FLAG"):
+        with B.flags(GROW_STACKS=False, NO_SUCH_FLAG=1):
+            pass
+    assert B.GROW_STACKS == before[0]

@@ -49,14 +49,8 @@ def piece():
 def _build(piece, **flags):
     """The piece at mjp, with mlc.mesh.build's flags (``WEB_BRIDGES``, ``ROD_WALL``) set as given."""
     sc, poses = piece
-    old = {k: getattr(B, k) for k in flags}
-    try:
-        for k, v in flags.items():
-            setattr(B, k, v)
+    with B.flags(**flags):
         return build_assembly(sc, load_profile("mjp"), poses, reuse=True)
-    finally:
-        for k, v in old.items():
-            setattr(B, k, v)
 
 
 @pytest.fixture(scope="module")

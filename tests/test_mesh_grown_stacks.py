@@ -36,12 +36,8 @@ def _piece(name):
 
 def _build(grow: bool):
     sc, poses = _piece("circuit_junction")
-    old = B.GROW_STACKS
-    B.GROW_STACKS = grow
-    try:
+    with B.flags(GROW_STACKS=grow):
         asm = build_assembly(sc, load_profile("mjp"), poses, reuse=True)
-    finally:
-        B.GROW_STACKS = old
     return asm, check_assembly(asm)
 
 

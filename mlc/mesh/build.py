@@ -47,6 +47,7 @@ clearance.
 """
 from __future__ import annotations
 
+import contextlib
 import copy
 import itertools
 import math
@@ -109,6 +110,23 @@ GROWN_CLEAR = True
 #: the collar never turns round to it (:func:`_fin_keep`; session 60)
 FIN_KEPT = True
 SHAVE_THIN = True        # the thin webs the trims leave away from a body's joints, taken away (mlc.mesh.shave; session 60)
+
+
+@contextlib.contextmanager
+def flags(**values):
+    """Set this module's build flags (``GROW_STACKS=False``, ...) for the duration of a ``with``
+    block, restored after it, also when it raises: for measuring what a flag changes (tests,
+    benchmarks).  An unknown flag's name is an error before anything is set."""
+    g = globals()
+    unknown = [k for k in values if k not in g or not k.isupper()]
+    if unknown:
+        raise AttributeError(f"mlc.mesh.build has no flag {', '.join(unknown)}")
+    old = {k: g[k] for k in values}
+    g.update(values)
+    try:
+        yield
+    finally:
+        g.update(old)
 
 
 # --------------------------------------------------------------------------- primitives
