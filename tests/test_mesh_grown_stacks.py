@@ -207,40 +207,10 @@ def test_a_grown_stack_near_another_body_is_built_short(monkeypatch):
     assert check_assembly(asm, walls=False).check("min_gap").ok
 
 
-def test_split_growth_puts_what_the_ball_can_spare_on_the_joints_side_and_the_rest_far():
-    """Session 61 (``SPLIT_GROWTH``): a stack whose far side has no room for all of its growth
-    grows the rest on the joint's side, as much there as the ball can lose (``slack``), less where
-    ``far_ok`` refuses that stretch, nothing where no split fits.  A model ``far_ok``: the far side
-    takes up to ``far_room`` mm, the joint's side up to ``near_room``."""
-    def far_ok_for(far_room, near_room, calls):
-        def far_ok(ax, side, a0, a1):
-            calls.append((side, a0, a1))
-            return (a1 - a0) <= (far_room if side == -1 else near_room) + 1e-9
-        return far_ok
-    g, S0, grow = 0.2, 2.6, 0.4
-    calls: list = []
-    f, n = B._split_growth(None, +1, S0, grow, 0.1, g, far_ok_for(0.33, 1.0, calls))
-    assert (round(f, 9), round(n, 9)) == (0.3, 0.1)
-    # the stretches asked for start where the short stack ends: far side -1, the joint's side +1
-    assert (-1, S0 / 2, S0 / 2 + 0.3) in [(s, a, round(b, 9)) for s, a, b in calls]
-    # the joint's side refuses 0.1 but takes 0.05: the far side must then take 0.35
-    f, n = B._split_growth(None, +1, S0, grow, 0.1, g, far_ok_for(0.36, 0.06, []))
-    assert (round(f, 9), round(n, 9)) == (0.35, 0.05)
-    # ... and where the far side has no room for 0.35 either, no split
-    assert B._split_growth(None, +1, S0, grow, 0.1, g, far_ok_for(0.33, 0.06, [])) == (0.0, 0.0)
-    # no slack (the ball already at the minimum wall round its pin): nothing is asked
-    calls = []
-    assert B._split_growth(None, +1, S0, grow, 0.0, g, far_ok_for(1, 1, calls)) == (0.0, 0.0) and not calls
-    # slack for all of it: the far side need not grow at all (and is not asked)
-    calls = []
-    f, n = B._split_growth(None, +1, S0, grow, 0.5, g, far_ok_for(0.0, 1.0, calls))
-    assert (round(f, 9), round(n, 9)) == (0.0, 0.4) and calls and all(s == +1 for s, *_ in calls)
-
-
 def test_far_clear_samples_again_finer_where_the_coarse_samples_are_within_their_own_reach():
     """``_far_clear`` samples the two knuckle cylinders every quarter clearance: a pair sampled
     nearer than the clearance plus that sampling's reach (step / sqrt 2) was refused though it may
-    keep the clearance.  With ``SPLIT_GROWTH`` such a pair is sampled again five times finer.  Two
+    keep the clearance.  With ``FINE_GAPS`` such a pair is sampled again five times finer.  Two
     coaxial stacks end to end (their gap is the distance of their end faces), the stack on x
     growing 0.3 mm towards the one on y: a gap between the clearance and the coarse bound is
     refused without, let grow with; a gap under the clearance is refused either way."""
@@ -255,6 +225,6 @@ def test_far_clear_samples_again_finer_where_the_coarse_samples_are_within_their
     for gap, fine in ((0.21, True), (0.21, False), (0.19, True)):
         ax = axis("hx", ["x1", "x2"], 0.0)
         bx = axis("hy", ["y1", "y2"], 1.25 + 0.3 + gap + 1.25)
-        with B.flags(SPLIT_GROWTH=fine):
+        with B.flags(FINE_GAPS=fine):
             ok = B._far_clear(ax, 1, 1.25, 1.55, [ax, bx], slabs, [], 0.6, c, [])
         assert ok == (gap > c and fine), (gap, fine, ok)

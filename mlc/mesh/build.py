@@ -110,9 +110,10 @@ GROWN_CLEAR = True
 #: the collar never turns round to it (:func:`_fin_keep`; session 60)
 FIN_KEPT = True
 SHAVE_THIN = True        # the thin webs the trims leave away from a body's joints, taken away (mlc.mesh.shave; session 60)
-#: a compound stack with no room on its far side for all of its growth grows the rest on the
-#: joint's side, its ball shorter by that much (:func:`_split_growth`; session 61)
-SPLIT_GROWTH = True
+#: where a grown stack's coarse samples (:func:`_far_clear`, :func:`_grown_near`) come nearer than the
+#: clearance plus their own reach but not nearer than the clearance, they are sampled again five
+#: times finer before the stack is kept short (session 61)
+FINE_GAPS = True
 
 
 @contextlib.contextmanager
@@ -617,7 +618,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
     state_T = _state_transforms(scene, prof, poses)
 
     grown: dict = {}      # id(axis) -> joint: compound stacks grown to the minimum wall (far side)
-    grown_far: dict = {}  # id(axis) -> the stretches it grew into (mm from its origin; _compound's "far")
+    grown_far: dict = {}  # id(axis) -> the stretch it grew into (mm from its origin; _compound's "far")
     posed_mid: list = []  # every hinge's midpoint in every pose, made on first use (_far_clear)
 
     def far_ok(ax, side, a0, a1):
@@ -799,10 +800,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
     stacks = [ax for ax in axes if ax.joint is not None]
     if stacks and kmin > prof.min_feature + 1e-9:
         short = [ax for ax in stacks if id(ax) not in grown]
-        split = sum(len(grown_far.get(id(ax), ())) > 1 for ax in stacks)
         notes.append(f"compound junctions: {len(grown)} of {len(stacks)} stacks with knuckles of the minimum wall "
-                     f"{kmin:g} mm (grown on the side away from the joint"
-                     + (f"; {split} of them partly on the joint's side, their balls smaller" if split else "") + ")"
+                     f"{kmin:g} mm (grown on the side away from the joint)"
                      + (f"; {len(short)} with {min(ax.knuckle for ax in short):.3g} mm knuckles, where a longer "
                         "stack would come near another hinge's in some pose or leave a body in pieces" if short else ""))
     if memo is not None:
@@ -836,16 +835,12 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
         if ax.span > ax.scene_span + 1e-9:
             for bn in ax.bodies:
                 if GROWN_CLEAR and id(ax) in grown_far:
-                    # a grown stack: over the stretches it grew into (at its ends), plates only as
-                    # long as its knuckles need (_grown_plates); over the rest of the span, as before
-                    lo, hi = -ax.span / 2, ax.span / 2
-                    for a0, a1 in grown_far[id(ax)]:
-                        if a0 <= -ax.span / 2 + 1e-9:
-                            lo = a1
-                        else:
-                            hi = a0
-                        plates[bn] += _grown_plates(bn, slabs[bn], ax, (a0, a1), reach, t)
-                    plates[bn] += _yoke_plates(slabs[bn], ax.origin, ax.direction, [(lo, hi)], reach, t)
+                    # a grown stack: over the stretch it grew into, plates only as long as its
+                    # knuckles need (_grown_plates); over the rest of the span, as before
+                    a0, a1 = grown_far[id(ax)]
+                    rest = (a1, ax.span / 2) if a0 <= -ax.span / 2 + 1e-9 else (-ax.span / 2, a0)
+                    plates[bn] += _yoke_plates(slabs[bn], ax.origin, ax.direction, [rest], reach, t)
+                    plates[bn] += _grown_plates(bn, slabs[bn], ax, (a0, a1), reach, t)
                 else:
                     plates[bn] += _yoke_plates(slabs[bn], ax.origin, ax.direction, [(-ax.span / 2, ax.span / 2)],
                                                reach, t)
@@ -2410,28 +2405,6 @@ def _never(*_) -> bool:
     return False
 
 
-def _split_growth(ax: HingeAxis, sg, S0, grow, slack, g, far_ok) -> tuple[float, float]:
-    """A compound stack's growth ``grow`` (mm) split between its far side and the joint's side
-    (``sg``: the joint's side along ``ax``) where the far side has no room for all of it: as much
-    on the joint's side as ``slack`` allows (mm the ball may lose and keep the minimum wall round
-    its pin), the rest on the far side; where ``far_ok`` refuses either stretch, less on the joint's
-    side (steps of a quarter knuckle gap).  The far side's stretch is kept short because its
-    stack meets the next stack end to end there, and ``far_ok`` measures the knuckles, not the
-    plates that widen the slabs to them (:func:`_grown_near`, later, does).  ``(far, near)`` in
-    mm, ``(0, 0)`` where no split fits.  (Session 61: on the README circuit 151 of 866 stacks
-    stayed short, mostly a chain's stack whose far end meets the previous half unit's stack end
-    to end, 0.165 mm apart at rest where the clearance is 0.2.)"""
-    if slack <= 1e-9:
-        return 0.0, 0.0
-    step = 0.25 * g if g > 0 else 0.05
-    lo = max(0.0, grow - slack)          # the least the far side may take: tried first
-    for f in [lo] + [x for x in np.arange(grow - step, lo + 1e-9, -step)][::-1]:
-        n = grow - f
-        if (f <= 1e-9 or far_ok(ax, -sg, S0 / 2, S0 / 2 + f)) and far_ok(ax, sg, S0 / 2, S0 / 2 + n):
-            return float(f), float(n)
-    return 0.0, 0.0
-
-
 def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mid: list) -> bool:
     """Whether the knuckle stack of ``ax`` may grow on its ``side`` (+-1 along its direction)
     from ``a0`` to ``a1`` (mm from its origin): its bodies' slabs lie along the axis (a hinge in
@@ -2498,8 +2471,8 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
             d_ = gap(S_own, S_other)
             if d_ < c + step / np.sqrt(2):
                 # sampled nearer than the clearance and the sampling's reach: at least as near as
-                # sampled; between those, sampled again five times finer (SPLIT_GROWTH)
-                if not SPLIT_GROWTH or d_ < c:
+                # sampled; between the two, sampled again five times finer (FINE_GAPS)
+                if not FINE_GAPS or d_ < c:
                     return False
                 fine = step / 5
                 if gap(_cylinder_points(p0, p1, ax.R, fine), _cylinder_points(q0, q1, bx.R, fine)) < c + fine / np.sqrt(2):
@@ -2508,8 +2481,8 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
 
 
 def _grown_near(grown_axes, far, shapes, axes, ujoints, slabs, state_T, reach, t, c) -> list:
-    """The grown stacks (of ``grown_axes``; ``far``: ``{id(axis): [(a0, a1), ...]}``, the stretches
-    each grew into, mm from its origin) whose new material comes nearer than the clearance ``c`` to a
+    """The grown stacks (of ``grown_axes``; ``far``: ``{id(axis): (a0, a1)}``, the stretch each
+    grew into, mm from its origin) whose new material comes nearer than the clearance ``c`` to a
     body other than the stack's own, at rest or in a pose of ``state_T``.  The new material: the
     knuckle cylinders over that stretch and the plates widening each body's slabs over it
     (:func:`_yoke_plates`), as surface points every ``c / 2`` (a surface point within
@@ -2561,8 +2534,8 @@ def _grown_near(grown_axes, far, shapes, axes, ujoints, slabs, state_T, reach, t
                     return True
         return False
 
-    out = []
-    def points(ax, bn, a0, a1, step_):
+    def points(ax, bn, step_):
+        a0, a1 = far[id(ax)]
         return np.concatenate([_cylinder_points(ax.origin + a0 * ax.direction, ax.origin + a1 * ax.direction, ax.R,
                                                 step_)]
                               + [_box_points(sb, step_) for sb in _grown_plates(bn, slabs[bn], ax, (a0, a1), reach, t)])
@@ -2570,15 +2543,13 @@ def _grown_near(grown_axes, far, shapes, axes, ujoints, slabs, state_T, reach, t
     fine = step / 5
     out = []
     for ax in grown_axes:
-        for a0, a1 in far[id(ax)]:
-            # sampled nearer than the clearance and the sampling's reach: at least as near as sampled;
-            # between those, sampled again five times finer (SPLIT_GROWTH)
-            if any(near(ax, bn, points(ax, bn, a0, a1, step))
-                   and (not SPLIT_GROWTH or near(ax, bn, points(ax, bn, a0, a1, step), c)
-                        or near(ax, bn, points(ax, bn, a0, a1, fine), c + fine / np.sqrt(2)))
-                   for bn in ax.bodies):
-                out.append(ax)
-                break
+        # sampled nearer than the clearance and the sampling's reach: at least as near as sampled;
+        # between the two, sampled again five times finer (FINE_GAPS)
+        if any(near(ax, bn, points(ax, bn, step))
+               and (not FINE_GAPS or near(ax, bn, points(ax, bn, step), c)
+                    or near(ax, bn, points(ax, bn, fine), c + fine / np.sqrt(2)))
+               for bn in ax.bodies):
+            out.append(ax)
     return out
 
 
@@ -2669,12 +2640,9 @@ def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, 
     grow on its far side from ``a0`` to ``a1`` (mm from ``ax.origin``); its end on the joint's side
     then stays where a stack of minimum-feature knuckles ends, so the collar, the ball and the
     yokes are that stack's, and the axis's origin moves by half the growth (``"origin"``,
-    ``"grown"``).  Where the far side has room for part of the growth only, the rest may go on
-    the joint's side (:func:`_split_growth`; the collar and the ball then shorter by it, the ball's
-    wall round the pin still the minimum wall).  Else (``far_ok`` None or false) knuckles of the
-    minimum feature, as before session 57: four knuckles and three gaps in a 2.5 mm slab leave
-    0.5 mm at mjp, under its 0.6 mm wall.  ``"far"``: the stretches grown into (mm from the new
-    origin), the far side's first."""
+    ``"grown"``).  Else (``far_ok`` None or false) knuckles of the minimum feature, as before
+    session 57: four knuckles and three gaps in a 2.5 mm slab leave 0.5 mm at mjp, under its
+    0.6 mm wall."""
     c, g = prof.clearance, prof.knuckle_gap
     a = float(np.dot(center - ax.origin, ax.direction))
     sg = 1.0 if a > 0 else -1.0
@@ -2688,13 +2656,10 @@ def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, 
     # hinge's stack comes near that stretch in any pose (``far_ok``); else minimum-feature knuckles
     S0 = max(L, nk * min(kmin, prof.min_feature) + (nk - 1) * g)
     S = max(L, nk * kmin + (nk - 1) * g)
-    f, n = S - S0, 0.0           # mm grown on the far side, on the joint's side
-    if f > 1e-9 and (far_ok is None or not far_ok(ax, -sg, S0 / 2, S0 / 2 + f)):
-        f, n = _split_growth(ax, sg, S0, S - S0, abs(a) - S0 / 2 - g - (r_pin + prof.min_wall), g,
-                             far_ok) if (SPLIT_GROWTH and far_ok is not None) else (0.0, 0.0)
-        S = S0 + f + n
+    if S > S0 + 1e-9 and (far_ok is None or not far_ok(ax, -sg, S0 / 2, S - S0 / 2)):
+        S = S0
     k = (S - (nk - 1) * g) / nk
-    shift = 0.5 * (f - n)        # the origin moves away from the joint by this much
+    shift = 0.5 * (S - S0)
     origin = ax.origin - sg * shift * ax.direction
     a = a + sg * shift
     intervals: dict = {bn: [] for bn in blist}
@@ -2718,7 +2683,7 @@ def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, 
                     dO, o_axis = abs(b) - bx.span / 2, bx
                     o_body = next(o for o in (others or [other]) if o in bx.bodies)
     hub_r = float(min(R, d0 - g, dO - c))
-    if hub_r < r_pin + prof.min_wall - 1e-9:
+    if hub_r < r_pin + prof.min_wall:
         return None
     # the other body's yoke knuckles (radius R about the second pin, from +-v0 outwards) clear
     # the collar (axially, by the knuckle gap) and the corners of both stacks (by the clearance)
@@ -2731,10 +2696,8 @@ def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, 
     lay_c = lay
     # the stretch the stack grew into (mm from the new origin along the axis): past the far end
     # of the short stack, out to the grown stack's far end
-    far = [tuple(sorted((-sg * (S / 2 - f), -sg * S / 2)))] if f > 1e-9 else []
-    if n > 1e-9:     # ... and the stretch it grew into on the joint's side (SPLIT_GROWTH)
-        far.append(tuple(sorted((sg * (S / 2 - n), sg * S / 2))))
-    return {"axis": ax, "origin": origin, "grown": bool(far), "far": far, "u": u.copy(), "span": S, "k": k,
+    far = tuple(sorted((-sg * (S0 - S / 2), -sg * S / 2)))
+    return {"axis": ax, "origin": origin, "grown": shift > 0, "far": far, "u": u.copy(), "span": S, "k": k,
             "intervals": intervals, "stack": stack,
             "joint_iv": joint_iv, "hub_r": hub_r, "collar": d0 - g, "hub_v": 2 * (v0 - g), "layout": lay,
             "o_axis": o_axis, "dO": dO, "layout_c": lay_c, "o_body": o_body}
