@@ -14,7 +14,8 @@ partners that sit at the clearance read a few tenths of a micrometre either side
 
 ``--joint-parts`` measures instead every junction's joint part against each part whose bounding
 box comes within 1 mm of its own (session 60: a half unit's fin now reaches to the ball's
-clearance, ``FIN_KEPT``).
+clearance, ``FIN_KEPT``); ``--parts REGEX`` the same for the parts whose names match REGEX
+(session 61: the bodies of the compound stacks that grew with ``FINE_GAPS``).
 
 Units: mm.  Rerun for the same numbers (the samples' seeds are fixed)."""
 from __future__ import annotations
@@ -66,10 +67,11 @@ def read_parts(path) -> dict:
 JOINT = re.compile(r"_j\d*_(hi|lo)$|_j_(hi|lo)$")
 
 
-def joint_part_gaps(parts: dict, n: int) -> list:
-    """Each compound or branch junction's joint part (named ``..._j<k>_lo/hi``) against every
-    other part whose bounding box comes within 1 mm of its own: the sampled gap of each pair
-    (session 60: the fin kept past the joint part's ball, ``FIN_KEPT``)."""
+def joint_part_gaps(parts: dict, n: int, which=JOINT) -> list:
+    """Each part whose name ``which`` matches (by default each compound or branch junction's joint
+    part, named ``..._j<k>_lo/hi``) against every other part whose bounding box comes within 1 mm
+    of its own: the sampled gap of each pair (session 60: the fin kept past the joint part's
+    ball, ``FIN_KEPT``).  A pair of two matching parts is measured once."""
     box = {k: (V.min(0), V.max(0)) for k, (V, _) in parts.items()}
     names = list(parts)
     lo = np.array([box[k][0] for k in names])
@@ -79,12 +81,12 @@ def joint_part_gaps(parts: dict, n: int) -> list:
         return trimesh.sample.sample_surface(trimesh.Trimesh(*parts[k], process=False), n, seed=seed)[0]
     rows = []
     for i, j in enumerate(names):
-        if not JOINT.search(j):
+        if not which.search(j):
             continue
         near = np.all((lo <= hi[i] + 1.0) & (hi >= lo[i] - 1.0), axis=1)
         tree = cKDTree(pts(j, 1))
         for k in np.nonzero(near)[0]:
-            if names[k] == j:
+            if names[k] == j or (k < i and which.search(names[k])):
                 continue
             rows.append({"a": j, "b": names[k], "gap_mm": round(float(tree.query(pts(names[k], 2))[0].min()), 5)})
     return rows
@@ -99,12 +101,14 @@ def main() -> int:
     ap.add_argument("-o", "--out", required=True)
     ap.add_argument("--joint-parts", action="store_true",
                     help="instead: every joint part against every body whose box comes within 1 mm of its own")
+    ap.add_argument("--parts", metavar="REGEX",
+                    help="instead: every part whose name matches REGEX against every body whose box comes within 1 mm of its own")
     a = ap.parse_args()
     parts = read_parts(a.mf3)
     units = sorted({m.group(1) for n in parts if (m := UNIT.match(n))})
     rows = []
-    if a.joint_parts:
-        rows = joint_part_gaps(parts, a.n)
+    if a.joint_parts or a.parts:
+        rows = joint_part_gaps(parts, a.n, re.compile(a.parts) if a.parts else JOINT)
         units = []
     for u in units:
         for x, y in (("AB", "DA"), ("BC", "CD")):
@@ -114,7 +118,8 @@ def main() -> int:
                                                     seed=k)[0] for k, s in ((1, x), (2, y)))
             rows.append({"a": f"{u}_{x}", "b": f"{u}_{y}", "gap_mm": round(float(cKDTree(pb).query(pa)[0].min()), 5)})
     g = np.array([r["gap_mm"] for r in rows])
-    out = {"benchmark": "half_unit_gaps" + (" (joint parts)" if a.joint_parts else ""), "commit": commit(), "label": a.label, "file": str(a.mf3),
+    kind = f" (parts {a.parts})" if a.parts else " (joint parts)" if a.joint_parts else ""
+    out = {"benchmark": "half_unit_gaps" + kind, "commit": commit(), "label": a.label, "file": str(a.mf3),
            "samples_per_part": a.n, "clearance_mm": a.clearance, "pairs": len(rows),
            "min_mm": float(g.min()), "under_clearance_by_0.01_mm_or_more": int((g < a.clearance - 0.01).sum()),
            "smallest": sorted(rows, key=lambda r: r["gap_mm"])[:20]}

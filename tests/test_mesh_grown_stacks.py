@@ -228,3 +228,36 @@ def test_far_clear_samples_again_finer_where_the_coarse_samples_are_within_their
         with B.flags(FINE_GAPS=fine):
             ok = B._far_clear(ax, 1, 1.25, 1.55, [ax, bx], slabs, [], 0.6, c, [])
         assert ok == (gap > c and fine), (gap, fine, ok)
+
+
+def test_fine_gaps_let_a_stack_grow_next_to_the_previous_unit_and_keep_the_clearance():
+    """Session 61: ``circuit_fine`` (tests/data_mesh: half units ``w_b_0_25`` to ``_29`` of the
+    README circuit with its 22 print poses, cut by ``mlc.mesh.pipeline.sub_scene``) holds one of
+    the 11 stacks of that circuit that grow only with ``FINE_GAPS``: stack D of ``w_b_0_27``, whose
+    grown far end comes within the coarse samples' reach of the clearance from the previous half
+    unit.  With it every stack of the piece grows, every blocking check passes and no wall is
+    under the minimum; without it that stack keeps 0.5 mm knuckles and thin regions.  The grown
+    stack's bodies keep the clearance from the previous half unit's parts, measured outside mlc
+    (trimesh samples, a k-d tree)."""
+    prof = load_profile("mjp")
+    sc, poses = _piece("circuit_fine")
+    with B.flags(FINE_GAPS=True):
+        asm = build_assembly(sc, prof, poses, reuse=True)
+    with B.flags(FINE_GAPS=False):
+        old = build_assembly(sc, prof, poses, reuse=True)
+    k = {ax.name: ax.knuckle for ax in _stacks(asm)}
+    k_old = {ax.name: ax.knuckle for ax in _stacks(old)}
+    assert len(k) == 8 and all(v >= prof.min_wall - 1e-9 for v in k.values()), k
+    assert k_old["w_b_0_27_hD"] < prof.min_wall - 1e-9, k_old
+    assert all(v >= prof.min_wall - 1e-9 for n, v in k_old.items() if n != "w_b_0_27_hD"), k_old
+    rep, rep_old = check_assembly(asm), check_assembly(old)
+    for name in BLOCKING:
+        assert rep.check(name).ok, (name, rep.check(name).detail, rep.check(name).failures)
+    assert rep.check("wall_thickness").ok, rep.check("wall_thickness").failures
+    assert not rep_old.check("wall_thickness").ok
+    parts = {p.name: p for p in asm.parts}
+    stack = [n for n in ("w_b_0_27_CD", "w_b_0_27_DA") if n in parts]
+    prev = [n for n in parts if n.startswith("w_b_0_26_")]
+    assert len(stack) == 2 and len(prev) == 4
+    gaps = {(a, b): _sampled_gap(parts[a], parts[b], n=100_000) for a in stack for b in prev}
+    assert min(gaps.values()) >= prof.clearance - 1e-3, gaps
