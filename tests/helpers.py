@@ -97,21 +97,27 @@ def web_sections(asm, min_wall, owner=None):
     return out
 
 
-def mesh_piece(name: str, walls: bool = True, **flags):
-    """A piece of a compiled circuit or robot (tests/data_mesh: NAME.yaml and NAME_poses.npz),
-    built at mjp with mlc.mesh.build's flags set as given (restored after), and its report:
-    ``(assembly, report)``."""
+def load_piece(name: str):
+    """A piece of a compiled circuit or robot as stored in tests/data_mesh (NAME.yaml, its scene,
+    and NAME_poses.npz, the print poses it was cut with): ``(scene, {pose: (pos, quat)})``."""
     import numpy as np
 
-    from mlc.mesh import build as B
-    from mlc.mesh.checks import check_assembly
-    from mlc.mesh.profiles import load_profile
     from mlc.scene.io import load_scene
 
     data = ROOT / "tests" / "data_mesh"
     z = np.load(data / f"{name}_poses.npz")
-    sc = load_scene(data / f"{name}.yaml")
-    poses = {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
+    return load_scene(data / f"{name}.yaml"), {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
+
+
+def mesh_piece(name: str, walls: bool = True, **flags):
+    """A piece of a compiled circuit or robot (tests/data_mesh: NAME.yaml and NAME_poses.npz),
+    built at mjp with mlc.mesh.build's flags set as given (restored after), and its report:
+    ``(assembly, report)``."""
+    from mlc.mesh import build as B
+    from mlc.mesh.checks import check_assembly
+    from mlc.mesh.profiles import load_profile
+
+    sc, poses = load_piece(name)
     with B.flags(**flags):
         asm = B.build_assembly(sc, load_profile("mjp"), poses, reuse=True)
     return asm, check_assembly(asm, walls=walls)

@@ -18,8 +18,6 @@ relieved by ``_relieve_host_holes``; and in row 11 the yoke of junction 61/62, t
 junction's twist, grazed its host's slab face (2e-5 mm^3), cleared by ``_clear_tipped_yokes``."""
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -28,13 +26,12 @@ from mlc.mesh.build import build_assembly
 from mlc.mesh.checks import check_assembly
 from mlc.mesh.profiles import load_profile
 
-DATA = Path(__file__).parent / "data_mesh"
+from helpers import load_piece
+
 
 
 def _piece(name):
-    from mlc.scene.io import load_scene
-    z = np.load(DATA / f"{name}_poses.npz")
-    return load_scene(DATA / f"{name}.yaml"), {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
+    return load_piece(name)
 
 
 def _pairs(asm):

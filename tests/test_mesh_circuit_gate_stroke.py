@@ -13,18 +13,16 @@ every logic state.  Such a pair now gets the motion trim in poses interpolated a
 of the path (``_clear_strokes``)."""
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
-from mlc.geometry.rotation import quat_to_matrix
 from mlc.mesh import build as B
 from mlc.mesh.build import build_assembly, transform_solid
 from mlc.mesh.checks import check_assembly
 from mlc.mesh.profiles import load_profile
 
-DATA = Path(__file__).parent / "data_mesh"
+from helpers import load_piece
+
 RUBS = {"state 01@0.71: g3_b_lo intersects g3_out_hi", "state 10@0.71: g3_a_lo intersects g3_out_hi",
         "state 01@0.86: g3_b_lo intersects g3_out_hi", "state 10@0.86: g3_a_lo intersects g3_out_hi"}
 BLOCKING = ("watertight", "part_count", "min_gap", "retention", "features")
@@ -32,9 +30,7 @@ BLOCKING = ("watertight", "part_count", "min_gap", "retention", "features")
 
 @pytest.fixture(scope="module")
 def piece():
-    from mlc.scene.io import load_scene
-    z = np.load(DATA / "circuit_g3_poses.npz")
-    return load_scene(DATA / "circuit_g3.yaml"), {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
+    return load_piece("circuit_g3")
 
 
 @pytest.fixture(scope="module")
@@ -76,9 +72,8 @@ def test_the_tips_keep_clear_along_the_whole_stroke(built, piece):
     ``@0.57`` to the state; each lever keeps clear of ``out_hi`` in every one, and keeps the
     clearance in the coarse poses."""
     asm, _ = built
-    sc, poses = piece
+    _, poses = piece
     c = asm.profile.clearance
-    names = [b.name for b in sc.bodies]
     for st, lever in (("01", "g3_b_lo"), ("10", "g3_a_lo")):
         seq = [f"{st}@0.57", f"{st}@0.71", f"{st}@0.86", st]
         for k in seq:

@@ -19,8 +19,6 @@ Both thin sides of a rod are now printed at the slab thickness.
 it and the whole circuit's 22 poses (see tests/test_mesh_circuit_gate_stroke.py)."""
 from __future__ import annotations
 
-from pathlib import Path
-
 import manifold3d as mf
 import numpy as np
 import pytest
@@ -31,19 +29,16 @@ from mlc.mesh.build import build_assembly
 from mlc.mesh.checks import check_assembly
 from mlc.mesh.profiles import load_profile
 from mlc.mesh.walls import thin_walls
-from mlc.scene.io import load_scene
 
-from helpers import web_sections
+from helpers import load_piece, web_sections
 
-DATA = Path(__file__).parent / "data_mesh"
 LEVERS = ("g3_a_lo", "g3_a_hi", "g3_b_lo", "g3_b_hi")
 BLOCKING = ("watertight", "part_count", "min_gap", "states", "retention", "features")
 
 
 @pytest.fixture(scope="module")
 def piece():
-    z = np.load(DATA / "circuit_g3_poses.npz")
-    return load_scene(DATA / "circuit_g3.yaml"), {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
+    return load_piece("circuit_g3")
 
 
 def _build(piece, **flags):

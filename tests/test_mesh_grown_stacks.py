@@ -14,8 +14,6 @@ built again with that stack short.
 with their four junctions (20 bodies, 8 joint parts) and the circuit's 22 print poses."""
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -24,14 +22,13 @@ from mlc.mesh.build import build_assembly
 from mlc.mesh.checks import check_assembly
 from mlc.mesh.profiles import load_profile
 
-DATA = Path(__file__).parent / "data_mesh"
+from helpers import load_piece
+
 BLOCKING = ("watertight", "part_count", "min_gap", "states", "retention", "features")
 
 
 def _piece(name):
-    from mlc.scene.io import load_scene
-    z = np.load(DATA / f"{name}_poses.npz")
-    return load_scene(DATA / f"{name}.yaml"), {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
+    return load_piece(name)
 
 
 def _build(grow: bool):

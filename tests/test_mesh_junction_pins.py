@@ -15,6 +15,8 @@ from mlc.mesh import build as B
 from mlc.mesh.build import build_assembly
 from mlc.mesh.profiles import load_profile
 
+from helpers import load_piece
+
 BEND = 12.0     # degrees about the pair's axis (lo -> hi): the pin across the slab twists by 9.96
 
 
@@ -178,12 +180,7 @@ def test_a_one_sided_yoke_takes_the_least_twisted_pin_when_only_its_side_is_clea
 def _wrist():
     """20 bodies of the Tetris robot (its wrist units ``rc_u4_dn_w0..w2`` and the coupling
     chain's last half units) and the whole robot's 22 print poses (tests/data_mesh)."""
-    from pathlib import Path
-
-    from mlc.scene.io import load_scene
-    d = Path(__file__).parent / "data_mesh"
-    z = np.load(d / "robot_wrist_poses.npz")
-    return load_scene(d / "robot_wrist.yaml"), {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
+    return load_piece("robot_wrist")
 
 
 def test_a_turned_pin_that_cuts_its_other_body_in_two_is_chosen_again(monkeypatch):

@@ -25,6 +25,8 @@ from mlc.mesh.checks import check_assembly
 from mlc.mesh.pipeline import sub_scene
 from mlc.mesh.profiles import load_profile
 
+from helpers import load_piece
+
 DATA = Path(__file__).parent / "data_mesh"
 PAIR = ("g2_out_lo", "g2_out_hi")
 
@@ -87,10 +89,7 @@ def _robot_g2():
     """Gate g2 of the README robot and two bond hops round it (20 bodies: its input chains' last
     and the coupling's first half units whole), with the whole robot's 22 print poses
     (``state_poses`` of its largest mechanism)."""
-    from mlc.scene.io import load_scene
-    z = np.load(DATA / "robot_g2_poses.npz")
-    return (load_scene(DATA / "robot_g2.yaml"),
-            {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])})
+    return load_piece("robot_g2")
 
 
 def test_turned_one_sided_yokes_on_crossed_output_levers_leave_their_free_side(monkeypatch):

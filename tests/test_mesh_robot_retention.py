@@ -12,9 +12,6 @@ robot's ``retention`` failures.  The relief is now cut only as far as every part
 hinge stays retained (``RELIEF_RETAINED``)."""
 from __future__ import annotations
 
-from pathlib import Path
-
-import numpy as np
 import pytest
 
 from mlc.mesh import build as B
@@ -22,14 +19,13 @@ from mlc.mesh.build import build_assembly
 from mlc.mesh.checks import _retention, check_assembly
 from mlc.mesh.profiles import load_profile
 
-DATA = Path(__file__).parent / "data_mesh"
+from helpers import load_piece
+
 
 
 @pytest.fixture(scope="module")
 def piece():
-    from mlc.scene.io import load_scene
-    z = np.load(DATA / "robot_relief_poses.npz")
-    return load_scene(DATA / "robot_relief.yaml"), {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
+    return load_piece("robot_relief")
 
 
 def _relieved(asm):

@@ -2450,6 +2450,7 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
         o = np.asarray(bx.origin, float)
         q0, q1 = o - 0.5 * bx.span * e, o + 0.5 * bx.span * e
         S_other = None      # its cylinder's surface points, made when first needed
+        fine_pts = None     # both cylinders' points five times finer (FINE_GAPS), made when first needed
         for T in Ts:
             M = _relative(host, bx.bodies[0], T)
             Qm = Q if M is None else Q @ M[:3, :3].T + M[:3, 3]
@@ -2475,7 +2476,9 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
                 if not FINE_GAPS or d_ < c:
                     return False
                 fine = step / 5
-                if gap(_cylinder_points(p0, p1, ax.R, fine), _cylinder_points(q0, q1, bx.R, fine)) < c + fine / np.sqrt(2):
+                if fine_pts is None:
+                    fine_pts = (_cylinder_points(p0, p1, ax.R, fine), _cylinder_points(q0, q1, bx.R, fine))
+                if gap(*fine_pts) < c + fine / np.sqrt(2):
                     return False
     return True
 
@@ -2545,11 +2548,12 @@ def _grown_near(grown_axes, far, shapes, axes, ujoints, slabs, state_T, reach, t
     for ax in grown_axes:
         # sampled nearer than the clearance and the sampling's reach: at least as near as sampled;
         # between the two, sampled again five times finer (FINE_GAPS)
-        if any(near(ax, bn, points(ax, bn, step))
-               and (not FINE_GAPS or near(ax, bn, points(ax, bn, step), c)
-                    or near(ax, bn, points(ax, bn, fine), c + fine / np.sqrt(2)))
-               for bn in ax.bodies):
-            out.append(ax)
+        for bn in ax.bodies:
+            X = points(ax, bn, step)
+            if near(ax, bn, X) and (not FINE_GAPS or near(ax, bn, X, c)
+                                    or near(ax, bn, points(ax, bn, fine), c + fine / np.sqrt(2))):
+                out.append(ax)
+                break
     return out
 
 
