@@ -227,6 +227,60 @@ def test_far_clear_samples_again_finer_where_the_coarse_samples_are_within_their
         assert ok == (gap > c and fine), (gap, fine, ok)
 
 
+def test_an_ordinary_hinge_end_to_end_with_a_growing_stack_yields_its_end():
+    """Session 62: most compound stacks left short met the previous half unit's ordinary hinge
+    end to end.  With ``YIELD_ENDS`` that hinge's facing end moves back, its three knuckles
+    shortened alike (not under ``kmin``, the minimum wall), by the least multiple of
+    ``YIELD_STEP`` that keeps the clearance, and only once the stack may grow.  Two coaxial
+    stacks end to end, the stack on x growing 0.3 mm towards the ordinary hinge on y."""
+    c, R, g, kmin = 0.2, 1.1, 0.2, 0.6
+    x = np.array([1.0, 0.0, 0.0])
+    slab = [B.SlabBox(np.zeros(3), np.eye(3), np.array([2.5, 4.0, 0.6]), 2)]
+    slabs = {"x1": slab, "x2": slab}
+
+    def axis(name, bodies, at, joint=None, k=0.7, direction=x):
+        span = 3 * k + 2 * g
+        ax_ = B.HingeAxis(name, [], np.array(at, float), direction.copy(), span, bodies, {}, k, R, 0.3, 0.5,
+                          layout=[bodies[0], bodies[1], bodies[0]], scene_span=2.5, joint=joint)
+        ax_.intervals = {bodies[0]: [(-span / 2, -span / 2 + k), (span / 2 - k, span / 2)],
+                         bodies[1]: [(-k / 2, k / 2)]}
+        return ax_
+
+    def grow(gap, others=(), **fl):
+        ax = axis("hx", ["x1", "x2"], [0.0, 0.0, 0.0])
+        bx = axis("hy", ["y1", "y2"], [1.25 + 0.3 + gap + 1.25, 0.0, 0.0])
+        notes = []
+        with B.flags(**fl):
+            ok = B._far_clear(ax, 1, 1.25, 1.55, [ax, bx, *others], slabs, [], 0.6, c, [], kmin=kmin, g=g,
+                              notes=notes)
+        return ok, bx, notes
+
+    # 0.1 mm apart: the hinge yields 0.15 mm (0.10 leaves the clearance itself, under its samples' reach)
+    at = 1.25 + 0.3 + 0.1 + 1.25
+    ok, bx, notes = grow(0.1)
+    assert ok and len(notes) == 1 and "yields 0.15 mm" in notes[0], notes
+    assert bx.span == pytest.approx(2.35) and bx.knuckle == pytest.approx(0.65)
+    assert bx.origin[0] == pytest.approx(at + 0.075)            # its far end stays
+    ends = sorted(a for ivs in bx.intervals.values() for iv in ivs for a in iv)
+    assert bx.origin[0] + ends[0] == pytest.approx(at - 1.25 + 0.15) and bx.origin[0] + ends[-1] == pytest.approx(at + 1.25)
+    assert all(b - a == pytest.approx(0.65) for ivs in bx.intervals.values() for a, b in ivs)
+    # the knuckles' gaps stay the knuckle gap
+    assert sorted(ends)[1:-1] == pytest.approx([ends[0] + 0.65, ends[0] + 0.85, ends[0] + 1.5, ends[0] + 1.7])
+    # without the flag, or nearer than three knuckles can give (0.3 mm down to 0.6 mm knuckles): refused, unchanged
+    for gap, fl in ((0.1, {"YIELD_ENDS": False}), (-0.15, {})):
+        ok, bx, notes = grow(gap, **fl)
+        assert not ok and not notes and bx.span == pytest.approx(2.5) and bx.knuckle == pytest.approx(0.7)
+    # a compound stack never yields (its joint part's collar and ball are laid out from its end)
+    cx = axis("hz", ["z1", "z2"], [1.25 + 0.3 + 0.1 + 1.25, 0.0, 0.0], joint="jz")
+    ax = axis("hx", ["x1", "x2"], [0.0, 0.0, 0.0])
+    assert not B._far_clear(ax, 1, 1.25, 1.55, [ax, cx], slabs, [], 0.6, c, [], kmin=kmin, g=g)
+    # a yield is not made when another stack keeps the stack short: the hinge stays as it was
+    y = np.array([0.0, 1.0, 0.0])
+    side = axis("hs", ["s1", "s2"], [1.4, 2 * R + 0.1, 0.0], joint="js", direction=y)
+    ok, bx, notes = grow(0.1, others=(side,))
+    assert not ok and not notes and bx.span == pytest.approx(2.5)
+
+
 def test_fine_gaps_let_a_stack_grow_next_to_the_previous_unit_and_keep_the_clearance():
     """Session 61: ``circuit_fine`` (tests/data_mesh: half units ``w_b_0_25`` to ``_29`` of the
     README circuit with its 22 print poses, cut by ``mlc.mesh.pipeline.sub_scene``) holds one of
@@ -257,4 +311,36 @@ def test_fine_gaps_let_a_stack_grow_next_to_the_previous_unit_and_keep_the_clear
     prev = [n for n in parts if n.startswith("w_b_0_26_")]
     assert len(stack) == 2 and len(prev) == 4
     gaps = {(a, b): _sampled_gap(parts[a], parts[b], n=100_000) for a in stack for b in prev}
+    assert min(gaps.values()) >= prof.clearance - 1e-3, gaps
+
+
+def test_the_previous_units_hinge_yields_so_that_a_stack_grows_and_keeps_the_clearance(grown):
+    """Session 62 on ``circuit_junction``: stack D of ``w_b_0_59`` met the previous half unit's
+    ordinary hinge C end to end (its cylinders 0.165 mm apart where the stack would grow).  With
+    ``YIELD_ENDS`` that hinge's facing end moves back 0.05 mm (knuckles of 0.683 mm, over the
+    minimum wall) and the stack grows; without, it keeps 0.5 mm knuckles.  Every blocking check
+    passes, fewer walls are thin, and the grown stack's bodies keep the clearance from the yielded
+    hinge's, measured outside mlc (trimesh samples, a k-d tree)."""
+    prof = load_profile("mjp")
+    sc, poses = _piece("circuit_junction")
+    with B.flags(YIELD_ENDS=False):
+        old = build_assembly(sc, prof, poses, reuse=True)
+    asm, rep = grown
+    k = {ax.name: ax.knuckle for ax in _stacks(asm)}
+    k_old = {ax.name: ax.knuckle for ax in _stacks(old)}
+    assert k["w_b_0_59_hD"] >= prof.min_wall - 1e-9 and k_old["w_b_0_59_hD"] < prof.min_wall - 1e-9
+    assert sum(v >= prof.min_wall - 1e-9 for v in k.values()) == sum(v >= prof.min_wall - 1e-9
+                                                                     for v in k_old.values()) + 1
+    yielded = {ax.name: ax for ax in asm.axes if ax.joint is None and ax.knuckle < 0.7 - 1e-9}
+    assert list(yielded) == ["w_b_0_58_hC"], {n: a.knuckle for n, a in yielded.items()}
+    assert yielded["w_b_0_58_hC"].knuckle >= prof.min_wall - 1e-9
+    assert [n for n in asm.notes if "yields" in n] == [
+        "hinge w_b_0_58_hC: its end yields 0.05 mm to the grown stack of w_b_0_59_hD (knuckles 0.683 mm)"]
+    rep_old = check_assembly(old)
+    for name in BLOCKING:
+        assert rep.check(name).ok, (name, rep.check(name).detail, rep.check(name).failures)
+    assert len(rep.check("wall_thickness").failures) < len(rep_old.check("wall_thickness").failures)
+    parts = {p.name: p for p in asm.parts}
+    gaps = {(a, b): _sampled_gap(parts[a], parts[b], n=100_000)
+            for a in ("w_b_0_59_CD", "w_b_0_59_DA") for b in ("w_b_0_58_BC", "w_b_0_58_CD")}
     assert min(gaps.values()) >= prof.clearance - 1e-3, gaps

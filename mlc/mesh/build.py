@@ -114,6 +114,11 @@ SHAVE_THIN = True        # the thin webs the trims leave away from a body's join
 #: clearance plus their own reach but not nearer than the clearance, they are sampled again five
 #: times finer before the stack is kept short (session 61)
 FINE_GAPS = True
+#: an ordinary hinge end to end with a compound stack that would grow (:func:`_far_clear`): its
+#: facing end moves back by multiples of YIELD_STEP mm, its knuckles shortened alike down to the
+#: minimum wall, where that lets the stack grow (session 62)
+YIELD_ENDS = True
+YIELD_STEP = 0.05
 
 
 @contextlib.contextmanager
@@ -622,7 +627,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
     posed_mid: list = []  # every hinge's midpoint in every pose, made on first use (_far_clear)
 
     def far_ok(ax, side, a0, a1):
-        return _far_clear(ax, side, a0, a1, axes, slabs, state_T, t, c, posed_mid)
+        return _far_clear(ax, side, a0, a1, axes, slabs, state_T, t, c, posed_mid,
+                          kmin=None if cones else kmin, g=g, notes=notes)
 
     if reuse is None:
         reuse = reuses(scene)
@@ -2405,7 +2411,8 @@ def _never(*_) -> bool:
     return False
 
 
-def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mid: list) -> bool:
+def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mid: list, kmin=None,
+               g: float = 0.0, notes: list | None = None) -> bool:
     """Whether the knuckle stack of ``ax`` may grow on its ``side`` (+-1 along its direction)
     from ``a0`` to ``a1`` (mm from its origin): its bodies' slabs lie along the axis (a hinge in
     their plane, not across a plate), and no other hinge's stack (of bodies other than
@@ -2415,7 +2422,14 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
     one), with ``STACK_CYLINDERS`` the two solid knuckle cylinders themselves must keep the
     clearance (:func:`_cylinder_points` of each against :func:`_cylinder_distance` to the other).
     ``posed_mid``: an empty list the first time, then every hinge's midpoint in every pose (a
-    prefilter, computed once per build)."""
+    prefilter, computed once per build).
+
+    With ``YIELD_ENDS`` and ``kmin`` (the shortest knuckle allowed, the minimum wall) an ordinary
+    hinge (no joint part in its stack) whose cylinder is what keeps the stack short yields: its
+    end facing the stretch moves back along its axis, every knuckle of its stack shortened alike
+    (knuckle gaps ``g``), by the least multiple of ``YIELD_STEP`` that clears in every pose, down
+    to knuckles of ``kmin``.  The hinges are changed (``span``, ``origin``, ``intervals``,
+    ``knuckle``; a line in ``notes``) only when the stack may grow."""
     for bn in ax.bodies:
         if not any(e1 - e0 >= 0.9 * ax.scene_span for e0, e1 in _slab_extents_along(slabs[bn], ax, t)):
             return False
@@ -2437,49 +2451,84 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
     for k, T in enumerate(Ts):
         q = pm if T is None else T[host][:3, :3] @ pm + T[host][:3, 3]
         near.update(np.nonzero(np.linalg.norm(posed_mid[0][k] - q, axis=1) < reach)[0].tolist())
-    if STACK_CYLINDERS:
-        S_own = _cylinder_points(p0, p1, ax.R, step)
+    yields: dict = {}       # id(hinge) -> (hinge, end (+-1 along it), mm): applied if the stack may grow
     for i in sorted(near):
         bx = axes[i]
         if bx is ax or set(bx.bodies) & set(ax.bodies):
             continue
         e = np.asarray(bx.direction, float)
-        Q = np.asarray(bx.origin, float) + np.linspace(-bx.span / 2, bx.span / 2,
-                                                        int(np.ceil(bx.span / step)) + 2)[:, None] * e
-        lim = ax.R + bx.R + c
         o = np.asarray(bx.origin, float)
         q0, q1 = o - 0.5 * bx.span * e, o + 0.5 * bx.span * e
-        S_other = None      # its cylinder's surface points, made when first needed
-        fine_pts = None     # both cylinders' points five times finer (FINE_GAPS), made when first needed
-        for T in Ts:
-            M = _relative(host, bx.bodies[0], T)
-            Qm = Q if M is None else Q @ M[:3, :3].T + M[:3, 3]
-            if np.min(np.linalg.norm(P[:, None, :] - Qm[None, :, :], axis=2)) >= lim:
-                continue            # the axes farther apart than both radii and the clearance
-            if not STACK_CYLINDERS:
-                return False
-            # the two solid cylinders (the grown stretch, the other stack), each one's surface
-            # points against the other: at least the clearance apart, plus the sampling's reach
-            # (a surface point is within step / sqrt(2) of a sample)
-            if S_other is None:
-                S_other = _cylinder_points(q0, q1, bx.R, step)
-            Mi = None if M is None else np.linalg.inv(M)
+        if _stacks_clear(ax, bx, p0, p1, P, q0, q1, Ts, host, step, c):
+            continue
+        nk = len(bx.layout)
+        if not (YIELD_ENDS and STACK_CYLINDERS and kmin is not None and bx.joint is None and nk >= 2):
+            return False
+        end = 1.0 if np.linalg.norm(q1 - pm) < np.linalg.norm(q0 - pm) else -1.0
+        most = nk * (bx.knuckle - kmin)
+        for m in range(1, int(np.floor(most / YIELD_STEP + 1e-9)) + 1):
+            dl = m * YIELD_STEP
+            y0, y1 = (q0, q1 - dl * e) if end > 0 else (q0 + dl * e, q1)
+            if _stacks_clear(ax, bx, p0, p1, P, y0, y1, Ts, host, step, c):
+                yields[id(bx)] = (bx, end, dl)
+                break
+        else:
+            return False
+    for bx, end, dl in yields.values():
+        nk = len(bx.layout)
+        bx.span -= dl
+        bx.origin = np.asarray(bx.origin, float) - 0.5 * end * dl * np.asarray(bx.direction, float)
+        bx.knuckle = (bx.span - (nk - 1) * g) / nk
+        bx.intervals = {bn: [] for bn in bx.bodies}
+        for j, bn in enumerate(bx.layout):
+            a_ = -bx.span / 2 + j * (bx.knuckle + g)
+            bx.intervals[bn].append((a_, a_ + bx.knuckle))
+        if notes is not None:
+            notes.append(f"hinge {bx.name}: its end yields {dl:.3g} mm to the grown stack of {ax.name} "
+                         f"(knuckles {bx.knuckle:.3g} mm)")
+    return True
 
-            def gap(a, b):
-                mine = a if Mi is None else a @ Mi[:3, :3].T + Mi[:3, 3]
-                theirs = b if M is None else b @ M[:3, :3].T + M[:3, 3]
-                return min(_cylinder_distance(mine, q0, q1, bx.R).min(), _cylinder_distance(theirs, p0, p1, ax.R).min())
-            d_ = gap(S_own, S_other)
-            if d_ < c + step / np.sqrt(2):
-                # sampled nearer than the clearance and the sampling's reach: at least as near as
-                # sampled; between the two, sampled again five times finer (FINE_GAPS)
-                if not FINE_GAPS or d_ < c:
-                    return False
-                fine = step / 5
-                if fine_pts is None:
-                    fine_pts = (_cylinder_points(p0, p1, ax.R, fine), _cylinder_points(q0, q1, bx.R, fine))
-                if gap(*fine_pts) < c + fine / np.sqrt(2):
-                    return False
+
+def _stacks_clear(ax: HingeAxis, bx: HingeAxis, p0, p1, P, q0, q1, Ts, host, step, c) -> bool:
+    """Whether the stretch ``p0``-``p1`` of ``ax``'s stack (samples ``P``) keeps the clearance ``c``
+    from ``bx``'s stack, the knuckle cylinder ``q0``-``q1``, at rest and in every pose ``Ts``
+    (:func:`_far_clear`)."""
+    e = (q1 - q0) / np.linalg.norm(q1 - q0)
+    L = float(np.linalg.norm(q1 - q0))
+    Q = q0 + np.linspace(0.0, L, int(np.ceil(L / step)) + 2)[:, None] * e
+    lim = ax.R + bx.R + c
+    S_own = S_other = None      # the cylinders' surface points, made when first needed
+    fine_pts = None             # both cylinders' points five times finer (FINE_GAPS), made when first needed
+    for T in Ts:
+        M = _relative(host, bx.bodies[0], T)
+        Qm = Q if M is None else Q @ M[:3, :3].T + M[:3, 3]
+        if np.min(np.linalg.norm(P[:, None, :] - Qm[None, :, :], axis=2)) >= lim:
+            continue            # the axes farther apart than both radii and the clearance
+        if not STACK_CYLINDERS:
+            return False
+        # the two solid cylinders (the grown stretch, the other stack), each one's surface
+        # points against the other: at least the clearance apart, plus the sampling's reach
+        # (a surface point is within step / sqrt(2) of a sample)
+        if S_other is None:
+            S_own = _cylinder_points(p0, p1, ax.R, step)
+            S_other = _cylinder_points(q0, q1, bx.R, step)
+        Mi = None if M is None else np.linalg.inv(M)
+
+        def gap(a, b):
+            mine = a if Mi is None else a @ Mi[:3, :3].T + Mi[:3, 3]
+            theirs = b if M is None else b @ M[:3, :3].T + M[:3, 3]
+            return min(_cylinder_distance(mine, q0, q1, bx.R).min(), _cylinder_distance(theirs, p0, p1, ax.R).min())
+        d_ = gap(S_own, S_other)
+        if d_ < c + step / np.sqrt(2):
+            # sampled nearer than the clearance and the sampling's reach: at least as near as
+            # sampled; between the two, sampled again five times finer (FINE_GAPS)
+            if not FINE_GAPS or d_ < c:
+                return False
+            fine = step / 5
+            if fine_pts is None:
+                fine_pts = (_cylinder_points(p0, p1, ax.R, fine), _cylinder_points(q0, q1, bx.R, fine))
+            if gap(*fine_pts) < c + fine / np.sqrt(2):
+                return False
     return True
 
 
@@ -2516,6 +2565,13 @@ def _grown_near(grown_axes, far, shapes, axes, ujoints, slabs, state_T, reach, t
         P = np.concatenate(P) if P else np.zeros((1, 3))
         ctr[i] = 0.5 * (P.min(axis=0) + P.max(axis=0))
         rad[i] = np.linalg.norm(P - ctr[i], axis=1).max() + max([r for *_, r in cyl[bn]], default=0.0)
+    # ... and each of its shapes' (a prefilter within the body): ``(centres, radii, kinds)``
+    each: dict = {}
+    for bn in names:
+        C = [sb.center for sb in shapes[bn]] + [0.5 * (p0 + p1) for p0, p1, _ in cyl[bn]]
+        rr = [0.5 * float(np.linalg.norm(sb.size)) for sb in shapes[bn]] + \
+             [0.5 * float(np.linalg.norm(p1 - p0)) + r for p0, p1, r in cyl[bn]]
+        each[bn] = (np.array(C, float).reshape(-1, 3), np.array(rr, float), len(shapes[bn]))
     Ts = [None] + [T for _, T in state_T]
     posed = [ctr if T is None else np.einsum("nij,nj->ni", np.array([T[b][:3, :3] for b in names]), ctr)
              + np.array([T[b][:3, 3] for b in names]) for T in Ts]
@@ -2531,9 +2587,14 @@ def _grown_near(grown_axes, far, shapes, axes, ujoints, slabs, state_T, reach, t
                 if ob in ax.bodies:
                     continue
                 M = _relative(ob, bn, T)
+                yc = xc if M is None else M[:3, :3] @ xc + M[:3, 3]
+                C, rr, nb = each[ob]
+                hit = np.nonzero(np.linalg.norm(C - yc, axis=1) < rr + xr + need)[0]
+                if not len(hit):
+                    continue            # no shape of ob within reach of the points' sphere
                 Y = X if M is None else X @ M[:3, :3].T + M[:3, 3]
-                if min([_box_distance(Y, sb).min() for sb in shapes[ob]]
-                       + [_cylinder_distance(Y, q0, q1, r).min() for q0, q1, r in cyl[ob]], default=np.inf) < need:
+                if min([_box_distance(Y, shapes[ob][j]).min() if j < nb else
+                        _cylinder_distance(Y, *cyl[ob][j - nb]).min() for j in hit]) < need:
                     return True
         return False
 
