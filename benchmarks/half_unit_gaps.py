@@ -77,8 +77,14 @@ def joint_part_gaps(parts: dict, n: int, which=JOINT) -> list:
     lo = np.array([box[k][0] for k in names])
     hi = np.array([box[k][1] for k in names])
 
+    cache: dict = {}
+
     def pts(k, seed):
-        return trimesh.sample.sample_surface(trimesh.Trimesh(*parts[k], process=False), n, seed=seed)[0]
+        # each part's samples once (the same points: the seed is fixed)
+        if (k, seed) not in cache:
+            cache[(k, seed)] = trimesh.sample.sample_surface(trimesh.Trimesh(*parts[k], process=False), n,
+                                                             seed=seed)[0]
+        return cache[(k, seed)]
     rows = []
     for i, j in enumerate(names):
         if not which.search(j):
