@@ -33,14 +33,13 @@ import trimesh
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent / "tests"))
 from gitstate import commit  # noqa: E402  (benchmarks/gitstate.py)
 
 from mlc.io.atomic import atomic_path  # noqa: E402
 from mlc.mesh import build as B  # noqa: E402
 from mlc.mesh.profiles import load_profile  # noqa: E402
-from mlc.scene.io import load_scene  # noqa: E402
-
-DATA = HERE.parent / "tests" / "data_mesh"
+from helpers import load_piece  # noqa: E402  (tests/helpers.py)
 
 
 #: the builds compared: mlc.mesh.build's flags for each
@@ -50,9 +49,7 @@ VARIANTS = {"grown": {"GROW_STACKS": True, "STACK_CYLINDERS": True, "GROWN_CLEAR
 
 
 def measure(piece: str, flags: dict) -> list[dict]:
-    z = np.load(DATA / f"{piece}_poses.npz")
-    sc = load_scene(DATA / f"{piece}.yaml")
-    poses = {str(k): (p, q) for k, p, q in zip(z["names"], z["pos"], z["quat"])}
+    sc, poses = load_piece(piece)
     with B.flags(**flags):
         asm = B.build_assembly(sc, load_profile("mjp"), poses, reuse=True)
     rows = []

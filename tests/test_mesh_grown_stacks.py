@@ -279,6 +279,21 @@ def test_an_ordinary_hinge_end_to_end_with_a_growing_stack_yields_its_end():
     side = axis("hs", ["s1", "s2"], [1.4, 2 * R + 0.1, 0.0], joint="js", direction=y)
     ok, bx, notes = grow(0.1, others=(side,))
     assert not ok and not notes and bx.span == pytest.approx(2.5)
+    # the prefilter's midpoints (made once per build) move with the yield, at rest and in every
+    # pose: a later stack near the yielded hinge's other end is measured against its new span
+    th = 0.7
+    T = np.eye(4)
+    T[:3, :3] = [[np.cos(th), -np.sin(th), 0.0], [np.sin(th), np.cos(th), 0.0], [0.0, 0.0, 1.0]]
+    T[:3, 3] = [0.4, -1.3, 2.0]
+    pose = {b: T for b in ("x1", "x2", "y1", "y2")}         # the whole pair moved rigidly
+    ax = axis("hx", ["x1", "x2"], [0.0, 0.0, 0.0])
+    bx = axis("hy", ["y1", "y2"], [at, 0.0, 0.0])
+    mids: list = []
+    assert B._far_clear(ax, 1, 1.25, 1.55, [ax, bx], slabs, [("moved", pose)], 0.6, c, mids, kmin=kmin, g=g)
+    assert bx.origin[0] == pytest.approx(at + 0.075)
+    assert mids[0][0, 1] == pytest.approx(bx.origin)
+    assert mids[0][1, 1] == pytest.approx(T[:3, :3] @ bx.origin + T[:3, 3])
+    assert mids[0][1, 0] == pytest.approx(T[:3, 3])          # the growing stack's own stays
 
 
 def test_fine_gaps_let_a_stack_grow_next_to_the_previous_unit_and_keep_the_clearance():

@@ -2422,7 +2422,7 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
     one), with ``STACK_CYLINDERS`` the two solid knuckle cylinders themselves must keep the
     clearance (:func:`_cylinder_points` of each against :func:`_cylinder_distance` to the other).
     ``posed_mid``: an empty list the first time, then every hinge's midpoint in every pose (a
-    prefilter, computed once per build).
+    prefilter, computed once per build and moved with each yield).
 
     With ``YIELD_ENDS`` and ``kmin`` (the shortest knuckle allowed, the minimum wall) an ordinary
     hinge (no joint part in its stack) whose cylinder is what keeps the stack short yields: its
@@ -2470,14 +2470,19 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
             dl = m * YIELD_STEP
             y0, y1 = (q0, q1 - dl * e) if end > 0 else (q0 + dl * e, q1)
             if _stacks_clear(ax, bx, p0, p1, P, y0, y1, Ts, host, step, c):
-                yields[id(bx)] = (bx, end, dl)
+                yields[id(bx)] = (i, bx, end, dl)
                 break
         else:
             return False
-    for bx, end, dl in yields.values():
+    for i, bx, end, dl in yields.values():
         nk = len(bx.layout)
         bx.span -= dl
         bx.origin = np.asarray(bx.origin, float) - 0.5 * end * dl * np.asarray(bx.direction, float)
+        # the prefilter's midpoints move with it: a later stack near this hinge's other end must
+        # still find it (its reach takes the new, shorter span)
+        posed_mid[0][0, i] = bx.origin
+        for k, T in enumerate(Ts[1:], start=1):
+            posed_mid[0][k, i] = T[bx.bodies[0]][:3, :3] @ bx.origin + T[bx.bodies[0]][:3, 3]
         bx.knuckle = (bx.span - (nk - 1) * g) / nk
         bx.intervals = {bn: [] for bn in bx.bodies}
         for j, bn in enumerate(bx.layout):
