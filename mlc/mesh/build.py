@@ -119,6 +119,10 @@ FINE_GAPS = True
 #: minimum wall, where that lets the stack grow (session 62)
 YIELD_ENDS = True
 YIELD_STEP = 0.05
+#: a universal joint's yoke plate into a rod (the post under a circuit gate's input lever) reaches at
+#: least the trim radius about its pin plus the slab thickness, so that the band the trim leaves of it
+#: is a full wall (session 63: it reached max(R, hub) + 2 t, 0.435 mm past a 1.865 mm trim at mjp)
+ROD_PLATE_WALL = True
 
 
 @contextlib.contextmanager
@@ -772,7 +776,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
             uj = make_uj(v, lays, hub)
             if best is not None and not (uj.rho[0] + uj.rho[1], modes != ("both", "both")) < best[0]:
                 continue     # its trim radii are at least these: it cannot beat the best layout
-            need = _ujoint_trim_memo(memo, uj, _uj_samples(uj, base_samples, slabs, reach, t, h), state_T, t, c, h)
+            need = _ujoint_trim_memo(memo, uj, _uj_samples(uj, base_samples, slabs, reach, t, h, n), state_T, t, c, h)
             rho = (max(uj.rho[0], need[0]), max(uj.rho[1], need[1]))
             score = (rho[0] + rho[1], modes != ("both", "both"))
             if best is None or score < best[0]:
@@ -832,7 +836,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
         if moved:     # the universal joints' trim radii, again for the slabs where they are now
             base_samples = {bn: _slab_samples(slabs[bn], h) for bn in slabs}
             for uj in ujoints:
-                need = _ujoint_trim(uj, _uj_samples(uj, base_samples, slabs, reach, t, h), state_T, t, c, h)
+                need = _ujoint_trim(uj, _uj_samples(uj, base_samples, slabs, reach, t, h, n), state_T, t, c, h)
                 uj.rho = (max(uj.rho[0], need[0]), max(uj.rho[1], need[1]))
 
     # -- yoke plates: widen slabs to the knuckle span near an axis ------------------
@@ -863,7 +867,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
     uj_plates = []      # (body, joint, plate): the universal joints' yoke plates (CLIP_UJ_PLATES)
     for uj in ujoints:
         for side, bn in enumerate(uj.bodies):
-            for sb in _uj_plates(uj, side, slabs[bn], uj.rho[side] + reach, t):
+            for sb in _uj_plates(uj, side, slabs[bn], uj.rho[side] + reach, t, n):
                 plates[bn].append(sb)
                 uj_plates.append((bn, uj, sb))
     shapes = {bn: slabs[bn] + plates[bn] for bn in slabs}
@@ -2899,7 +2903,7 @@ def _branch(members, S, joints, scene, bodies, axes, slabs, s, prof, R, r_pin, r
             uj.o_axis = comp["o_axis"]
         uj.primary = not out
         uj.mates = [p for p in side[sg] if p != pg]
-        need = _ujoint_trim_memo(memo, uj, _uj_samples(uj, base_samples, slabs, reach, t, h), state_T, t, c, h)
+        need = _ujoint_trim_memo(memo, uj, _uj_samples(uj, base_samples, slabs, reach, t, h, prof.circular_segments), state_T, t, c, h)
         uj.rho = (max(uj.rho[0], need[0]), max(uj.rho[1], need[1]))
         out.append(uj)
     return out, comp
@@ -2957,7 +2961,7 @@ def _severs(uj: UJoint, sbs, reach, t, n) -> bool:
     knuckles only (the build adds the plates of its hinges, which may hold it together)."""
     lay = uj.layouts[1]
     knuckles = [cylinder(uj.center, uj.axes[1], a0, a1, uj.R, n) for a0, a1 in lay.own]
-    body = union([box(sb.center, sb.R, sb.size) for sb in sbs + _uj_plates(uj, 1, sbs, uj.rho[1] + reach, t)]
+    body = union([box(sb.center, sb.R, sb.size) for sb in sbs + _uj_plates(uj, 1, sbs, uj.rho[1] + reach, t, n)]
                  + knuckles)
     cut = _clean(union([subtract(body, [cylinder(uj.center, uj.axes[1], a0, a1, uj.rho[1], n, cutter=True)
                                         for a0, a1 in _complement(lay.own, *lay.cut)])] + knuckles))
@@ -4258,10 +4262,10 @@ def _extent_along(sbs, center, d) -> float:
     return float(np.sum(np.abs(near.R.T @ d) * near.size))
 
 
-def _uj_samples(uj: UJoint, base_samples, slabs, reach, t, h) -> dict:
+def _uj_samples(uj: UJoint, base_samples, slabs, reach, t, h, n) -> dict:
     """The sample points (mm) of a universal joint's two bodies for its trim radii: their slabs'
     (``base_samples``) and the yoke plates that widen them to its knuckles (:func:`_uj_plates`)."""
-    return {bn: np.concatenate([base_samples[bn], _slab_samples(_uj_plates(uj, k, slabs[bn], uj.rho[k] + reach, t), h)])
+    return {bn: np.concatenate([base_samples[bn], _slab_samples(_uj_plates(uj, k, slabs[bn], uj.rho[k] + reach, t, n), h)])
             for k, bn in enumerate(uj.bodies)}
 
 
@@ -4291,18 +4295,19 @@ def _fin_free(uj: UJoint, state_T, c, t) -> bool:
 def _fin_keep(uj: UJoint, c, t, n) -> mf.Manifold:
     """The part of a compound junction's fin that O's trim about the second pin leaves where
     :func:`_fin_free`: past the joint part's ball and the clearance."""
-    fin = _uj_plates(uj, 1, [], 0.0, t)[0]
+    fin = _uj_plates(uj, 1, [], 0.0, t, n)[0]
     r_keep = uj.hub_r + c
     big = 2 * float(np.max(fin.size)) + 4 * r_keep
     return subtract(box(fin.center, fin.R, fin.size), [cylinder(uj.center, uj.axes[1], -big, big, r_keep, n, cutter=True)])
 
 
-def _uj_plates(uj: UJoint, side: int, sbs, reach, t):
+def _uj_plates(uj: UJoint, side: int, sbs, reach, t, n):
     """The plates joining a universal joint's yoke knuckles to the body of ``side``: none for
     the host of a compound junction (its knuckles are in its hinge's stack); for the other body
     of a compound junction whose own hinge lies on the same line (the next layer), a fin across
     both knuckles, in the plane of u and v and ``t`` thick, from the second pin up into that
-    body's end knuckle; else :func:`_yoke_plates`."""
+    body's end knuckle; else :func:`_yoke_plates` (into a rod, with ``ROD_PLATE_WALL``: at least
+    the slab thickness past the trim about the pin, whose ``n``-gon reaches ``rho / cos(pi / n)``)."""
     lay = uj.layouts[side]
     if uj.host is not None and side == 0:
         return []
@@ -4323,8 +4328,13 @@ def _uj_plates(uj: UJoint, side: int, sbs, reach, t):
             out.append(SlabBox(uj.center + v * 0.5 * (b0 + b1) + u * 0.5 * hgt, np.column_stack([v, u, np.cross(v, u)]),
                                np.array([abs(b1 - b0), hgt, t]), 2))
         return out
-    return _yoke_plates(sbs, uj.center, uj.axes[side], [lay.plate], reach, t,
-                        rod_reach=max(uj.R, uj.hub_r) + 2 * t if side == 1 and uj.free_pin else None,
+    rod_reach = None
+    if side == 1 and uj.free_pin:
+        # over the knuckles and the hub; with ROD_PLATE_WALL past the trim about the pin by a wall
+        rod_reach = max(uj.R, uj.hub_r) + 2 * t
+        if ROD_PLATE_WALL:
+            rod_reach = max(rod_reach, uj.rho[side] / np.cos(np.pi / n) + t)
+    return _yoke_plates(sbs, uj.center, uj.axes[side], [lay.plate], reach, t, rod_reach=rod_reach,
                         fin_min=uj.R + t)
 
 
