@@ -100,6 +100,9 @@ def test_turned_one_sided_yokes_on_crossed_output_levers_leave_their_free_side(m
     lever's plate was.  Now it stops at the hub there: the pair's intersection drops 38-fold (what
     is left: g2_out_lo's trim radii, shrunk to keep it in one piece, leave its pivot cut short)."""
     sc, poses = _robot_g2()
+    # (the trims shrunk as in session 55: with UNSPLIT_JOINTS_FIRST, session 63, the pair keeps the
+    # clearance with or without this step, the next test)
+    monkeypatch.setattr(B, "UNSPLIT_JOINTS_FIRST", False)
 
     def pair_volume():
         asm = build_assembly(sc, load_profile("mjp"), poses, reuse=True)
@@ -115,3 +118,53 @@ def test_turned_one_sided_yokes_on_crossed_output_levers_leave_their_free_side(m
     before = pair_volume()
     assert before > 1.7, before
     assert after < 0.05, after
+
+
+def _sampled_gaps(asm, poses, a, b, n=200_000):
+    """The gap (mm) between parts ``a`` and ``b`` in each pose, measured outside mlc and manifold3d:
+    trimesh's surface samples of each (seeded), posed by the assembly's part transforms, nearest
+    pairs by a k-d tree (an upper bound of the true gap; near 0 where the two surfaces cross)."""
+    import trimesh
+    from scipy.spatial import cKDTree
+
+    def surf(name, seed):
+        m = asm.part(name).solid.to_mesh()
+        tm = trimesh.Trimesh(np.asarray(m.vert_properties)[:, :3], np.asarray(m.tri_verts), process=False)
+        return trimesh.sample.sample_surface(tm, n, seed=seed)[0]
+    pa, pb = surf(a, 1), surf(b, 2)
+    out = {}
+    for k, pq in poses.items():
+        T = asm.part_transforms(*pq)
+        A = pa @ T[a][:3, :3].T + T[a][:3, 3]
+        Bp = pb @ T[b][:3, :3].T + T[b][:3, 3]
+        out[k] = float(cKDTree(Bp).query(A, distance_upper_bound=1.0)[0].min())    # (inf: over 1 mm)
+    return out
+
+
+def test_a_levers_pivot_cut_stays_whole_where_its_junctions_trims_shrink(monkeypatch):
+    """Session 63 (``UNSPLIT_JOINTS_FIRST``): what session 55 left of the robot's pair, 0.047 mm^3
+    in states 00, 01 and 11 and ``min_gap`` 0.  ``g2_out_lo``'s trims at their sampled radii cut it
+    in pieces, and ``_Unsplit`` shrank every trim radius of its joints, its pivot's with its
+    coupling junction's: the pivot's cut, short, no longer cleared ``g2_out_hi``.  The junction's
+    radii now shrink first, the pivot's kept whole: the pair keeps the clearance in every pose of
+    the robot (``min_gap``, ``states``; and outside mlc, trimesh samples and a k-d tree)."""
+    sc, poses = _robot_g2()
+    prof = load_profile("mjp")
+
+    def build():
+        asm = build_assembly(sc, prof, poses, reuse=True)
+        return asm, check_assembly(asm, walls=False)
+    asm, rep = build()
+    for name in ("watertight", "part_count", "min_gap", "retention", "features"):
+        assert rep.check(name).ok, (name, rep.check(name).detail, rep.check(name).failures)
+    assert _pair_failures(rep) == []
+    assert any(n.startswith("g2_out_lo: trim radii of its universal joints (its hinges' kept) shrunk")
+               for n in asm.notes), asm.notes
+    gaps = _sampled_gaps(asm, poses, *PAIR)
+    assert len(gaps) == 22 and min(gaps.values()) > prof.clearance - 0.05, gaps
+    # every trim radius shrunk alike (as before): the pair meets in states 00, 01 and 11
+    monkeypatch.setattr(B, "UNSPLIT_JOINTS_FIRST", False)
+    old, old_rep = build()
+    fails = _pair_failures(old_rep)
+    assert any("g2_out_lo intersects g2_out_hi" in f for f in fails), fails
+    assert min(_sampled_gaps(old, poses, *PAIR).values()) < 0.05

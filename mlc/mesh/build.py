@@ -968,23 +968,23 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
         # trims that would leave the body in several pieces (a connector half unit whose slab
         # the trim radii of its hinge and universal joint eat, issue 13, session 50): rebuilt
         # with those radii shrunk towards the least that keeps the knuckles clear (_Unsplit)
-        n_notes, shrink = len(notes), _Unsplit(reuse)
+        my_uj = [(uj, 0 if uj.bodies[0] == bn else 1) for uj in ujoints if bn in uj.bodies]
+        n_notes, shrink = len(notes), _Unsplit(reuse, joints=bool(my_uj))
         # a branch page's arm, which ends on the face of its own end knuckle, is carried into it
         links = _rod_links(shapes[bn], my_axes, bn, t, s) if bn in pages else []
         solid0 = union([box(sb.center, sb.R, sb.size) for sb in shapes[bn] + links] + _bend_fills(slabs[bn]))
-        my_uj = [(uj, 0 if uj.bodies[0] == bn else 1) for uj in ujoints if bn in uj.bodies]
         # (a mechanism of its own: a cut that ends at the span's end runs on past what is left of
         # the body along the axis when that would be thinner than the minimum wall; issue 13:
         # out_hi's yoke plate, 0.19 mm past the pivot's cut at sla)
         sheet = {ax.name: (None if reuse else _ext_ivs(shapes[bn], ax), prof.min_wall) for ax in my_axes}
         while True:     # once, or again at the next trim-radius fraction (_Unsplit)
             del notes[n_notes:]
-            f = shrink.f
+            f, f_ax = shrink.f, shrink.f_axes
             solid = solid0
             # 1. clear the other bodies' knuckles
 
             def axis_cuts(ax, grow=0.0):
-                return [cylinder(ax.origin, ax.direction, a0, a1, _toward(ax.R + c, ax.rho, f) + grow, n, cutter=True)
+                return [cylinder(ax.origin, ax.direction, a0, a1, _toward(ax.R + c, ax.rho, f_ax) + grow, n, cutter=True)
                         for a0, a1 in _ext(_complement(ax.intervals[bn], -ax.span / 2, ax.span / 2), ax.span, t,
                                            *sheet[ax.name])]
             other_cuts, avoid, avoid_sweep = [], [], []
@@ -1140,7 +1140,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
             if shrink.done(len(solid.decompose())):
                 break
         if shrink.f < 1.0:
-            notes.append(f"{bn}: trim radii of its joints shrunk to {shrink.f:.3g} of the way from the least "
+            which = "its universal joints (its hinges' kept)" if shrink.axes_full else "its joints"
+            notes.append(f"{bn}: trim radii of {which} shrunk to {shrink.f:.3g} of the way from the least "
                          "that clears their knuckles to the sampled ones: at the full radii the body "
                          "was in several pieces")
         # the spot where the attachment hole would go (0.85 mm in from the site), kept if possible
@@ -2324,6 +2325,10 @@ def _ujoint_trim_memo(memo, uj: UJoint, samples, state_T, t, c, h):
 #: large assemblies (reuse): a body that the trims of its joints leave in several pieces is rebuilt
 #: with their radii shrunk; this many bisection steps between the least radii and the sampled ones
 UNSPLIT_STEPS = 5
+#: ... and first with its hinges' radii kept whole, its universal joints' alone shrunk; both only where
+#: that still splits it (session 63: the robot's g2_out_lo, its pivot's cut shrunk with its coupling
+#: junction's, met g2_out_hi)
+UNSPLIT_JOINTS_FIRST = True
 
 
 def _toward(least: float, rho: float, f: float) -> float:
@@ -2345,11 +2350,23 @@ class _Unsplit:
     one piece; if even ``f`` = 0 splits it, it is built as before.  What the smaller radii leave
     close is left to the final trims (:func:`_resolve`, which never keep a split) and the
     ``states`` check.  A body whole at the sampled radii is built exactly as before; so is
-    every body of a mechanism of its own (the library gates)."""
+    every body of a mechanism of its own (the library gates).
 
-    def __init__(self, reuse):
+    With ``UNSPLIT_JOINTS_FIRST`` and universal joints on the body (``joints``), the search runs
+    first on those joints' radii alone, its hinges' kept at the sampled ones (``f_axes`` 1: a
+    lever's pivot cut stays whole where its coupling junction's shrinks), and on both only if the
+    joints' least radii still leave it in pieces."""
+
+    def __init__(self, reuse, joints: bool = False):
         self.on = bool(reuse) and UNSPLIT_STEPS > 0
         self.f, self.lo, self.hi, self.tries, self.final = 1.0, None, 1.0, 0, False
+        self.joints_first = bool(joints) and UNSPLIT_JOINTS_FIRST
+        self.axes_full = False      # the hinges' radii kept at f = 1 (the first search)
+
+    @property
+    def f_axes(self) -> float:
+        """The fraction the body's hinges' trim radii are built with."""
+        return 1.0 if self.axes_full else self.f
 
     def done(self, pieces: int) -> bool:
         """Whether the body just built (``pieces``, built at ``self.f``) is kept; else ``self.f``
@@ -2363,8 +2380,14 @@ class _Unsplit:
         else:
             self.lo = self.f
         if self.lo is None:
-            # f = 1 splits: try the least radii; if they split it too, build it as before
-            self.f, self.final = (0.0, False) if self.f == 1.0 else (1.0, True)
+            # f = 1 splits: try the least radii (the joints' alone first); if they split it too,
+            # both, then build it as before
+            if self.f == 1.0:
+                self.f, self.axes_full = 0.0, self.joints_first
+            elif self.axes_full:
+                self.f, self.axes_full, self.hi, self.tries = 0.0, False, 1.0, 1
+            else:
+                self.f, self.final = 1.0, True
             return False
         if self.tries > UNSPLIT_STEPS:
             if self.f == self.lo:
