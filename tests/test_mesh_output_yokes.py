@@ -146,8 +146,9 @@ def test_a_levers_pivot_cut_stays_whole_where_its_junctions_trims_shrink(monkeyp
     in states 00, 01 and 11 and ``min_gap`` 0.  ``g2_out_lo``'s trims at their sampled radii cut it
     in pieces, and ``_Unsplit`` shrank every trim radius of its joints, its pivot's with its
     coupling junction's: the pivot's cut, short, no longer cleared ``g2_out_hi``.  The junction's
-    radii now shrink first, the pivot's kept whole: the pair keeps the clearance in every pose of
-    the robot (``min_gap``, ``states``; and outside mlc, trimesh samples and a k-d tree)."""
+    radii now shrink first, the pivot's kept whole: the pair keeps the clearance as built
+    (``min_gap``) and meets in none of the robot's poses (``states``); outside mlc, trimesh samples
+    and a k-d tree read gaps over 0.15 mm in every pose (an upper bound: the samples' spacing)."""
     sc, poses = _robot_g2()
     prof = load_profile("mjp")
 
