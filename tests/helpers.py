@@ -69,7 +69,6 @@ def web_sections(asm, min_wall, owner=None):
     middle of the other bodies' knuckles, near the axis and not the pin, with the diameter of the
     largest disc in it (manifold3d slices, Clipper2 offsets to 0.001 mm; as
     benchmarks/mesh_gates.py's section_webs), independent of mlc.mesh.walls."""
-    import manifold3d as mf
     import numpy as np
 
     from mlc.mesh.build import _perp_frame
@@ -89,12 +88,50 @@ def web_sections(asm, min_wall, owner=None):
                     continue
                 if np.hypot(max(x0, 0, -x1), max(y0, 0, -y1)) > c.rho + 2 * min_wall:
                     continue
-                lo, hi = 0.0, 2.0
-                while hi - lo > 5e-4:
-                    r = 0.5 * (lo + hi)
-                    lo, hi = (lo, r) if piece.offset(-r, mf.JoinType.Round).is_empty() else (r, hi)
-                out.append(2 * lo)
+                out.append(largest_disc(piece))
     return out
+
+
+def largest_disc(section) -> float:
+    """The diameter (mm) of the largest disc in a manifold3d ``CrossSection``: the largest inward
+    offset (Clipper2, round joins) that leaves it non-empty, bisected to 0.001 mm (up to 4 mm)."""
+    import manifold3d as mf
+
+    lo, hi = 0.0, 2.0
+    while hi - lo > 5e-4:
+        r = 0.5 * (lo + hi)
+        lo, hi = (lo, r) if section.offset(-r, mf.JoinType.Round).is_empty() else (r, hi)
+    return 2 * lo
+
+
+def posed_gaps(a, b, transforms, n=300_000, bound=None):
+    """The gap (mm) between two manifold3d solids ``a`` and ``b`` in each of ``transforms`` (pairs
+    ``(Ta, Tb)`` of rigid 4x4 transforms of each, ``None``: as built), measured outside mlc and
+    manifold3d: trimesh's seeded surface samples of each (``n``), nearest pairs by a scipy k-d tree.
+    An upper bound of the true gap (the samples' spacing); near 0 where the two surfaces cross; inf
+    over ``bound`` (mm) when one is given."""
+    import numpy as np
+    import trimesh
+    from scipy.spatial import cKDTree
+
+    def surf(solid, seed):
+        m = solid.to_mesh()
+        tm = trimesh.Trimesh(np.asarray(m.vert_properties)[:, :3], np.asarray(m.tri_verts), process=False)
+        return trimesh.sample.sample_surface(tm, n, seed=seed)[0]
+
+    def moved(p, T):
+        return p if T is None else p @ T[:3, :3].T + T[:3, 3]
+    pa, pb = surf(a, 1), surf(b, 2)
+    return [float(cKDTree(moved(pb, Tb)).query(moved(pa, Ta), distance_upper_bound=np.inf if bound is None
+                                                 else bound)[0].min()) for Ta, Tb in transforms]
+
+
+def part_gaps(asm, a, b, poses, n=200_000):
+    """:func:`posed_gaps` of the assembly's parts ``a`` and ``b`` in each of ``poses`` (``{name:
+    (pos, quat)}``, posed by the assembly's part transforms): ``{name: gap}`` (mm; inf over 1 mm)."""
+    Ts = {k: asm.part_transforms(*pq) for k, pq in poses.items()}
+    gaps = posed_gaps(asm.part(a).solid, asm.part(b).solid, [(T[a], T[b]) for T in Ts.values()], n, bound=1.0)
+    return dict(zip(Ts, gaps))
 
 
 def load_piece(name: str):

@@ -19,7 +19,6 @@ Both thin sides of a rod are now printed at the slab thickness.
 it and the whole circuit's 22 poses (see tests/test_mesh_circuit_gate_stroke.py)."""
 from __future__ import annotations
 
-import manifold3d as mf
 import numpy as np
 import pytest
 
@@ -30,7 +29,7 @@ from mlc.mesh.checks import check_assembly
 from mlc.mesh.profiles import load_profile
 from mlc.mesh.walls import thin_walls
 
-from helpers import load_piece, web_sections
+from helpers import largest_disc, load_piece, mesh_piece, part_gaps, web_sections
 
 LEVERS = ("g3_a_lo", "g3_a_hi", "g3_b_lo", "g3_b_hi")
 BLOCKING = ("watertight", "part_count", "min_gap", "states", "retention", "features")
@@ -106,12 +105,8 @@ def _post_sections(asm, sc):
         M = np.hstack([F, (-F @ c)[:, None]])
         cs = asm.part(b.name).solid.transform(M.tolist()).slice(0.0)
         (piece,) = [p for p in cs.decompose() if p.bounds()[0] <= 0 <= p.bounds()[2] and p.bounds()[1] <= 0 <= p.bounds()[3]]
-        lo, hi = 0.0, 2.0
-        while hi - lo > 5e-4:
-            r = 0.5 * (lo + hi)
-            lo, hi = (lo, r) if piece.offset(-r, mf.JoinType.Round).is_empty() else (r, hi)
         x0, y0, x1, y1 = piece.bounds()
-        out[b.name] = (2 * lo, x1 - x0, y1 - y0)
+        out[b.name] = (largest_disc(piece), x1 - x0, y1 - y0)
     return out
 
 
@@ -152,11 +147,7 @@ def _yoke_plate_sections(asm):
                 x0, y0, x1, y1 = p.bounds()
                 if np.hypot(np.clip(0.0, x0, x1), np.clip(0.0, y0, y1)) >= uj.rho[1] + 0.1:
                     continue        # not on the trim: the post itself, cut across
-                lo, hi = 0.0, 2.0
-                while hi - lo > 5e-4:
-                    r = 0.5 * (lo + hi)
-                    lo, hi = (lo, r) if p.offset(-r, mf.JoinType.Round).is_empty() else (r, hi)
-                discs.append(2 * lo)
+                discs.append(largest_disc(p))
         out[bn] = discs
     return out
 
@@ -182,3 +173,30 @@ def test_without_rod_plate_walls_the_band_past_the_trim_is_thin(piece):
     assert all(secs.values()) and max(max(d) for d in secs.values()) < old.profile.min_wall - 0.1, secs
     thin = [w for bn in LEVERS for w in thin_walls(bn, old.part(bn).solid, old.profile.min_wall)]
     assert len(thin) == 4 and all(w.thickness_mm < old.profile.min_wall - 0.1 for w in thin), thin
+
+
+def test_the_yoke_plate_into_a_post_stays_short_where_a_longer_one_would_meet_the_core():
+    """Session 64 (``ROD_PLATE_CLEAR``): the Tetris robot's gates turn their input levers further
+    than the circuit's (``g2_a_lo`` 73 degrees from ``core_ab`` in state 11), and there the longer
+    plate of ``ROD_PLATE_WALL`` met ``core_cd``: on ``robot_g2`` (the robot's gate g2 with two bond
+    hops round it and the robot's 22 poses) ``g2_core_cd`` intersected ``g2_a_lo`` in states 11 and
+    11@0.86.  The plate's stretch past the old reach is now tested against the other bodies in
+    every pose and kept back (to 2.3 mm here) where it comes near one; the circuit's gate keeps
+    its full wall (the test above).  Outside mlc: trimesh samples of the two finished parts posed
+    in the 22 poses, a k-d tree's nearest pairs (an upper bound of the gap)."""
+    sc, poses = load_piece("robot_g2")
+    asm, rep = mesh_piece("robot_g2", walls=False)
+    assert not [f for f in rep.check("states").failures if "g2_core_cd intersects g2_a_lo" in f]
+    (uj,) = [u for u in asm.ujoints if u.name == "w_y_2_end_lo"]
+    t, n = asm.slab_thickness, asm.profile.circular_segments
+    old, full = B._rod_reaches(uj, t, n)
+    assert full > old + 0.1 and uj.rod_wall is not None and old <= uj.rod_wall < full, (old, full, uj.rod_wall)
+    assert any(nt.startswith("universal joint w_y_2_end_lo: g2_a_lo's yoke plate into its rod reaches")
+               for nt in asm.notes), asm.notes
+    gaps = part_gaps(asm, "g2_core_cd", "g2_a_lo", poses)
+    assert len(gaps) == 22 and min(gaps.values()) > 0.05, gaps
+    # the full reach in every pose: the two meet in state 11
+    asm2, rep2 = mesh_piece("robot_g2", walls=False, ROD_PLATE_CLEAR=False)
+    fails = [f for f in rep2.check("states").failures if "g2_core_cd intersects g2_a_lo" in f]
+    assert any(f.startswith("state 11:") for f in fails), rep2.check("states").failures
+    assert min(part_gaps(asm2, "g2_core_cd", "g2_a_lo", poses).values()) < 0.02

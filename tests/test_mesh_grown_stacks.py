@@ -22,7 +22,7 @@ from mlc.mesh.build import build_assembly
 from mlc.mesh.checks import check_assembly
 from mlc.mesh.profiles import load_profile
 
-from helpers import load_piece
+from helpers import load_piece, posed_gaps
 
 BLOCKING = ("watertight", "part_count", "min_gap", "states", "retention", "features")
 
@@ -137,17 +137,8 @@ def test_stacks_measured_as_cylinders_grow_where_their_axes_alone_kept_them_shor
 
 
 def _sampled_gap(a, b, n=300_000):
-    """The gap (mm) between two finished parts measured outside mlc and manifold3d: trimesh's
-    surface samples of each, nearest pairs by a k-d tree (an upper bound of the true gap)."""
-    import trimesh
-    from scipy.spatial import cKDTree
-
-    def surf(part, seed):
-        m = part.solid.to_mesh()
-        tm = trimesh.Trimesh(np.asarray(m.vert_properties)[:, :3], np.asarray(m.tri_verts), process=False)
-        return trimesh.sample.sample_surface(tm, n, seed=seed)[0]
-    pa, pb = surf(a, 1), surf(b, 2)
-    return float(cKDTree(pb).query(pa)[0].min())
+    """The gap (mm) between two finished parts as built (:func:`helpers.posed_gaps`)."""
+    return posed_gaps(a.solid, b.solid, [(None, None)], n)[0]
 
 
 def test_grown_plates_stop_short_of_the_bodys_other_hinges(monkeypatch):

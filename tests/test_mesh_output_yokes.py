@@ -25,7 +25,7 @@ from mlc.mesh.checks import check_assembly
 from mlc.mesh.pipeline import sub_scene
 from mlc.mesh.profiles import load_profile
 
-from helpers import load_piece
+from helpers import load_piece, part_gaps
 
 DATA = Path(__file__).parent / "data_mesh"
 PAIR = ("g2_out_lo", "g2_out_hi")
@@ -120,27 +120,6 @@ def test_turned_one_sided_yokes_on_crossed_output_levers_leave_their_free_side(m
     assert after < 0.05, after
 
 
-def _sampled_gaps(asm, poses, a, b, n=200_000):
-    """The gap (mm) between parts ``a`` and ``b`` in each pose, measured outside mlc and manifold3d:
-    trimesh's surface samples of each (seeded), posed by the assembly's part transforms, nearest
-    pairs by a k-d tree (an upper bound of the true gap; near 0 where the two surfaces cross)."""
-    import trimesh
-    from scipy.spatial import cKDTree
-
-    def surf(name, seed):
-        m = asm.part(name).solid.to_mesh()
-        tm = trimesh.Trimesh(np.asarray(m.vert_properties)[:, :3], np.asarray(m.tri_verts), process=False)
-        return trimesh.sample.sample_surface(tm, n, seed=seed)[0]
-    pa, pb = surf(a, 1), surf(b, 2)
-    out = {}
-    for k, pq in poses.items():
-        T = asm.part_transforms(*pq)
-        A = pa @ T[a][:3, :3].T + T[a][:3, 3]
-        Bp = pb @ T[b][:3, :3].T + T[b][:3, 3]
-        out[k] = float(cKDTree(Bp).query(A, distance_upper_bound=1.0)[0].min())    # (inf: over 1 mm)
-    return out
-
-
 def test_a_levers_pivot_cut_stays_whole_where_its_junctions_trims_shrink(monkeypatch):
     """Session 63 (``UNSPLIT_JOINTS_FIRST``): what session 55 left of the robot's pair, 0.047 mm^3
     in states 00, 01 and 11 and ``min_gap`` 0.  ``g2_out_lo``'s trims at their sampled radii cut it
@@ -161,11 +140,11 @@ def test_a_levers_pivot_cut_stays_whole_where_its_junctions_trims_shrink(monkeyp
     assert _pair_failures(rep) == []
     assert any(n.startswith("g2_out_lo: trim radii of its universal joints (its hinges' kept) shrunk")
                for n in asm.notes), asm.notes
-    gaps = _sampled_gaps(asm, poses, *PAIR)
+    gaps = part_gaps(asm, *PAIR, poses)
     assert len(gaps) == 22 and min(gaps.values()) > prof.clearance - 0.05, gaps
     # every trim radius shrunk alike (as before): the pair meets in states 00, 01 and 11
     monkeypatch.setattr(B, "UNSPLIT_JOINTS_FIRST", False)
     old, old_rep = build()
     fails = _pair_failures(old_rep)
     assert any("g2_out_lo intersects g2_out_hi" in f for f in fails), fails
-    assert min(_sampled_gaps(old, poses, *PAIR).values()) < 0.05
+    assert min(part_gaps(old, *PAIR, poses).values()) < 0.05

@@ -123,6 +123,11 @@ YIELD_STEP = 0.05
 #: least the trim radius about its pin plus the slab thickness, so that the band the trim leaves of it
 #: is a full wall (session 63: it reached max(R, hub) + 2 t, 0.435 mm past a 1.865 mm trim at mjp)
 ROD_PLATE_WALL = True
+#: ... only as far as its stretch past the old reach (``max(R, hub) + 2 t``) keeps the slab thickness
+#: and clearance from every other body's material in every pose (:func:`_rod_wall_reach`; session 64:
+#: the Tetris robot's gates turn their input levers further than the circuit's, 73 degrees, and the
+#: longer post plate met ``core_cd``, 0.01-0.13 mm^3 in g1, g2 and g3)
+ROD_PLATE_CLEAR = True
 
 
 @contextlib.contextmanager
@@ -304,6 +309,8 @@ class UJoint:
     free_pin: bool = False    # O's hinges run along u, so _PinClearance chose v: its yoke plate into a
                               # rod stops over the knuckles (_yoke_plates' rod_reach)
     turned: bool = False      # compound junction: v turned about u by least_twist
+    rod_wall: float | None = None  # (ROD_PLATE_CLEAR) how far (mm) the plate into a rod reaches, where
+                                   # the full ROD_PLATE_WALL reach would come near another body
 
 
 @dataclass
@@ -872,6 +879,32 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
                 uj_plates.append((bn, uj, sb))
     shapes = {bn: slabs[bn] + plates[bn] for bn in slabs}
     samples = {bn: _slab_samples(shapes[bn], h) for bn in shapes}
+    if ROD_PLATE_CLEAR and ROD_PLATE_WALL:
+        # a plate into a rod past the trim about its pin by a wall, where that stretch keeps the
+        # slab thickness and the clearance from every other body in every pose (session 64)
+        def rod_clash(bn, boxes):
+            P = _slab_samples(boxes, h)
+            return any(len(ii) for B in samples if B != bn
+                       for ii, _ in _close_pairs_posed(P, samples[B], [_relative(bn, B, Ts) for Ts in bridge_T],
+                                                       t + c + h))
+        cut_back = []
+        for uj in ujoints:
+            bn = uj.bodies[1]
+            r = _rod_wall_reach(uj, slabs[bn], uj.rho[1] + reach, t, n, h, lambda boxes, bn=bn: rod_clash(bn, boxes))
+            if r is None or r >= _rod_reaches(uj, t, n)[1] - 1e-9:
+                continue
+            uj.rod_wall = r
+            at = [i for i, (b, u, _) in enumerate(uj_plates) if u is uj and b == bn]
+            for i, sb in zip(at, _uj_plates(uj, 1, slabs[bn], uj.rho[1] + reach, t, n), strict=True):
+                plates[bn][next(k for k, x in enumerate(plates[bn]) if x is uj_plates[i][2])] = sb
+                uj_plates[i] = (bn, uj, sb)
+            cut_back.append((bn, uj.name, r))
+        for bn, jn, r in cut_back:
+            notes.append(f"universal joint {jn}: {bn}'s yoke plate into its rod reaches {r:.2f} mm from the pin, "
+                         "short of a full wall past the trim about it, clear of the other bodies")
+        if cut_back:
+            shapes = {bn: slabs[bn] + plates[bn] for bn in slabs}
+            samples = {bn: _slab_samples(shapes[bn], h) for bn in shapes}
     if GROWN_CLEAR and grown:
         # a grown stack's new stretch (its knuckles and the plates widening its bodies' slabs to
         # them) clear of every other body in every pose; else built again with that stack short
@@ -2438,6 +2471,20 @@ def _never(*_) -> bool:
     return False
 
 
+def _posed_points(pts, hosts, Ts) -> np.ndarray:
+    """Points (mm, rest world; ``hosts[i]``: the body point ``i`` is fixed in) in each pose of
+    ``Ts`` (body -> 4x4; ``None``: at rest): an array ``(len(Ts), len(pts), 3)``."""
+    pts = np.asarray(pts, float).reshape(-1, 3)
+    out = []
+    for T in Ts:
+        if T is None:
+            out.append(pts.copy())
+            continue
+        Rs = np.array([T[h][:3, :3] for h in hosts])
+        out.append(np.einsum("nij,nj->ni", Rs, pts) + np.array([T[h][:3, 3] for h in hosts]))
+    return np.stack(out)
+
+
 def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mid: list, kmin=None,
                g: float = 0.0, notes: list | None = None) -> bool:
     """Whether the knuckle stack of ``ax`` may grow on its ``side`` (+-1 along its direction)
@@ -2464,8 +2511,7 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
     if not posed_mid:
         mids = np.array([bx.origin for bx in axes], float)
         hosts = [bx.bodies[0] for bx in axes]
-        posed_mid.append(np.stack([mids] + [np.einsum("nij,nj->ni", np.array([T[h][:3, :3] for h in hosts]), mids)
-                                            + np.array([T[h][:3, 3] for h in hosts]) for T in Ts[1:]]))
+        posed_mid.append(_posed_points(mids, hosts, Ts))
     d = np.asarray(ax.direction, float)
     p0 = np.asarray(ax.origin, float) + side * a0 * d
     p1 = np.asarray(ax.origin, float) + side * a1 * d
@@ -2475,8 +2521,7 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
     pm = 0.5 * (p0 + p1)
     reach = 0.5 * abs(a1 - a0) + 2 * max(bx.R for bx in axes) + c + 0.5 * np.array([bx.span for bx in axes])
     near = set()
-    for k, T in enumerate(Ts):
-        q = pm if T is None else T[host][:3, :3] @ pm + T[host][:3, 3]
+    for k, q in enumerate(_posed_points(pm, [host], Ts)[:, 0]):
         near.update(np.nonzero(np.linalg.norm(posed_mid[0][k] - q, axis=1) < reach)[0].tolist())
     yields: dict = {}       # id(hinge) -> (hinge, end (+-1 along it), mm): applied if the stack may grow
     for i in sorted(near):
@@ -2507,9 +2552,7 @@ def _far_clear(ax: HingeAxis, side, a0, a1, axes, slabs, state_T, t, c, posed_mi
         bx.origin = np.asarray(bx.origin, float) - 0.5 * end * dl * np.asarray(bx.direction, float)
         # the prefilter's midpoints move with it: a later stack near this hinge's other end must
         # still find it (its reach takes the new, shorter span)
-        posed_mid[0][0, i] = bx.origin
-        for k, T in enumerate(Ts[1:], start=1):
-            posed_mid[0][k, i] = T[bx.bodies[0]][:3, :3] @ bx.origin + T[bx.bodies[0]][:3, 3]
+        posed_mid[0][:, i] = _posed_points(bx.origin, [bx.bodies[0]], Ts)[:, 0]
         bx.knuckle = (bx.span - (nk - 1) * g) / nk
         bx.intervals = {bn: [] for bn in bx.bodies}
         for j, bn in enumerate(bx.layout):
@@ -4354,11 +4397,53 @@ def _uj_plates(uj: UJoint, side: int, sbs, reach, t, n):
     rod_reach = None
     if side == 1 and uj.free_pin:
         # over the knuckles and the hub; with ROD_PLATE_WALL past the trim about the pin by a wall
-        rod_reach = max(uj.R, uj.hub_r) + 2 * t
-        if ROD_PLATE_WALL:
-            rod_reach = max(rod_reach, uj.rho[side] / np.cos(np.pi / n) + t)
+        # (ROD_PLATE_CLEAR: as far as that keeps clear of the other bodies, uj.rod_wall)
+        old, full = _rod_reaches(uj, t, n)
+        rod_reach = full if uj.rod_wall is None else max(old, uj.rod_wall)
     return _yoke_plates(sbs, uj.center, uj.axes[side], [lay.plate], reach, t, rod_reach=rod_reach,
                         fin_min=uj.R + t)
+
+
+def _rod_reaches(uj: UJoint, t, n) -> tuple:
+    """(old, full): how far (mm) a universal joint's yoke plate into a rod reaches from its pin
+    (``UJoint.free_pin``): over the knuckles and the hub, ``max(R, hub) + 2 t``; and with
+    ``ROD_PLATE_WALL`` at least the slab thickness past the trim about the pin (an ``n``-gon of
+    radius ``rho``, out to ``rho / cos(pi / n)``), else the old reach again."""
+    old = max(uj.R, uj.hub_r) + 2 * t
+    return old, max(old, uj.rho[1] / np.cos(np.pi / n) + t) if ROD_PLATE_WALL else old
+
+
+def _rod_wall_reach(uj: UJoint, sbs, reach, t, n, h, clash) -> float | None:
+    """(ROD_PLATE_CLEAR) How far (mm) the yoke plate into a rod of a universal joint's body O
+    (``sbs``: its slabs) may reach: the full ``ROD_PLATE_WALL`` reach where its stretch past the
+    old reach (:func:`_rod_reaches`) is clear (``clash(boxes)`` false of it), else the longest clear
+    reach in steps of ``h`` down to the old one; ``None`` when nothing is to be chosen (not a joint
+    into a rod, or the full reach is no longer than the old)."""
+    if not (ROD_PLATE_WALL and uj.free_pin):
+        return None
+    old, full = _rod_reaches(uj, t, n)
+    if full <= old + 1e-9:
+        return None
+    lay = uj.layouts[1]
+    short = _yoke_plates(sbs, uj.center, uj.axes[1], [lay.plate], reach, t, rod_reach=old, fin_min=uj.R + t)
+    long = _yoke_plates(sbs, uj.center, uj.axes[1], [lay.plate], reach, t, rod_reach=full, fin_min=uj.R + t)
+    grew = [(a, b) for a, b in zip(short, long) if b.size[1] > a.size[1] + 1e-9]
+    if not grew:
+        return None
+
+    def stretch(r):        # each grown plate's part from the old reach out to r
+        out = []
+        for a, b in grew:
+            w = b.R[:, 1]
+            start = b.center - w * b.size[1] / 2
+            size = b.size.copy()
+            size[1] = r - a.size[1]
+            out.append(SlabBox(start + w * 0.5 * (a.size[1] + r), b.R, size, b.normal_axis, b.offset))
+        return out
+    r = full
+    while r > old + 1e-9 and clash(stretch(r)):
+        r = max(old, r - h)
+    return r
 
 
 def _knuckles_off_slab(sbs, ax: HingeAxis, bn: str, t) -> bool:
