@@ -128,6 +128,11 @@ ROD_PLATE_WALL = True
 #: the Tetris robot's gates turn their input levers further than the circuit's, 73 degrees, and the
 #: longer post plate met ``core_cd``, 0.01-0.13 mm^3 in g1, g2 and g3)
 ROD_PLATE_CLEAR = True
+#: a universal joint's second pin chosen clear (:class:`_PinClearance`) of the knuckles and pin caps
+#: of the joints laid out before it on both their pins, not only on their second (session 64: the
+#: cap of gate g2's joint d on ``core_cd`` met the yoke knuckle of the chain's end joint under
+#: ``g2_a_lo`` in the Tetris robot's state 11, 0.39 mm^3)
+FIRST_PIN_CLEAR = True
 
 
 @contextlib.contextmanager
@@ -791,6 +796,12 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
                 best = (score, uj)
         uj = best[1]
         ujoints.append(uj)
+        if FIRST_PIN_CLEAR and compound is None:
+            # the first pin's knuckles and caps (on C, along u) for the joints after it too
+            lay0 = uj.layouts[0]
+            r0 = [x for a0, a1 in lay0.own + lay0.caps for x in (a0, 0.5 * (a0 + a1), a1)]
+            if r0:
+                pin_clear.add(cb, center, uj.axes[0], radii, r=np.array(r0))
         if compound is not None:
             hx = compound["axis"]
             hx.span, hx.knuckle, hx.intervals = compound["span"], compound["k"], compound["intervals"]
@@ -1647,12 +1658,32 @@ class _PinClearance:
         self.pending: dict = {}         # joint -> (body, point, untwisted second pin), mm,
                                         # until it is laid out: least_twist
         self._tree = None
+        self._kposed = None             # the knuckle points posed in every state (made on use)
 
     def add(self, body: str, center, v, radii, joint: str | None = None, r=None) -> None:
         """Knuckle axis points of a laid-out yoke (on ``body``), for the joints after it
         (``r``: their signed distances along ``v``, mm; both sides at ``radii`` by default)."""
         self.knuckles.append((body, center + np.outer(np.r_[radii, -radii] if r is None else r, v)))
         self.pending.pop(joint, None)
+        self._kposed = None
+
+    def _knuckles_posed_near(self, center, ob: str) -> np.ndarray:
+        """(FIRST_PIN_CLEAR) Which of ``knuckles`` come within the crop of the joint point in some
+        posed state, seen from ``ob`` (its lever may turn a knuckle far from where it is at rest
+        towards a joint part: the robot's gates turn their input levers 73 degrees)."""
+        if not self.knuckles or not self.state_T:
+            return np.zeros(len(self.knuckles), bool)
+        if self._kposed is None:
+            # every knuckle point posed in every state: (states, points, 3), and each point's item
+            pts = [(i, bn, k) for i, (bn, k) in enumerate(self.knuckles)]
+            self._kitem = np.concatenate([np.full(len(k), i) for i, _, k in pts])
+            self._kposed = np.stack([np.concatenate([k @ Ts[bn][:3, :3].T + Ts[bn][:3, 3] for _, bn, k in pts])
+                                     for _, Ts in self.state_T])
+        cs = np.array([Ts[ob][:3, :3] @ center + Ts[ob][:3, 3] for _, Ts in self.state_T])
+        d = np.linalg.norm(self._kposed - cs[:, None, :], axis=2).min(axis=0)
+        out = np.zeros(len(self.knuckles), bool)
+        out[self._kitem[d < self.crop]] = True
+        return out
 
     def _near(self, center, cb: str, ob: str) -> list:
         """[(body, points, need)] of the other bodies' slab samples and knuckles within the crop."""
@@ -1667,8 +1698,9 @@ class _PinClearance:
             bn = self.names[i]
             if bn not in (cb, ob):
                 out.append((bn, self._P[ix[self._owner[ix] == i]], self.slab_need))
-        for bn, k in self.knuckles:
-            if bn not in (cb, ob) and np.min(np.linalg.norm(k - center, axis=1)) < self.crop:
+        posed = self._knuckles_posed_near(center, ob) if FIRST_PIN_CLEAR else np.zeros(len(self.knuckles), bool)
+        for (bn, k), near_posed in zip(self.knuckles, posed):
+            if bn not in (cb, ob) and (near_posed or np.min(np.linalg.norm(k - center, axis=1)) < self.crop):
                 out.append((bn, k, self.knuckle_need))
         return out
 
