@@ -1658,14 +1658,18 @@ class _PinClearance:
         self.pending: dict = {}         # joint -> (body, point, untwisted second pin), mm,
                                         # until it is laid out: least_twist
         self._tree = None
-        self._kposed = None             # the knuckle points posed in every state (made on use)
+        self._kposed_items: list = []   # each knuckle item's points posed in every state
+        self._kposed = None             # ... all of them in one array (made on use)
 
     def add(self, body: str, center, v, radii, joint: str | None = None, r=None) -> None:
         """Knuckle axis points of a laid-out yoke (on ``body``), for the joints after it
         (``r``: their signed distances along ``v``, mm; both sides at ``radii`` by default)."""
-        self.knuckles.append((body, center + np.outer(np.r_[radii, -radii] if r is None else r, v)))
+        k = center + np.outer(np.r_[radii, -radii] if r is None else r, v)
+        self.knuckles.append((body, k))
         self.pending.pop(joint, None)
-        self._kposed = None
+        if self.state_T:      # posed once, here: (states, points, 3)
+            self._kposed_items.append(np.stack([k @ Ts[body][:3, :3].T + Ts[body][:3, 3] for _, Ts in self.state_T]))
+            self._kposed = None
 
     def _knuckles_posed_near(self, center, ob: str) -> np.ndarray:
         """(FIRST_PIN_CLEAR) Which of ``knuckles`` come within the crop of the joint point in some
@@ -1674,11 +1678,9 @@ class _PinClearance:
         if not self.knuckles or not self.state_T:
             return np.zeros(len(self.knuckles), bool)
         if self._kposed is None:
-            # every knuckle point posed in every state: (states, points, 3), and each point's item
-            pts = [(i, bn, k) for i, (bn, k) in enumerate(self.knuckles)]
-            self._kitem = np.concatenate([np.full(len(k), i) for i, _, k in pts])
-            self._kposed = np.stack([np.concatenate([k @ Ts[bn][:3, :3].T + Ts[bn][:3, 3] for _, bn, k in pts])
-                                     for _, Ts in self.state_T])
+            # every knuckle point posed in every state (states, points, 3), and each point's item
+            self._kposed = np.concatenate(self._kposed_items, axis=1)
+            self._kitem = np.concatenate([np.full(len(k), i) for i, (_, k) in enumerate(self.knuckles)])
         cs = np.array([Ts[ob][:3, :3] @ center + Ts[ob][:3, 3] for _, Ts in self.state_T])
         d = np.linalg.norm(self._kposed - cs[:, None, :], axis=2).min(axis=0)
         out = np.zeros(len(self.knuckles), bool)
