@@ -1658,18 +1658,15 @@ class _PinClearance:
         self.pending: dict = {}         # joint -> (body, point, untwisted second pin), mm,
                                         # until it is laid out: least_twist
         self._tree = None
-        self._kposed_items: list = []   # each knuckle item's points posed in every state
-        self._kposed = None             # ... all of them in one array (made on use)
+        self._kposed_items: list = []   # each knuckle item's points posed in every state (made on use)
+        self._kposed = None             # ... all of them in one array
+        self._kposed_for = None         # ... for this state_T
 
     def add(self, body: str, center, v, radii, joint: str | None = None, r=None) -> None:
         """Knuckle axis points of a laid-out yoke (on ``body``), for the joints after it
         (``r``: their signed distances along ``v``, mm; both sides at ``radii`` by default)."""
-        k = center + np.outer(np.r_[radii, -radii] if r is None else r, v)
-        self.knuckles.append((body, k))
+        self.knuckles.append((body, center + np.outer(np.r_[radii, -radii] if r is None else r, v)))
         self.pending.pop(joint, None)
-        if self.state_T:      # posed once, here: (states, points, 3)
-            self._kposed_items.append(np.stack([k @ Ts[body][:3, :3].T + Ts[body][:3, 3] for _, Ts in self.state_T]))
-            self._kposed = None
 
     def _knuckles_posed_near(self, center, ob: str) -> np.ndarray:
         """(FIRST_PIN_CLEAR) Which of ``knuckles`` come within the crop of the joint point in some
@@ -1677,8 +1674,12 @@ class _PinClearance:
         towards a joint part: the robot's gates turn their input levers 73 degrees)."""
         if not self.knuckles or not self.state_T:
             return np.zeros(len(self.knuckles), bool)
-        if self._kposed is None:
-            # every knuckle point posed in every state (states, points, 3), and each point's item
+        if self._kposed_for is not self.state_T:
+            self._kposed_items, self._kposed, self._kposed_for = [], None, self.state_T
+        if len(self._kposed_items) < len(self.knuckles):
+            # each knuckle item posed once, in every state: (states, points, 3)
+            for bn, k in self.knuckles[len(self._kposed_items):]:
+                self._kposed_items.append(np.stack([k @ Ts[bn][:3, :3].T + Ts[bn][:3, 3] for _, Ts in self.state_T]))
             self._kposed = np.concatenate(self._kposed_items, axis=1)
             self._kitem = np.concatenate([np.full(len(k), i) for i, (_, k) in enumerate(self.knuckles)])
         cs = np.array([Ts[ob][:3, :3] @ center + Ts[ob][:3, 3] for _, Ts in self.state_T])
