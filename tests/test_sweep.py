@@ -9,7 +9,6 @@ import pytest
 import yaml
 
 from mlc.cli import main
-from mlc.errors import MlcError
 from mlc.io.schema import load_schema
 from mlc.sweep.measure import run_task
 from mlc.sweep.spec import load_spec

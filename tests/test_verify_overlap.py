@@ -11,7 +11,7 @@ import trimesh
 from scipy.spatial import ConvexHull
 from helpers import ROOT
 
-from mlc.gates.parts import EX, EY, EZ, hinge, slab_body, universal_joint
+from mlc.gates.parts import EX, EZ, hinge, slab_body, universal_joint
 from mlc.scene.model import Body, Box, Scene
 from mlc.verify.overlap import _quat_matrices, box_clearance, box_separation, clearance
 
@@ -112,7 +112,6 @@ def test_universal_joint_pass_through_is_reported():
 
 
 def test_poses_argument_moves_bodies():
-    o = np.zeros(3)
     s = _two_slab_scene(np.array([-1.0, 0, 0]), np.array([-0.2, 0, 0]), np.array([0.2, 0, 0]), np.array([1.0, 0, 0]))
     r = clearance(s)
     assert r.min_clearance == pytest.approx(0.4, abs=1e-12)

@@ -122,7 +122,8 @@ def run(args) -> int:
         notice(args.scheme)
     rep = verify_scene_file(scene, args.dynamic, args.kT, args.seeds, args.scheme, args.rows,
                             args.require_clearance, tau=args.tau, dt=args.dt, jobs=args.jobs)
+    fmt = format_report
     if isinstance(scene.meta, dict) and scene.meta.get("element") == "robot":
-        from mlc.robot.verify import format_robot_report as format_report
-    print(json.dumps(rep.as_dict()) if args.json else format_report(rep))
+        from mlc.robot.verify import format_robot_report as fmt
+    print(json.dumps(rep.as_dict()) if args.json else fmt(rep))
     return 0 if rep.ok else 1

@@ -1658,8 +1658,9 @@ class _PinClearance:
         self.pending: dict = {}         # joint -> (body, point, untwisted second pin), mm,
                                         # until it is laid out: least_twist
         self._tree = None
-        self._kposed_items: list = []   # each knuckle item's points posed in every state (made on use)
-        self._kposed = None             # ... all of them in one array
+        self._kbuf = None               # every knuckle item's points posed in every state, (states, cap, 3),
+        self._kitem = None              # ... each point's item (cap,): filled up to _kn points,
+        self._kn = self._kdone = 0      # ... from the first _kdone items (made on use)
         self._kposed_for = None         # ... for this state_T
 
     def add(self, body: str, center, v, radii, joint: str | None = None, r=None) -> None:
@@ -1675,17 +1676,27 @@ class _PinClearance:
         if not self.knuckles or not self.state_T:
             return np.zeros(len(self.knuckles), bool)
         if self._kposed_for is not self.state_T:
-            self._kposed_items, self._kposed, self._kposed_for = [], None, self.state_T
-        if len(self._kposed_items) < len(self.knuckles):
-            # each knuckle item posed once, in every state: (states, points, 3)
-            for bn, k in self.knuckles[len(self._kposed_items):]:
-                self._kposed_items.append(np.stack([k @ Ts[bn][:3, :3].T + Ts[bn][:3, 3] for _, Ts in self.state_T]))
-            self._kposed = np.concatenate(self._kposed_items, axis=1)
-            self._kitem = np.concatenate([np.full(len(k), i) for i, (_, k) in enumerate(self.knuckles)])
+            self._kbuf, self._kitem, self._kn, self._kdone, self._kposed_for = None, None, 0, 0, self.state_T
+        if self._kdone < len(self.knuckles):
+            # each new knuckle item posed once, in every state, into a buffer that doubles when full
+            new = [(i, np.stack([k @ Ts[bn][:3, :3].T + Ts[bn][:3, 3] for _, Ts in self.state_T]))
+                   for i, (bn, k) in enumerate(self.knuckles[self._kdone:], self._kdone)]
+            m = sum(q.shape[1] for _, q in new)
+            if self._kbuf is None or self._kn + m > self._kbuf.shape[1]:
+                cap = max(64, 2 * (self._kn + m))
+                buf, item = np.empty((len(self.state_T), cap, 3)), np.empty(cap, dtype=int)
+                if self._kbuf is not None:
+                    buf[:, :self._kn], item[:self._kn] = self._kbuf[:, :self._kn], self._kitem[:self._kn]
+                self._kbuf, self._kitem = buf, item
+            for i, q in new:
+                self._kbuf[:, self._kn:self._kn + q.shape[1]] = q
+                self._kitem[self._kn:self._kn + q.shape[1]] = i
+                self._kn += q.shape[1]
+            self._kdone = len(self.knuckles)
         cs = np.array([Ts[ob][:3, :3] @ center + Ts[ob][:3, 3] for _, Ts in self.state_T])
-        d = np.linalg.norm(self._kposed - cs[:, None, :], axis=2).min(axis=0)
+        d = np.linalg.norm(self._kbuf[:, :self._kn] - cs[:, None, :], axis=2).min(axis=0)
         out = np.zeros(len(self.knuckles), bool)
-        out[self._kitem[d < self.crop]] = True
+        out[self._kitem[:self._kn][d < self.crop]] = True
         return out
 
     def _near(self, center, cb: str, ob: str) -> list:

@@ -22,7 +22,6 @@ import io
 import json
 import logging
 import math
-import os
 import platform
 from pathlib import Path
 

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 from mlc.errors import Loc, MlcError
 from mlc.io.schema import load_schema, validate
-from mlc.io.yamlsrc import load_file, loc_of
+from mlc.io.yamlsrc import loc_of
 from mlc.sweep.scenes import BUILDERS
 
 #: integrator parameters and their defaults (None: the integrator's own default)
