@@ -113,7 +113,8 @@ def test_report_json_round_trip():
         "watertight", "part_count", "min_gap", "states", "motion_clearance", "retention", "features",
         "wall_thickness", "bed_contact", "supports"]
     assert [c["blocking"] for c in d["checks"]][-3:] == [False, False, False]
-    assert d["checks"][4]["blocking"] is False
+    # motion_clearance: without dense poses measured in the states check's poses, a goal there
+    assert d["checks"][4]["blocking"] is False and "states check's poses" in d["checks"][4]["detail"]
 
 
 @pytest.mark.parametrize("profile", ["mjp", "fdm"])
@@ -164,6 +165,87 @@ def test_motion_clearance_fails_within_the_clearance_without_meeting():
     mc = motion_check(asm, poses)
     assert mc.ok and (mc.value is None or mc.value >= c - 1e-6), mc.detail
     assert not motion_check(asm, None).ok and not motion_check(asm, None).blocking   # not measured: reported
+
+
+def test_coarse_motion_clearance_without_dense_poses():
+    """Without dense poses (a compiled circuit's case), ``motion_clearance`` is measured in the
+    states check's own poses: the two slabs of the test above half a clearance apart in one of
+    them fail it (that pose named, that gap), though the states check passes, and the report says
+    so as a goal not met (not blocking); 1.5 clearances apart they pass."""
+    from mlc.mesh.export import part_meshes
+    from mlc.scene.model import Scene
+    prof = load_profile("mjp")
+    c, s = prof.clearance, prof.sigma_mm
+    sc = Scene("two_slabs", [ex._slab("A", 0.0), ex._slab("B", 0.0, origin=(0.0, 1.0, 0.0))], []).check()
+    rest = (np.array([b.position for b in sc.bodies], float), np.array([b.orientation for b in sc.bodies], float))
+    meshes = dict(part_meshes(build_assembly(sc, prof, {"0": rest}, resolve=False)))
+    g0 = meshes["B"].vertices[:, 1].min() - meshes["A"].vertices[:, 1].max()      # mm, on the meshes
+
+    def moved(gap):
+        p = rest[0].copy()
+        p[1, 1] -= (g0 - gap) / s
+        return p, rest[1]
+    rep = check_assembly(build_assembly(sc, prof, {"0": rest, "near": moved(0.5 * c), "clear": moved(1.5 * c)},
+                                        resolve=False), walls=False)
+    mc = rep.check("motion_clearance")
+    assert not mc.ok and not mc.blocking, mc.detail
+    assert mc.failures == [f"near: A - B: {0.5 * c:.4f} mm"] and abs(mc.value - 0.5 * c) < 1e-6
+    assert "states check's poses" in mc.detail
+    assert rep.check("states").ok and "[GOAL NOT MET] motion_clearance" in rep.text()
+    mc = check_assembly(build_assembly(sc, prof, {"0": rest, "clear": moved(1.5 * c)}, resolve=False),
+                        walls=False).check("motion_clearance")
+    assert mc.ok, mc.detail
+
+
+def test_coarse_motion_clearance_leaves_jointed_parts_to_the_states_check():
+    """Two slabs on one hinge, one moved across the axis by half the clearance: the pin sits off
+    the middle of its hole, closer to its wall than the clearance (the dense check, which measures
+    every pair, says so: the pose is what the test claims), without meeting it.  The coarse
+    check leaves such jointed pairs to the states check (a twisted joint bears on its pin) and
+    passes."""
+    from mlc.mesh.checks import motion_check
+    prof = load_profile("mjp")
+    c, s = prof.clearance, prof.sigma_mm
+    sc = ex.hinge_pair()
+    (p0, q0), = ex.hinge_poses(sc, {"0": 0.0}).values()
+    p1 = p0.copy()
+    p1[1, 0] += 0.5 * c / s                   # across the hinge's axis (z)
+    poses = {"0": (p0, q0), "off": (p1, q0)}
+    asm = build_assembly(sc, prof, poses)
+    rep = check_assembly(asm, walls=False)
+    assert rep.check("states").ok, rep.check("states").failures
+    dense = motion_check(asm, poses)
+    assert not dense.ok and dense.value < c - 0.25 * c, dense.detail      # the jointed pair within the clearance
+    assert rep.check("motion_clearance").ok, rep.check("motion_clearance").detail
+
+
+def test_coarse_motion_clearance_of_circuit_pieces():
+    """A piece of the Tetris robot (gate g2 with its couplings, the robot's 22 poses) has parts that
+    share no joint closer than the clearance in its poses, which the coarse check names; outside
+    mlc, trimesh samples of each named pair posed in that pose and a k-d tree (an upper bound of
+    the gap) find them closer than the clearance too.  The README circuit's gate g3 with its
+    chains' ends keeps the clearance in all 22 of its poses."""
+    import re
+
+    from helpers import mesh_piece, part_gaps
+    asm, rep = mesh_piece("robot_g2", walls=False)
+    mc = rep.check("motion_clearance")
+    c = asm.profile.clearance
+    assert not mc.ok and not mc.blocking, mc.detail
+    named = {}
+    for f in mc.failures:
+        st, a, b, g = re.match(r"(\S+): (\S+) - (\S+): ([\d.]+) mm", f).groups()
+        named.setdefault((a, b), []).append((st, float(g)))
+    assert ("g2_a_lo", "g2_out_hi") in named or ("g2_out_hi", "g2_a_lo") in named, sorted(named)
+    partners = {p.name: set(p.partners) for p in asm.parts}
+    for (a, b), hits in named.items():
+        assert b not in partners[a] and a not in partners[b]
+        st, g = min(hits, key=lambda h: h[1])
+        outside = part_gaps(asm, a, b, {st: asm.poses[st]})[st]
+        assert g - 1e-6 <= outside < c, (a, b, st, g, outside)
+    asm, rep = mesh_piece("circuit_g3", walls=False)
+    mc = rep.check("motion_clearance")
+    assert mc.ok and "22 poses" not in mc.detail and "18 poses on the way" in mc.detail, mc.detail
 
 
 def _verts(asm, name):

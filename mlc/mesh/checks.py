@@ -13,8 +13,9 @@ Checks (each one can fail; a failed check makes ``mlc stl`` exit non-zero unless
                  their bodies
 ``motion_clearance`` no two parts closer than the clearance in any pose of the dense paths
                  from rest and of every switch between two states (a mechanism of fewer than 64
-                 parts, such as a library gate; for a compiled circuit it is not measured and
-                 does not block)
+                 parts, such as a library gate); a compiled circuit, posed coarsely, in the
+                 states check's poses, between parts that share no joint (_CoarseClearance; a
+                 goal there, not blocking)
 ``retention``    every jointed part displaced by 1.5 x clearance in each of six directions
                  (along and across its axis) runs into a joint partner: nothing falls out
 ``features``     every feature is at least the profile's minimum (slab, knuckle wall, pin,
@@ -41,8 +42,8 @@ from mlc.mesh.build import Assembly, _log, _perp_frame, box, transform_solid, un
 from mlc.mesh.congruence import shape_key
 
 #: checks reported but not (yet) failing an export: the library gates do not meet them (issue 13).
-#: ``motion_clearance`` blocks where it is measured (a mechanism of fewer than 64 parts) and is
-#: reported only where it is not (a compiled circuit)
+#: ``motion_clearance`` blocks where it is measured on dense poses (a library gate) and is reported only
+#: where it is measured on a compiled circuit's coarse poses (a goal there) or not at all (no poses)
 NON_BLOCKING = ("wall_thickness", "bed_contact", "supports")
 VOL_EPS = 1e-6    # mm^3: intersections smaller than this are numerical contact, not overlap
 GAP_EPS = 1e-6    # mm
@@ -51,6 +52,9 @@ SUPPORT_MAX = 0.10         # support volume / part volume
 OVERHANG_DEG = 45.0        # faces steeper than this from vertical need support (FDM rule of thumb)
 ISLAND_FEATURES = 3.0      # an island's support column: a square of this many min_feature a side
 APART = True               # large assemblies: states and min_gap prove pairs apart from their triangles first (mlc.mesh.apart)
+#: without dense poses (a compiled circuit) ``motion_clearance`` is measured in the states check's poses
+#: between parts that share no joint (:class:`_CoarseClearance`, session 65); off: not measured, as before
+COARSE_CLEARANCE = True
 
 
 @dataclass
@@ -134,13 +138,13 @@ def motion_check(asm: Assembly, poses: dict | None) -> Check:
     """The ``motion_clearance`` goal: in every pose of ``poses`` (``{name: (pos, quat)}``, sigma:
     the dense paths and switches of :func:`mlc.mesh.pipeline.state_poses` with ``max_move``) every
     pair of parts keeps the clearance (:func:`mlc.mesh.spatial.posed_gaps`); not measured without
-    poses (a compiled circuit: the states check tests its coarse poses for intersection only)."""
+    poses (a compiled circuit has no dense poses: :class:`_CoarseClearance` measures it in the
+    states check's poses instead)."""
     c = asm.profile.clearance
     blocking = "motion_clearance" not in NON_BLOCKING
     if not poses:
-        return Check("motion_clearance", False, None, c, "not measured: no dense poses (a mechanism of 64 "
-                     "parts or more, such as a compiled circuit, is posed coarsely and checked for intersection "
-                     "only)", ["the clearance in motion was not measured"], False)
+        return Check("motion_clearance", False, None, c, "not measured: no poses (static verification gave "
+                     "none)", ["the clearance in motion was not measured"], False)
     from mlc.mesh.spatial import local_boxes, part_frames, posed_gaps
     parts = asm.parts
     frames = part_frames(asm)
@@ -165,6 +169,100 @@ def motion_check(asm: Assembly, poses: dict | None) -> Check:
                      else f" >= clearance {c:g} mm"))
     return Check("motion_clearance", not low, None if smallest is None else round(smallest[0], 5), c, detail,
                  low, blocking)
+
+
+def _box_corners(frames, llo, lhi) -> np.ndarray:
+    """The corners of each part's own box (local boxes ``[llo, hi]`` in their 4x4 ``frames``), in the
+    world as printed: ``(n, 8, 3)``, mm."""
+    sel = np.array([[(lhi if (k >> a) & 1 else llo)[:, a] for a in range(3)] for k in range(8)])
+    Fr = np.asarray(frames, float)
+    return np.einsum("nij,nkj->nki", Fr[:, :3, :3], np.transpose(sel, (2, 0, 1))) + Fr[:, None, :3, 3]
+
+
+def _moves(cand, Tp, corners) -> np.ndarray:
+    """For each pair ``(i, j)`` of ``cand``, the largest move of a point of part j relative to part i
+    between rest and the pose ``Tp`` (each part's 4x4): the largest move of a corner of j's own box,
+    an affine map's norm being convex (mm).  A pair whose gap as printed is more than that cannot
+    have closed it."""
+    P = np.asarray(cand, int)
+    Ta = np.asarray(Tp, float)
+    M = np.linalg.solve(Ta[P[:, 0]], Ta[P[:, 1]])                          # j seen from i
+    X = corners[P[:, 1]]
+    return np.linalg.norm(np.einsum("nij,nkj->nki", M[:, :3, :3], X) + M[:, None, :3, 3] - X, axis=2).max(axis=1)
+
+
+class _CoarseClearance:
+    """The ``motion_clearance`` goal of a mechanism without dense poses (64 parts or more, a
+    compiled circuit): in every pose the states check poses it in (the logic states and points on
+    the way to them), every pair of parts that share no joint keeps the clearance.  Parts jointed to
+    each other (:attr:`Part.partners`: a hinge's bodies, a universal joint's part and its bodies)
+    are left to the states check: a joint that twists or bends past its printed play sets its pin
+    on the wall of its hole (gap 0, not an intersection), where a library gate's exact kinematics
+    keep the clearance.  A goal here, reported and not blocking (as ``wall_thickness``,
+    ``bed_contact`` and ``supports``): compiled circuits do not meet it yet (the slabs of a chain's
+    consecutive half units pass within it where their junction bends; a gate's levers under the
+    robot's larger turns; ``benchmarks/results/coarse_clearance_s65.json``), and blocking would fail
+    every circuit's export.  A pair is measured (manifold3d ``min_gap``, to the clearance) where its
+    oriented boxes come within the clearance, unless it moved, relative to each other, by less than
+    its gap as printed less the clearance (the states check's rule); congruent pairs in one relative
+    pose once (:mod:`mlc.mesh.congruence`)."""
+
+    def __init__(self, asm: Assembly, rest_gap: dict, frames, llo, lhi):
+        self.asm, self.c, self.rest_gap = asm, asm.profile.clearance, rest_gap
+        self.frames, self.llo, self.lhi = frames, llo, lhi
+        self.cong = getattr(asm, "congruence", None)
+        parts = asm.parts
+        idx = {p.name: i for i, p in enumerate(parts)}
+        self.partner = {(min(i, j), max(i, j)) for i, p in enumerate(parts) for j in
+                        (idx.get(q) for q in p.partners) if j is not None}
+        self.corners = _box_corners(frames, llo, lhi)
+        self.low, self.smallest, self.measured = [], None, 0
+
+    def pose(self, name, Tp, plo, phi, posed: dict) -> None:
+        """Measure the pose ``name`` (``Tp``: each part's 4x4, mm; ``plo``, ``phi``: the posed
+        world boxes; ``posed``: the posed solids made so far, shared with the states check)."""
+        from mlc.mesh.spatial import box_pairs, obb_overlap
+        c, parts, cong = self.c, self.asm.parts, self.cong
+        cand = [pr for pr in box_pairs(plo, phi, c) if pr not in self.partner]
+        cand = obb_overlap(cand, [t @ f for t, f in zip(Tp, self.frames)], self.llo, self.lhi, pad=0.5 * c + GAP_EPS)
+        if not cand:
+            return
+        d = _moves(cand, Tp, self.corners)
+        g0 = np.array([self.rest_gap.get(pr, 2 * c) for pr in cand])
+        cand = [pr for pr, keep in zip(cand, d >= g0 - c - 1e-9) if keep]
+        rels = cong.rel_many(cand, Tp) if cong is not None else None
+
+        def gap(i, j):
+            for k in (i, j):
+                if k not in posed:
+                    posed[k] = transform_solid(parts[k].solid, Tp[k])
+            return float(posed[i].min_gap(posed[j], c))
+        for k, (i, j) in enumerate(cand):
+            self.measured += 1
+            g = (gap(i, j) if cong is None else
+                 cong.lookup(("gap", c, cong.key(i, parts[i].solid), cong.key(j, parts[j].solid), rels[k]),
+                             lambda: gap(i, j)))
+            if self.smallest is None or g < self.smallest[0]:
+                self.smallest = (g, parts[i].name, parts[j].name, name)
+            if g < c - GAP_EPS:
+                self.low.append(f"{name}: {parts[i].name} - {parts[j].name}: {g:.4f} mm"
+                                + (" (touching)" if g <= GAP_EPS else ""))
+
+    def check(self, poses: dict) -> Check:
+        c = self.c
+        n_path = sum("@" in str(k) for k in poses)
+        what = (f"{len(poses) - n_path} logic states and {n_path} poses on the way to them (the states check's "
+                f"poses, not dense paths), between parts that share no joint")
+        if self.smallest is None:
+            detail = f"no two parts within the clearance {c:g} mm in {what}"
+        else:
+            g, a, b, st = self.smallest
+            pairs = {f.split(": ")[1] for f in self.low}
+            detail = (f"smallest gap {g:.3f} mm ({a} - {b}, {st}) in {what}"
+                      + (f"; {len(pairs)} pairs closer than the clearance {c:g} mm, {len(self.low)} times over the "
+                         f"poses" if self.low else f" >= clearance {c:g} mm"))
+        return Check("motion_clearance", not self.low, None if self.smallest is None else round(self.smallest[0], 5),
+                     c, detail, self.low, False)
 
 
 def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True,
@@ -252,15 +350,13 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True,
         llo, lhi = local_boxes([p.solid for p in parts], frames)
         rlo = np.array([b[0] for b in boxes]).reshape(-1, 3)
         rhi = np.array([b[1] for b in boxes]).reshape(-1, 3)
-        if cong is not None:
-            # corners of each part's own box, in the world as printed (mm)
-            sel = np.array([[(lhi if (k >> a) & 1 else llo)[:, a] for a in range(3)] for k in range(8)])
-            loc = np.transpose(sel, (2, 0, 1))                                           # (n, 8, 3)
-            Fr = np.asarray(frames, float)
-            corners = np.einsum("nij,nkj->nki", Fr[:, :3, :3], loc) + Fr[:, None, :3, 3]
+        corners = _box_corners(frames, llo, lhi) if cong is not None else None
         skipped = 0
         apart_n = [0]
         meshes: dict = {}
+        # without dense poses (a compiled circuit), the clearance in motion is measured here, in
+        # these poses, between parts that share no joint (:class:`_CoarseClearance`)
+        coarse = _CoarseClearance(asm, rest_gap, frames, llo, lhi) if COARSE_CLEARANCE and not motion_poses else None
 
         def mesh_of(k):
             if k not in meshes:
@@ -277,18 +373,15 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True,
                 # large assemblies: a pair that moves, relative to each other, by less than its gap
                 # as printed cannot meet (every point of j moves by at most the largest move of a
                 # corner of its own box, an affine map's norm being convex): no boolean for it
-                P = np.asarray(cand, int)
-                Ta = np.asarray(Tp, float)
-                M = np.linalg.solve(Ta[P[:, 0]], Ta[P[:, 1]])                          # j seen from i
-                X = corners[P[:, 1]]
-                d = np.linalg.norm(np.einsum("nij,nkj->nki", M[:, :3, :3], X) + M[:, None, :3, 3] - X,
-                                   axis=2).max(axis=1)
+                d = _moves(cand, Tp, corners)
                 g0 = np.array([rest_gap.get((i, j), 2 * c) for i, j in cand])
                 keep = ~((g0 > GAP_EPS) & (d < g0 - 1e-9))
                 skipped += int((~keep).sum())
                 cand = [pr for pr, k in zip(cand, keep) if k]
             posed = {}
             posed_v = {}
+            if coarse is not None:
+                coarse.pose(st, Tp, plo, phi, posed)
 
             def vol(i, j):
                 for k in (i, j):
@@ -334,7 +427,7 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True,
                             "no equilibrium poses: the logic states were not checked",
                             ["static verification gave no poses (use --force to export unchecked)"]))
 
-    checks.append(motion_check(asm, motion_poses))
+    checks.append(coarse.check(poses) if poses and coarse is not None else motion_check(asm, motion_poses))
     _log("check states done")
     # -- retention ---------------------------------------------------------------------------
     checks.append(_retention(asm))

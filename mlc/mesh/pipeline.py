@@ -269,7 +269,8 @@ def _dense_poses(scene: Scene, profile: Profile, notes: list) -> dict | None:
     ``motion_clearance`` check (mlc.mesh.checks.motion_check): for a mechanism
     of fewer than ``REUSE_MIN_PARTS`` parts, :func:`state_poses` with ``max_move`` the clearance in
     sigma (two parts that keep the clearance in two consecutive poses, each point moving at most
-    that much, cannot meet between them); None for a larger one (a compiled circuit: too many)."""
+    that much, cannot meet between them); None for a larger one (a compiled circuit: too many; its
+    ``motion_clearance`` is measured in its coarse poses, mlc.mesh.checks._CoarseClearance)."""
     from mlc.mesh.build import reuses
     if reuses(scene) or profile.clearance <= 0:
         return None          # (no clearance: nothing to keep; min_gap fails the export)
@@ -457,7 +458,7 @@ def _merge_reports(scene, profile, mechs, built, full, owner) -> Report:
     checks.append(Check("motion_clearance", all(ch.ok for _, ch in subs), min(vals) if vals else None, c,
                         "; ".join(f"{mechs[k].scene.name}: {ch.detail}" for k, ch in subs)[:2000],
                         [f"{mechs[k].scene.name}: {f}" for k, ch in subs for f in ch.failures],
-                        # a measured mechanism short of the clearance blocks; not measured does not
+                        # a mechanism short of the clearance on dense poses blocks; coarse or not measured does not
                         any(not ch.ok and ch.blocking for _, ch in subs) or all(ch.ok for _, ch in subs)))
     # measured walls: per distinct mechanism (copies are translated, their walls the same)
     walls = [(k, reps[k].check("wall_thickness")) for k in reps if "wall_thickness" in
