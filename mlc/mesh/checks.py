@@ -216,7 +216,7 @@ class _CoarseClearance:
         self.partner = {(min(i, j), max(i, j)) for i, p in enumerate(parts) for j in
                         (idx.get(q) for q in p.partners) if j is not None}
         self.corners = _box_corners(frames, llo, lhi)
-        self.low, self.smallest, self.measured = [], None, 0
+        self.low, self.smallest = [], None
 
     def pose(self, name, Tp, plo, phi, posed: dict) -> None:
         """Measure the pose ``name`` (``Tp``: each part's 4x4, mm; ``plo``, ``phi``: the posed
@@ -238,7 +238,6 @@ class _CoarseClearance:
                     posed[k] = transform_solid(parts[k].solid, Tp[k])
             return float(posed[i].min_gap(posed[j], c))
         for k, (i, j) in enumerate(cand):
-            self.measured += 1
             g = (gap(i, j) if cong is None else
                  cong.lookup(("gap", c, cong.key(i, parts[i].solid), cong.key(j, parts[j].solid), rels[k]),
                              lambda: gap(i, j)))
