@@ -70,7 +70,9 @@ def test_the_far_corners_of_a_junction_bent_to_its_stop_clear(junction, monkeypa
     prof = load_profile("mjp")
     states, pairs = _pairs(build_assembly(sc, prof, poses, reuse=True))
     assert states.ok, states.failures
-    # each of the three changes, left out alone, leaves its intersection
+    # each of the three changes, left out alone, leaves its intersection (without the state trims
+    # of session 66, which trim some of these pairs of bodies sharing no hinge in the state instead)
+    monkeypatch.setattr(B, "STATE_CLEAR", False)
     monkeypatch.setattr(B, "BEVEL_ENDS", False)
     _, pairs = _pairs(build_assembly(sc, prof, poses, reuse=True))
     assert pairs == {"w_b_0_60_AB intersects w_b_0_61_AB"}, pairs

@@ -106,6 +106,12 @@ STACK_CYLINDERS = True
 #: stack's own in every pose (:func:`_grown_near`), else the stack is built short (session 59): a
 #: grown stack's plates met a half unit's hinge partner past that hinge's span, where no trim clears them
 GROWN_CLEAR = True
+#: a compound junction's yoke on both sides whose knuckle on one side comes within the clearance
+#: of another joint's yoke plate on another body in some pose (where neither the pin choice, which
+#: sees slabs and knuckles, nor the trims, which keep knuckles and would cut the plate off its
+#: knuckles, clear it) is built again one-sided, on the other side (:func:`_knuckles_at_plates`;
+#: session 66: the compiled (a & b) | c, the chain's first junctions on g1's two output levers)
+KNUCKLE_PLATES = True
 #: a compound junction's fin kept past the joint part's ball, clear of O's trim about the second pin, where
 #: the collar never turns round to it (:func:`_fin_keep`; session 60)
 FIN_KEPT = True
@@ -478,7 +484,7 @@ def build_assembly(scene: Scene, profile: Profile, poses: dict | None = None,
                 # a compound junction's turned pin left its other body in pieces: built again,
                 # those joints' pins chosen among the ones that leave it whole (session 52, below)
                 _log(f"universal joints {', '.join(sorted(map(str, e.joints)))}: the turned pin (or a "
-                     "grown stack) cut the other body in pieces; built again with pins that leave it whole")
+                     "grown stack) cut the other body in pieces, or a knuckle met another joint's plate; built again")
                 untwist |= e.joints
     finally:
         _LOCAL[0] = None     # primitives are built in the world again, whatever happened
@@ -772,6 +778,11 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
             if jname in untwist:
                 notes.append(f"universal joint {jname}: its turned pin cut {ob} in pieces; "
                              + ("pin as laid out" if v is v_laid else "turned less"))
+        forced = next((m for m in "+-" if ("side", jname, m) in untwist), None)
+        if compound is not None and forced is not None:
+            o_mode = forced
+            notes.append(f"universal joint {jname}: one-sided yoke ({forced}) on {ob}, its knuckle on the other "
+                         "side met another joint's yoke plate in a pose")
         pin_clear.add(ob, center, v, radii, jname,
                       r=None if o_mode == "both" else (1 if o_mode == "+" else -1) * np.r_[radii, cap_r])
         best = None
@@ -916,6 +927,12 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
         if cut_back:
             shapes = {bn: slabs[bn] + plates[bn] for bn in slabs}
             samples = {bn: _slab_samples(shapes[bn], h) for bn in shapes}
+    if KNUCKLE_PLATES and reuse and state_T:
+        hit = _knuckles_at_plates(ujoints, uj_plates, state_T, R + c + t / 2, h)
+        hit = {(jn, m) for jn, m in hit if ("side", jn, "+") not in untwist and ("side", jn, "-") not in untwist}
+        _log(f"yoke knuckles at other joints' plates: {len(hit)} junction(s) built again one-sided")
+        if hit:
+            raise _Untwist({("side", jn, m) for jn, m in hit})
     if GROWN_CLEAR and grown:
         # a grown stack's new stretch (its knuckles and the plates widening its bodies' slabs to
         # them) clear of every other body in every pose; else built again with that stack short
@@ -2653,6 +2670,42 @@ def _stacks_clear(ax: HingeAxis, bx: HingeAxis, p0, p1, P, q0, q1, Ts, host, ste
     return True
 
 
+def _knuckles_at_plates(ujoints, uj_plates, state_T, need, h) -> set:
+    """(KNUCKLE_PLATES) ``{(joint, mode)}``: the compound junctions whose other body's yoke, on
+    both sides of the hub, has its knuckles on one side only within ``need`` (mm: knuckle radius,
+    half the plate thickness and the clearance) of the yoke plates of another joint on another
+    body in some posed state (``state_T``), and the one-sided mode that keeps the other side.
+    Knuckles: points on the pin at each knuckle's ends and middle; plates: the boxes of
+    ``uj_plates`` (``(body, joint, box)``) sampled every ``h`` mm on their mid-planes."""
+    from scipy.spatial import cKDTree
+    items = []                 # (joint, body, points (k, 3), signs (k,))
+    for uj in ujoints:
+        lay = uj.layouts[1]
+        if uj.host is None or lay.mode != "both":
+            continue
+        r = np.array([x for a0, a1 in lay.own for x in (a0, 0.5 * (a0 + a1), a1)])
+        items.append((uj, uj.bodies[1], uj.center + np.outer(r, uj.axes[1]), np.sign(r)))
+    if not items or not uj_plates:
+        return set()
+    P = [(bn, uj, _slab_samples([sb], h)) for bn, uj, sb in uj_plates]
+    P = [(bn, uj, q) for bn, uj, q in P if len(q)]
+    if not P:
+        return set()
+    owner = np.concatenate([np.full(len(q), k) for k, (_, _, q) in enumerate(P)])
+    bad: dict = {}
+    for _, Ts in state_T:
+        if Ts is None:
+            continue
+        Q = np.concatenate([q @ Ts[bn][:3, :3].T + Ts[bn][:3, 3] for bn, _, q in P])
+        tree = cKDTree(Q)
+        for uj, bn, K, sg in items:
+            Kp = K @ Ts[bn][:3, :3].T + Ts[bn][:3, 3]
+            for k, near in enumerate(tree.query_ball_point(Kp, need)):
+                if any(P[owner[i]][0] != bn and P[owner[i]][1] is not uj for i in near):
+                    bad.setdefault(uj.name, set()).add(sg[k])
+    return {(jn, "+" if sides == {-1.0} else "-") for jn, sides in bad.items() if len(sides) == 1 and 0.0 not in sides}
+
+
 def _grown_near(grown_axes, far, shapes, axes, ujoints, slabs, state_T, reach, t, c) -> list:
     """The grown stacks (of ``grown_axes``; ``far``: ``{id(axis): (a0, a1)}``, the stretch each
     grew into, mm from its origin) whose new material comes nearer than the clearance ``c`` to a
@@ -3856,6 +3909,15 @@ STROKE_STEP = 0.5
 #: ... at most this many pairs are trimmed so (the cost stays bounded on a large scene; a note says
 #: how many were left)
 STROKE_MAX_PAIRS = 32
+#: ... and two bodies that share no hinge and meet in a logic state too (session 66): the final
+#: trims of a large assembly (_resolve with reuse) trim only what is too close as printed, trusting
+#: the sampled trim radii to clear every pose, and those clear only a hinge's own bodies (the
+#: compiled (a & b) | c: g2's a_hi met out_hi in row 110, 0.012 mm^3); at most STATE_MAX_PAIRS
+#: such pairs, and a trim that does not settle its pair is not kept
+STATE_CLEAR = True
+STATE_MAX_PAIRS = 4
+#: ... each trimmed in a child process stopped after this long (s), with TRIM_MEMORY
+STATE_TRIM_SECONDS = 20.0
 STROKE_EPS = 1e-6          # mm^3: the states check's VOL_EPS (mlc.mesh.checks)
 
 
@@ -3969,16 +4031,32 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
     for k, here in zip(on_way, met):
         for ij in here:
             pairs.setdefault(ij, []).append(k)
-    if not pairs:
-        return
     ends = [k for k, n in enumerate(names) if "@" not in n]
-    in_state = set().union(*_meeting_pairs(asm, [Ts[k] for k in ends], lambda i, j: (i, j) in pairs, boxes))
+    met_end = _meeting_pairs(asm, [Ts[k] for k in ends], lambda i, j: body[i] and body[j], boxes)
+    in_state = set().union(*met_end)
     pairs = {ij: ks for ij, ks in pairs.items() if ij not in in_state}
+    state_pairs: dict = {}
+    if STATE_CLEAR:
+        # bodies that share no hinge and meet in a logic state: trimmed over the stretches of the
+        # paths that end where they meet (on the way there too), if that settles them
+        for k, here in zip(ends, met_end):
+            for i, j in here:
+                if parts[j].name not in parts[i].partners:
+                    state_pairs.setdefault((i, j), []).append(k)
+        for ij in sorted(state_pairs)[STATE_MAX_PAIRS:]:
+            del state_pairs[ij]
+        if len(in_state) > len(state_pairs):
+            asm.notes.append(f"bodies that meet in a logic state: {len(in_state)} pairs, {len(state_pairs)} of them "
+                             f"(sharing no hinge, at most {STATE_MAX_PAIRS}) trimmed where that settles them")
+        for ij, ks in state_pairs.items():
+            ks += [k for k, here in zip(on_way, met) if ij in here]
+    if not pairs and not state_pairs:
+        return
     if len(pairs) > STROKE_MAX_PAIRS:
         asm.notes.append(f"rubs on the way to the states: {len(pairs)} pairs of bodies, the first "
                          f"{STROKE_MAX_PAIRS} trimmed")
     frames, llo, lhi = boxes[:3]
-    for (i, j), ks in sorted(pairs.items())[:STROKE_MAX_PAIRS]:
+    for (i, j), ks in sorted(pairs.items())[:STROKE_MAX_PAIRS] + sorted(state_pairs.items()):
         A, B = parts[i], parts[j]
         sel = np.array([[(lhi if (q >> a) & 1 else llo)[j, a] for a in range(3)] for q in range(8)])
         corners = sel @ frames[j][:3, :3].T + frames[j][:3, 3]     # B's box corners, rest world
@@ -4005,11 +4083,52 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
         view.parts = [A, B]
         view.congruence = None
         before, n_notes = len(asm.motion_trims), len(asm.notes)
-        _clear_motion(view, protected, soft_protected, dense_names, dense_T)
+        if (i, j) in state_pairs:
+            # a pair that meets in a state: trimmed in a child process with a time and memory cap
+            # (a trim that cannot settle it tries every growth, minutes on two gate parts), and
+            # kept only if it settles it (the states check reports it otherwise)
+            got = _isolated(lambda: _settled_motion(view, protected, soft_protected, dense_names, dense_T, before,
+                                                    n_notes), STATE_TRIM_SECONDS, TRIM_MEMORY)
+            where = ", ".join(names[k] for k in ks if "@" not in names[k])
+            if not isinstance(got, tuple):
+                asm.notes.append(f"{A.name} and {B.name} meet in {where}: "
+                                 + ("no trim settles it" if got == "none" else
+                                    f"trim stopped (over {STATE_TRIM_SECONDS:g} s or {TRIM_MEMORY / 2 ** 30:g} GiB)")
+                                 + ", not trimmed")
+                continue
+            meshes, trims, notes_ = got
+            for P in (A, B):
+                if P.name in meshes:
+                    P.solid = mf.Manifold(mf.Mesh64(vert_properties=meshes[P.name][0], tri_verts=meshes[P.name][1]))
+            asm.motion_trims += trims
+            asm.notes += notes_
+        else:
+            _clear_motion(view, protected, soft_protected, dense_names, dense_T)
         for t in asm.motion_trims[before:]:
-            t["stroke"] = True
+            t["state" if (i, j) in state_pairs else "stroke"] = True
         asm.notes[n_notes:] = [x.replace("of the dense paths", "interpolated on the way to the states")
                                for x in asm.notes[n_notes:]]
+
+
+def _settled_motion(view: "Assembly", protected, soft_protected, names, Ts, before: int, n_notes: int):
+    """:func:`_clear_motion` of ``view``'s parts in the poses ``Ts``, for a child process
+    (:func:`_isolated`): ``({part: (vertices, triangles)}, motion_trims, notes)`` of what it
+    trimmed if every trim settled its pair, else ``"none"`` (``before``/``n_notes``: the lengths
+    of ``view.motion_trims``/``view.notes`` before)."""
+    solids = {p.name: p.solid for p in view.parts}
+    _clear_motion(view, protected, soft_protected, names, Ts)
+    trims = view.motion_trims[before:]
+    if not trims or not all(t["settled"] for t in trims):
+        for p in view.parts:          # (run in this process where there is no fork)
+            p.solid = solids[p.name]
+        del view.motion_trims[before:], view.notes[n_notes:]
+        return "none"
+    out = {}
+    for p in view.parts:
+        if p.solid is not solids[p.name]:
+            m = p.solid.to_mesh64()
+            out[p.name] = (np.asarray(m.vert_properties, float)[:, :3].copy(), np.asarray(m.tri_verts, np.uint64).copy())
+    return out, [dict(t) for t in trims], list(view.notes[n_notes:])
 
 
 def _posed_gap(A: "Part", B: "Part", T: dict, search: float) -> float:
