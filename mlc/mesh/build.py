@@ -4097,6 +4097,7 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
                                  + ", not trimmed")
                 continue
             meshes, trims, notes_ = got
+            del asm.motion_trims[before:], asm.notes[n_notes:]     # (what it left here, run without a fork)
             for P in (A, B):
                 if P.name in meshes:
                     P.solid = mf.Manifold(mf.Mesh64(vert_properties=meshes[P.name][0], tri_verts=meshes[P.name][1]))
