@@ -115,6 +115,15 @@ KNUCKLE_PLATES = True
 #: a compound junction's fin kept past the joint part's ball, clear of O's trim about the second pin, where
 #: the collar never turns round to it (:func:`_fin_keep`; session 60)
 FIN_KEPT = True
+#: a compound junction's two knuckles that face across its joint point (the host stack's knuckle ending
+#: nearest it, the other body's yoke knuckles' inner ends) have their rims there chamfered at 45
+#: degrees by this fraction of the clearance, at most RIM_CAP of half the minimum wall
+#: (:func:`_rim_chamfers`; session 67: square, their rims were 0.2 mm apart at mjp, and the
+#: junction's bend and twist in the poses, the scene's ball joint, took them to 0.03 mm)
+RIM_CHAMFER = 0.8
+#: ... and its host body (C) is trimmed about the first pin this many clearances farther than the
+#: other body's yoke knuckles reach (R + c before; session 67: 0.2 mm, 0.10 in the poses)
+HOST_CUT_MARGIN = 1.0
 SHAVE_THIN = True        # the thin webs the trims leave away from a body's joints, taken away (mlc.mesh.shave; session 60)
 #: where a grown stack's coarse samples (:func:`_far_clear`, :func:`_grown_near`) come nearer than the
 #: clearance plus their own reach but not nearer than the clearance, they are sampled again five
@@ -212,6 +221,22 @@ def cone(origin, direction, s0, s1, r0, r1, segments, cutter=False) -> mf.Manifo
         s0, s1, r0, r1 = s1, s0, r1, r0
     c = mf.Manifold.cylinder(float(s1 - s0), float(r0 * k), float(r1 * k), int(segments))
     return c.transform(_affine(_perp_frame(d), np.asarray(origin, float) + s0 * d))
+
+
+def knuckle(origin, direction, s0, s1, radius, segments, lo=0.0, hi=0.0) -> mf.Manifold:
+    """:func:`cylinder` with its rim chamfered at 45 degrees by ``lo`` at ``s0`` and ``hi`` at ``s1``
+    (mm; each at most a third of the length).  One revolved section, the same polygon as the
+    cylinder's: a cone and a cylinder unioned leave slivers of triangles along their seam, where
+    the wall measure (:mod:`mlc.mesh.walls`) found rings of the minimum wall thin."""
+    lo, hi = (min(max(x, 0.0), (s1 - s0) / 3) for x in (lo, hi))
+    if lo <= 0 and hi <= 0:
+        return cylinder(origin, direction, s0, s1, radius, segments)
+    L = float(s1 - s0)
+    ring = [(0.0, 0.0)] + ([(radius - lo, 0.0), (radius, lo)] if lo > 0 else [(radius, 0.0)]) + \
+        ([(radius, L - hi), (radius - hi, L)] if hi > 0 else [(radius, L)]) + [(0.0, L)]
+    d = np.asarray(direction, float) / np.linalg.norm(direction)
+    m = mf.CrossSection([[(float(x), float(y)) for x, y in ring]]).revolve(int(segments))
+    return m.transform(_affine(_perp_frame(d), np.asarray(origin, float) + s0 * d))
 
 
 def box(center, R, size) -> mf.Manifold:
@@ -1030,6 +1055,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
         # the trim radii of its hinge and universal joint eat, issue 13, session 50): rebuilt
         # with those radii shrunk towards the least that keeps the knuckles clear (_Unsplit)
         my_uj = [(uj, 0 if uj.bodies[0] == bn else 1) for uj in ujoints if bn in uj.bodies]
+        rims = _rim_chamfers(bn, my_axes, my_uj, ujoints, min(RIM_CHAMFER * c, RIM_CAP * prof.min_wall / 2)) \
+            if RIM_CHAMFER else {}
         n_notes, shrink = len(notes), _Unsplit(reuse, joints=bool(my_uj))
         # a branch page's arm, which ends on the face of its own end knuckle, is carried into it
         links = _rod_links(shapes[bn], my_axes, bn, t, s) if bn in pages else []
@@ -1148,10 +1175,11 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
             keep = []
             for ax in my_axes:
                 for a0, a1 in ax.intervals[bn]:
-                    keep.append(cylinder(ax.origin, ax.direction, a0, a1, R, n))
+                    keep.append(knuckle(ax.origin, ax.direction, a0, a1, R, n, *rims.get((ax.name, a0, a1), (0, 0))))
             for uj, side in my_uj:
                 for a0, a1 in uj.layouts[side].own:
-                    keep.append(cylinder(uj.center, uj.axes[side], a0, a1, uj.layouts[side].r_own or R, n))
+                    keep.append(knuckle(uj.center, uj.axes[side], a0, a1, uj.layouts[side].r_own or R, n,
+                                        *rims.get((uj.name, side, a0, a1), (0, 0))))
             # rings where the slab is too narrow for a hole; holes inside slabs are drilled last,
             # where the slab has room for them after trimming
             rings = [cylinder(x[0], x[1], -t / 2, t / 2, lug_out, n) for x in lugs[bn] if x[2]]
@@ -2931,7 +2959,8 @@ def _compound(ax: HingeAxis, center, host_body, other, axes, s, prof, R, r_pin, 
         if np.isfinite(dd) and dd - R < c:
             v0 = max(v0, R + float(np.sqrt(c * c - max(0.0, dd - R) ** 2)))
     u = ax.direction * sg
-    lay = YokeLayout("host", [], [], (-(d0 + S), 0.0), (-(R + c), R + c), (0.0, 0.0), reach=max(d0 - g, hub_r))
+    m = HOST_CUT_MARGIN * c
+    lay = YokeLayout("host", [], [], (-(d0 + S), 0.0), (-(R + c + m), R + c + m), (0.0, 0.0), reach=max(d0 - g, hub_r))
     lay_c = lay
     # the stretch the stack grew into (mm from the new origin along the axis): past the far end
     # of the short stack, out to the grown stack's far end
@@ -3101,6 +3130,53 @@ def _own_ends(ax: HingeAxis, bn: str) -> None:
     ax.intervals = {b: [] for b in blist}
     for b, iv in zip(layout, slots):
         ax.intervals[b].append(iv)
+
+
+#: a rim chamfer is at most this fraction of half the minimum wall: a ball of the minimum wall still
+#: fits in a knuckle's ring of that wall right to its end face (it does up to (2 - sqrt 2) = 0.586)
+RIM_CAP = 0.55
+
+
+def _rim_chamfers(bn, my_axes, my_uj, ujoints, ch) -> dict:
+    """Rim chamfers (mm, at each end) of body ``bn``'s knuckles that face another knuckle across a
+    compound junction's joint point (:data:`RIM_CHAMFER`): keyed ``(axis name, s0, s1)`` for a hinge's
+    knuckle, ``(joint name, side, s0, s1)`` for a yoke knuckle; values ``(lo, hi)``.
+
+    Square, the host stack's knuckle ending nearest the joint point (along the first pin, its end
+    face towards the joint point) and the other body's yoke knuckle (along the second pin, its inner
+    end face towards it) leave a corner gap of about the clearance between their rims: each stands
+    the knuckle gap past the hub, and each reaches its radius R across the other's line.  A 45 degree
+    chamfer of ``ch`` on both rims widens it by about ``sqrt 2 ch``; the faces' inner parts, which bear
+    along the pins, stay."""
+    out: dict = {}
+    if ch <= 0:
+        return out
+    for uj, side in my_uj:
+        lay = uj.layouts[side]
+        if uj.host is None or side != 1 or lay.holes is not None:
+            continue
+        for a0, a1 in lay.own:
+            out[(uj.name, side, a0, a1)] = (ch if a0 >= 0 else 0.0, ch if a1 <= 0 else 0.0)
+    for ax in my_axes:
+        if ax.joint is None:
+            continue
+        ivs = sorted([(iv, b) for b, lst in ax.intervals.items() for iv in lst]
+                     + ([(tuple(ax.joint_iv), ax.joint)] if ax.joint_iv else []))
+        for uj in ujoints:
+            if uj.host is not ax:
+                continue
+            b = float(np.dot(uj.center - ax.origin, ax.direction))
+            below = [(iv, o) for iv, o in ivs if iv[1] <= b + 1e-6]
+            above = [(iv, o) for iv, o in ivs if iv[0] >= b - 1e-6]
+            if below and below[-1][1] == bn:
+                a0, a1 = below[-1][0]
+                lo, hi = out.get((ax.name, a0, a1), (0.0, 0.0))
+                out[(ax.name, a0, a1)] = (lo, ch)
+            if above and above[0][1] == bn:
+                a0, a1 = above[0][0]
+                lo, hi = out.get((ax.name, a0, a1), (0.0, 0.0))
+                out[(ax.name, a0, a1)] = (ch, hi)
+    return out
 
 
 def _compound_yoke_layout(mode, hub, g, k, cap, W, s, turned=False) -> YokeLayout:

@@ -1,0 +1,113 @@
+"""What session 67's compound-junction clearances (issue 13: ``RIM_CHAMFER``, the knuckle rims that
+face across a compound junction's joint point chamfered; ``HOST_CUT_MARGIN``, the host body trimmed a
+clearance farther about the first pin) change on compiled circuits and robots, and what they cost.
+
+Each case (a compiled scene's largest mechanism posed by ``mlc.mesh.pipeline.state_poses``, or a
+``tests/data_mesh`` piece with its stored print poses) is built at mjp as ``mlc stl`` builds it
+(``build_assembly(..., reuse=True)``) twice in one run, the square junctions (both flags 0) and the
+defaults, alternating per case so both see the same load, and checked (``check_assembly``, with the
+wall measure unless ``--no-walls``).  Recorded per build: its seconds and the check's, every check's
+result, ``motion_clearance``'s pairs under the clearance by kind (``coarse_clearance.kind_of``) with
+the smallest gap, and the wall measure's thin regions.
+
+    python benchmarks/rim_chamfer.py --piece circuit_junction --piece robot_g2 --piece robot_wrist \\
+        --scene out/circuit.yaml -o benchmarks/results/rim_chamfer_s67.json
+
+Writes the JSON and a bar plot next to it (``.png``).  Units: seconds, mm."""
+from __future__ import annotations
+
+import argparse
+import json
+import sys
+import time
+from collections import Counter
+from pathlib import Path
+
+import mlc  # noqa: F401 -- before numpy (mlc/__init__.py)
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parent / "tests"))
+from coarse_clearance import kind_of  # noqa: E402
+from fine_gaps_cost import _load  # noqa: E402
+from gitstate import commit  # noqa: E402
+
+from mlc.io.atomic import atomic_path  # noqa: E402
+from mlc.mesh import build as B  # noqa: E402
+from mlc.mesh import checks as C  # noqa: E402
+from mlc.mesh.profiles import load_profile  # noqa: E402
+
+VARIANTS = {"square": {"RIM_CHAMFER": 0.0, "HOST_CUT_MARGIN": 0.0}, "chamfered": {}}
+
+
+def _run(sc, poses, flags: dict, walls: bool) -> dict:
+    with B.flags(**flags):
+        t0 = time.perf_counter()
+        asm = B.build_assembly(sc, load_profile("mjp"), poses, reuse=True)
+        build_s = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        rep = C.check_assembly(asm, walls=walls)
+        check_s = time.perf_counter() - t0
+    mc = rep.check("motion_clearance")
+    pairs = sorted({f.split(": ")[1] for f in mc.failures})
+    out = {"flags": flags, "build_s": round(build_s, 2), "check_s": round(check_s, 2),
+           "checks": {ch.name: {"ok": ch.ok, "blocking": ch.blocking, "value": ch.value,
+                                 "failures": len(ch.failures)} for ch in rep.checks},
+           "clearance_smallest_mm": mc.value, "pairs_under_clearance": len(pairs),
+           "pose_pairs_under_clearance": len(mc.failures),
+           "kinds": dict(Counter(kind_of(p) for p in pairs).most_common()), "pairs": pairs[:300]}
+    if walls:
+        wt = rep.check("wall_thickness")
+        out["thin_regions"] = len(wt.failures)
+        out["thinnest_mm"] = wt.value
+    return out
+
+
+def main(argv=None) -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--scene", action="append", default=[], help="a compiled scene (circuit.yaml, robot.yaml)")
+    ap.add_argument("--piece", action="append", default=[], help="a tests/data_mesh piece by name")
+    ap.add_argument("--no-walls", action="store_true", help="skip the wall measure")
+    ap.add_argument("-o", "--out", required=True)
+    args = ap.parse_args(argv)
+    cases = []
+    for scene, piece in [(None, p) for p in args.piece] + [(s, None) for s in args.scene]:
+        label, sc, poses = _load(scene, piece)
+        runs = {}
+        order = list(VARIANTS) if len(cases) % 2 == 0 else list(VARIANTS)[::-1]
+        for name in order:
+            runs[name] = _run(sc, poses, VARIANTS[name], not args.no_walls)
+            r = runs[name]
+            print(label, name, {k: r[k] for k in ("build_s", "check_s", "pairs_under_clearance",
+                                                  "clearance_smallest_mm", "kinds")},
+                  "thin", r.get("thin_regions"), flush=True)
+        sq, ch = runs["square"], runs["chamfered"]
+        cases.append({"case": label, "bodies": len(sc.bodies), "poses": len(poses), "runs": runs,
+                      "pairs_square": sq["pairs_under_clearance"], "pairs_chamfered": ch["pairs_under_clearance"],
+                      "build_ratio": ch["build_s"] / sq["build_s"],
+                      "blocking_same": all(sq["checks"][k]["ok"] == ch["checks"][k]["ok"]
+                                           for k in sq["checks"] if sq["checks"][k]["blocking"])})
+    out = {"benchmark": "rim_chamfer", "commit": commit(), "profile": "mjp", "cases": cases}
+    with atomic_path(args.out) as tmp:
+        Path(tmp).write_text(json.dumps(out, indent=1) + "\n")
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(7, 3.5))
+    x = np.arange(len(cases))
+    ax.bar(x - 0.2, [max(c["pairs_square"], 0.5) for c in cases], 0.4, label="square junctions")
+    ax.bar(x + 0.2, [max(c["pairs_chamfered"], 0.5) for c in cases], 0.4, label="chamfered (session 67)")
+    ax.set_yscale("log")
+    ax.set_xticks(x, [Path(c["case"]).stem if c["case"].endswith(".yaml") else c["case"] for c in cases])
+    ax.set_ylabel("pairs of parts under the clearance")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    with atomic_path(str(Path(args.out).with_suffix(".png"))) as tmp:
+        fig.savefig(tmp, format="png", dpi=120)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
