@@ -1,11 +1,13 @@
-"""What session 67's compound-junction clearances (issue 13: ``RIM_CHAMFER``, the knuckle rims that
-face across a compound junction's joint point chamfered; ``HOST_CUT_MARGIN``, the host body trimmed a
-clearance farther about the first pin) change on compiled circuits and robots, and what they cost.
+"""What session 67's clearances in motion (issue 13: ``RIM_CHAMFER``, the knuckle rims that face
+across a compound junction's joint point chamfered; ``HOST_CUT_MARGIN``, the host body trimmed a
+clearance farther about the first pin; ``CLOSE_STROKES``, bodies that come within the clearance on
+the way to a state trimmed as the meeting ones) change on compiled circuits and robots, and what
+they cost.
 
 Each case (a compiled scene's largest mechanism posed by ``mlc.mesh.pipeline.state_poses``, or a
 ``tests/data_mesh`` piece with its stored print poses) is built at mjp as ``mlc stl`` builds it
-(``build_assembly(..., reuse=True)``) twice in one run, the square junctions (both flags 0) and the
-defaults, alternating per case so both see the same load, and checked (``check_assembly``, with the
+(``build_assembly(..., reuse=True)``) twice in one run, as session 66 built it (the three flags
+off) and with the defaults, alternating per case so both see the same load, and checked (``check_assembly``, with the
 wall measure unless ``--no-walls``).  Recorded per build: its seconds and the check's, every check's
 result, ``motion_clearance``'s pairs under the clearance by kind (``coarse_clearance.kind_of``) with
 the smallest gap, and the wall measure's thin regions.
@@ -39,7 +41,7 @@ from mlc.mesh import build as B  # noqa: E402
 from mlc.mesh import checks as C  # noqa: E402
 from mlc.mesh.profiles import load_profile  # noqa: E402
 
-VARIANTS = {"square": {"RIM_CHAMFER": 0.0, "HOST_CUT_MARGIN": 0.0}, "chamfered": {}}
+VARIANTS = {"s66": {"RIM_CHAMFER": 0.0, "HOST_CUT_MARGIN": 0.0, "CLOSE_STROKES": False}, "s67": {}}
 
 
 def _run(sc, poses, flags: dict, walls: bool) -> dict:
@@ -83,9 +85,9 @@ def main(argv=None) -> int:
             print(label, name, {k: r[k] for k in ("build_s", "check_s", "pairs_under_clearance",
                                                   "clearance_smallest_mm", "kinds")},
                   "thin", r.get("thin_regions"), flush=True)
-        sq, ch = runs["square"], runs["chamfered"]
+        sq, ch = runs["s66"], runs["s67"]
         cases.append({"case": label, "bodies": len(sc.bodies), "poses": len(poses), "runs": runs,
-                      "pairs_square": sq["pairs_under_clearance"], "pairs_chamfered": ch["pairs_under_clearance"],
+                      "pairs_s66": sq["pairs_under_clearance"], "pairs_s67": ch["pairs_under_clearance"],
                       "build_ratio": ch["build_s"] / sq["build_s"],
                       "blocking_same": all(sq["checks"][k]["ok"] == ch["checks"][k]["ok"]
                                            for k in sq["checks"] if sq["checks"][k]["blocking"])})
@@ -97,8 +99,8 @@ def main(argv=None) -> int:
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(7, 3.5))
     x = np.arange(len(cases))
-    ax.bar(x - 0.2, [max(c["pairs_square"], 0.5) for c in cases], 0.4, label="square junctions")
-    ax.bar(x + 0.2, [max(c["pairs_chamfered"], 0.5) for c in cases], 0.4, label="chamfered (session 67)")
+    ax.bar(x - 0.2, [max(c["pairs_s66"], 0.5) for c in cases], 0.4, label="session 66's build")
+    ax.bar(x + 0.2, [max(c["pairs_s67"], 0.5) for c in cases], 0.4, label="session 67's")
     ax.set_yscale("log")
     ax.set_xticks(x, [Path(c["case"]).stem if c["case"].endswith(".yaml") else c["case"] for c in cases])
     ax.set_ylabel("pairs of parts under the clearance")

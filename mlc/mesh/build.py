@@ -121,8 +121,9 @@ FIN_KEPT = True
 #: (:func:`_rim_chamfers`; session 67: square, their rims were 0.2 mm apart at mjp, and the
 #: junction's bend and twist in the poses, the scene's ball joint, took them to 0.03 mm)
 RIM_CHAMFER = 0.8
-#: ... and its host body (C) is trimmed about the first pin this many clearances farther than the
-#: other body's yoke knuckles reach (R + c before; session 67: 0.2 mm, 0.10 in the poses)
+#: ... and its host body (C; not the hinge's other bodies) is trimmed about the first pin this many
+#: clearances farther than the other body's yoke knuckles reach (R + c before; session 67: 0.2 mm,
+#: 0.10 in the poses)
 HOST_CUT_MARGIN = 1.0
 SHAVE_THIN = True        # the thin webs the trims leave away from a body's joints, taken away (mlc.mesh.shave; session 60)
 #: where a grown stack's coarse samples (:func:`_far_clear`, :func:`_grown_near`) come nearer than the
@@ -1092,8 +1093,12 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
             for uj in ujoints:      # compound junction: the other bodies of its hinge clear the yoke too
                 if uj.host is not None and bn in uj.host.bodies and bn not in uj.bodies:
                     rho_h = _toward(float(np.hypot(uj.layouts[1].extent, uj.R)) + c, uj.rho[0], f)
-                    other_cuts.append(cylinder(uj.center, uj.axes[0], *uj.layouts[0].cut, rho_h, n, cutter=True))
-                    avoid.append((uj.center, uj.axes[0], *uj.layouts[0].cut, rho_h))
+                    # (to R + c: HOST_CUT_MARGIN is C's alone; here it cut the slab beside the end
+                    # knuckle, between it and the cut round the joint's knuckle, to a 0.4 mm web)
+                    m = HOST_CUT_MARGIN * c
+                    h0, h1 = uj.layouts[0].cut[0] + m, uj.layouts[0].cut[1] - m
+                    other_cuts.append(cylinder(uj.center, uj.axes[0], h0, h1, rho_h, n, cutter=True))
+                    avoid.append((uj.center, uj.axes[0], h0, h1, rho_h))
             cuts = [x for ax in my_axes for x in axis_cuts(ax)] + other_cuts
             cut_solid = _clean(subtract(solid, cuts))
             base_n = len(_clean(solid).decompose())
@@ -3994,6 +3999,13 @@ STATE_CLEAR = True
 STATE_MAX_PAIRS = 4
 #: ... each trimmed in a child process stopped after this long (s), with TRIM_MEMORY
 STATE_TRIM_SECONDS = 20.0
+#: ... and two bodies that share no hinge and come within the clearance on the way to a state
+#: without meeting anywhere (session 67: a gate's input lever passing its output lever, 0.021 mm, in
+#: the README circuit and the robot: the coarse ``motion_clearance`` goal), the pairs printed
+#: farthest apart first (a stroke: a lever sweeping past another part, not a joint's play), at most
+#: CLOSE_MAX_PAIRS, each as a state pair (capped, kept only if it settles the pair)
+CLOSE_STROKES = True
+CLOSE_MAX_PAIRS = 8
 STROKE_EPS = 1e-6          # mm^3: the states check's VOL_EPS (mlc.mesh.checks)
 
 
@@ -4046,6 +4058,38 @@ def _meeting_pairs(asm: "Assembly", Ts: list, wanted=None, boxes=None) -> list:
                  cong.lookup(("volume", cong.key(i, parts[i].solid), cong.key(j, parts[j].solid), rels[k]),
                              lambda: vol(i, j)))
             if v > STROKE_EPS:
+                here.add((i, j))
+        out.append(here)
+    return out
+
+
+def _near_pairs(asm: "Assembly", Ts: list, wanted, boxes, c: float) -> list:
+    """For each part-transform dict of ``Ts``, the pairs ``(i, j)`` of parts (of those ``wanted(i,
+    j)`` lets through) closer than ``c`` there (manifold3d ``min_gap``, the coarse clearance check's
+    measure and congruence cache key), as in :func:`_meeting_pairs`."""
+    parts = asm.parts
+    cong = asm.congruence
+    frames, llo, lhi, lo, hi = boxes
+    out = []
+    for T in Ts:
+        Tp = [T[p.name] for p in parts]
+        plo, phi = posed_boxes(lo, hi, Tp)
+        cand = [ij for ij in box_pairs(plo, phi, c) if wanted(*ij)]
+        cand = obb_overlap(cand, [t @ f for t, f in zip(Tp, frames)], llo, lhi, pad=0.5 * c + 1e-6)
+        posed: dict = {}
+
+        def gap(i, j):
+            for k in (i, j):
+                if k not in posed:
+                    posed[k] = transform_solid(parts[k].solid, Tp[k])
+            return float(posed[i].min_gap(posed[j], c))
+        rels = cong.rel_many(cand, Tp) if cong is not None else None
+        here = set()
+        for k, (i, j) in enumerate(cand):
+            g = (gap(i, j) if cong is None else
+                 cong.lookup(("gap", c, cong.key(i, parts[i].solid), cong.key(j, parts[j].solid), rels[k]),
+                             lambda: gap(i, j)))
+            if g < c - 1e-6:
                 here.add((i, j))
         out.append(here)
     return out
@@ -4112,6 +4156,7 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
     in_state = set().union(*met_end)
     pairs = {ij: ks for ij, ks in pairs.items() if ij not in in_state}
     state_pairs: dict = {}
+    near_only: set = set()       # (CLOSE_STROKES) of state_pairs: those that only come near
     if STATE_CLEAR:
         # bodies that share no hinge and meet in a logic state: trimmed over the stretches of the
         # paths that end where they meet (on the way there too), if that settles them
@@ -4126,6 +4171,23 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
                              f"(sharing no hinge, at most {STATE_MAX_PAIRS}) trimmed where that settles them")
         for ij, ks in state_pairs.items():
             ks += [k for k, here in zip(on_way, met) if ij in here]
+    if CLOSE_STROKES:
+        # bodies that share no hinge and come within the clearance on the way, meeting nowhere:
+        # trimmed as a state pair (capped, kept if settled), those printed farthest apart first
+        near = _near_pairs(asm, [Ts[k] for k in on_way], lambda i, j: body[i] and body[j] and (i, j) not in pairs
+                            and (i, j) not in in_state and parts[j].name not in parts[i].partners, boxes, c)
+        close: dict = {}
+        for k, here in zip(on_way, near):
+            for ij in here:
+                close.setdefault(ij, []).append(k)
+        printed = {ij: float(parts[ij[0]].solid.min_gap(parts[ij[1]].solid, 50 * c)) for ij in close}
+        ranked = sorted(close, key=lambda ij: (-printed[ij], ij))
+        if len(ranked) > CLOSE_MAX_PAIRS:
+            asm.notes.append(f"bodies within the clearance on the way to the states: {len(ranked)} pairs, the "
+                             f"{CLOSE_MAX_PAIRS} printed farthest apart trimmed where that settles them")
+        for ij in ranked[:CLOSE_MAX_PAIRS]:
+            state_pairs[ij] = close[ij]
+            near_only.add(ij)
     if not pairs and not state_pairs:
         return
     if len(pairs) > STROKE_MAX_PAIRS:
@@ -4166,8 +4228,12 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
             got = _isolated(lambda: _settled_motion(view, protected, soft_protected, dense_names, dense_T, before,
                                                     n_notes), STATE_TRIM_SECONDS, TRIM_MEMORY)
             where = ", ".join(names[k] for k in ks if "@" not in names[k])
+            if (i, j) in near_only:
+                where = "within the clearance on the way to " + ", ".join(sorted({names[k].split("@")[0] for k in ks}))
+            else:
+                where = "meet in " + where
             if not isinstance(got, tuple):
-                asm.notes.append(f"{A.name} and {B.name} meet in {where}: "
+                asm.notes.append(f"{A.name} and {B.name} {where}: "
                                  + ("no trim settles it" if got == "none" else
                                     f"trim stopped (over {STATE_TRIM_SECONDS:g} s or {TRIM_MEMORY / 2 ** 30:g} GiB)")
                                  + ", not trimmed")
@@ -4182,7 +4248,7 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
         else:
             _clear_motion(view, protected, soft_protected, dense_names, dense_T)
         for t in asm.motion_trims[before:]:
-            t["state" if (i, j) in state_pairs else "stroke"] = True
+            t["near" if (i, j) in near_only else "state" if (i, j) in state_pairs else "stroke"] = True
         asm.notes[n_notes:] = [x.replace("of the dense paths", "interpolated on the way to the states")
                                for x in asm.notes[n_notes:]]
 
