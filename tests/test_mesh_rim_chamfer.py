@@ -11,7 +11,10 @@ the circuit's 22 print poses):
   took them to 0.03 mm.  Now both rims are chamfered at 45 degrees (``RIM_CHAMFER``, 0.16 mm at mjp);
 - the host's body (C) was trimmed about the first pin to ``R + c`` on each side of the joint
   point, where the other body's yoke knuckles reach ``R``: 0.2 mm, down to 0.10 in the poses.  Now
-  ``R + 2c`` (``HOST_CUT_MARGIN``)."""
+  ``R + 2c`` (``HOST_CUT_MARGIN``; C alone: on the hinge's other bodies it left a 0.4 mm web).
+
+The square build is session 66's: both flags off, and ``CLOSE_STROKES`` (the stroke trims of bodies
+that only come near, tests/test_mesh_circuit_gate_stroke.py) off too."""
 from __future__ import annotations
 
 import numpy as np
@@ -76,7 +79,7 @@ def test_a_chamfered_ring_of_the_minimum_wall_measures_whole():
 
 @pytest.fixture(scope="module")
 def square():
-    return mesh_piece("circuit_junction", walls=False, RIM_CHAMFER=0.0, HOST_CUT_MARGIN=0.0)
+    return mesh_piece("circuit_junction", walls=False, RIM_CHAMFER=0.0, HOST_CUT_MARGIN=0.0, CLOSE_STROKES=False)
 
 
 @pytest.fixture(scope="module")
@@ -108,7 +111,7 @@ def test_chamfered_junctions_keep_the_clearance_and_every_check(chamfered, squar
     close = _close(rep)
     assert not any(p.endswith("w_b_0_60_CD - w_b_0_61_AB") or p.endswith("w_b_0_59_BC - w_b_0_60_CD")
                    for p in close), sorted(close)
-    assert len(close) <= 8, sorted(close)
+    assert len(close) <= 4, sorted(close)
     assert rep.check("motion_clearance").value > 0.14
     # the chamfers take no wall: no more thin regions than the square build's
     _, sq_rep = square
