@@ -72,25 +72,30 @@ def main(argv=None) -> int:
     ap.add_argument("--scene", action="append", default=[], help="a compiled scene (circuit.yaml, robot.yaml)")
     ap.add_argument("--piece", action="append", default=[], help="a tests/data_mesh piece by name")
     ap.add_argument("--no-walls", action="store_true", help="skip the wall measure")
+    ap.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS),
+                    help="which builds (default both; one alone records no comparison)")
     ap.add_argument("-o", "--out", required=True)
     args = ap.parse_args(argv)
     cases = []
     for scene, piece in [(None, p) for p in args.piece] + [(s, None) for s in args.scene]:
         label, sc, poses = _load(scene, piece)
         runs = {}
-        order = list(VARIANTS) if len(cases) % 2 == 0 else list(VARIANTS)[::-1]
+        order = [v for v in (list(VARIANTS) if len(cases) % 2 == 0 else list(VARIANTS)[::-1]) if v in args.variants]
         for name in order:
             runs[name] = _run(sc, poses, VARIANTS[name], not args.no_walls)
             r = runs[name]
             print(label, name, {k: r[k] for k in ("build_s", "check_s", "pairs_under_clearance",
                                                   "clearance_smallest_mm", "kinds")},
                   "thin", r.get("thin_regions"), flush=True)
-        sq, ch = runs["s66"], runs["s67"]
-        cases.append({"case": label, "bodies": len(sc.bodies), "poses": len(poses), "runs": runs,
-                      "pairs_s66": sq["pairs_under_clearance"], "pairs_s67": ch["pairs_under_clearance"],
-                      "build_ratio": ch["build_s"] / sq["build_s"],
-                      "blocking_same": all(sq["checks"][k]["ok"] == ch["checks"][k]["ok"]
-                                           for k in sq["checks"] if sq["checks"][k]["blocking"])})
+        case = {"case": label, "bodies": len(sc.bodies), "poses": len(poses), "runs": runs}
+        for v in runs:
+            case[f"pairs_{v}"] = runs[v]["pairs_under_clearance"]
+        if len(runs) == 2:
+            sq, ch = runs["s66"], runs["s67"]
+            case.update({"build_ratio": ch["build_s"] / sq["build_s"],
+                         "blocking_same": all(sq["checks"][k]["ok"] == ch["checks"][k]["ok"]
+                                              for k in sq["checks"] if sq["checks"][k]["blocking"])})
+        cases.append(case)
     out = {"benchmark": "rim_chamfer", "commit": commit(), "profile": "mjp", "cases": cases}
     with atomic_path(args.out) as tmp:
         Path(tmp).write_text(json.dumps(out, indent=1) + "\n")
@@ -99,8 +104,8 @@ def main(argv=None) -> int:
     import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(7, 3.5))
     x = np.arange(len(cases))
-    ax.bar(x - 0.2, [max(c["pairs_s66"], 0.5) for c in cases], 0.4, label="session 66's build")
-    ax.bar(x + 0.2, [max(c["pairs_s67"], 0.5) for c in cases], 0.4, label="session 67's")
+    for dx, v, lab in ((-0.2, "s66", "session 66's build"), (0.2, "s67", "session 67's")):
+        ax.bar(x + dx, [max(c.get(f"pairs_{v}", 0), 0.5) for c in cases], 0.4, label=lab)
     ax.set_yscale("log")
     ax.set_xticks(x, [Path(c["case"]).stem if c["case"].endswith(".yaml") else c["case"] for c in cases])
     ax.set_ylabel("pairs of parts under the clearance")

@@ -1093,10 +1093,7 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
             for uj in ujoints:      # compound junction: the other bodies of its hinge clear the yoke too
                 if uj.host is not None and bn in uj.host.bodies and bn not in uj.bodies:
                     rho_h = _toward(float(np.hypot(uj.layouts[1].extent, uj.R)) + c, uj.rho[0], f)
-                    # (to R + c: HOST_CUT_MARGIN is C's alone; here it cut the slab beside the end
-                    # knuckle, between it and the cut round the joint's knuckle, to a 0.4 mm web)
-                    m = HOST_CUT_MARGIN * c
-                    h0, h1 = uj.layouts[0].cut[0] + m, uj.layouts[0].cut[1] - m
+                    h0, h1 = _host_cut(uj, bn, c)
                     other_cuts.append(cylinder(uj.center, uj.axes[0], h0, h1, rho_h, n, cutter=True))
                     avoid.append((uj.center, uj.axes[0], h0, h1, rho_h))
             cuts = [x for ax in my_axes for x in axis_cuts(ax)] + other_cuts
@@ -1646,12 +1643,12 @@ def _clear_tipped_yokes(asm: "Assembly", notes: list, Ts: list) -> None:
         O = uj.bodies[1]
         lay, d = uj.layouts[1], hx.direction
         c_h = float((uj.center - hx.origin) @ d)
-        ends = sorted(c_h + float(uj.axes[0] @ d) * np.array(uj.layouts[0].cut), key=abs)
-        h_cut = ends[0]                  # the cut's end at the host layer
         sl = -np.sign(c_h) if c_h else 1.0   # toward the layer
         for X in hx.bodies:
             if X == O or X not in by or O not in by:
                 continue
+            ends = sorted(c_h + float(uj.axes[0] @ d) * np.array(_host_cut(uj, X, c)), key=abs)
+            h_cut = ends[0]                  # the cut's end at the host layer
             for T in Ts:
                 M = np.linalg.inv(T[X]) @ T[O]
                 cc = M[:3, :3] @ uj.center + M[:3, 3]
@@ -3140,6 +3137,19 @@ def _own_ends(ax: HingeAxis, bn: str) -> None:
 #: a rim chamfer is at most this fraction of half the minimum wall: a ball of the minimum wall still
 #: fits in a knuckle's ring of that wall right to its end face (it does up to (2 - sqrt 2) = 0.586)
 RIM_CAP = 0.55
+
+
+def _host_cut(uj: UJoint, bn: str, c: float) -> tuple:
+    """The range along a compound junction's first pin (mm from the joint point) over which host
+    body ``bn`` is trimmed clear of the other body's yoke: the layout's (``R + c`` and
+    :data:`HOST_CUT_MARGIN` clearances more) for C, the junction's own body; ``R + c`` for the
+    hinge's other bodies (with the margin it cut the slab beside their end knuckle, between it and
+    the cut round the joint's knuckle, to a 0.4 mm web: the robot's wrist, session 67)."""
+    h0, h1 = uj.layouts[0].cut
+    if bn == uj.bodies[0]:
+        return h0, h1
+    m = HOST_CUT_MARGIN * c
+    return h0 + m, h1 - m
 
 
 def _rim_chamfers(bn, my_axes, my_uj, ujoints, ch) -> dict:
