@@ -93,3 +93,49 @@ def test_posed_gaps_against_every_pose_measured_and_the_distance():
         for (i, j), g in here.items():
             assert i == 0 and abs(g - gaps[k][j - 1]) < sag
     assert abs(smallest[0] - 0.3 * c) < sag
+
+
+def test_posed_pairs_and_pair_gaps_against_every_pair_measured():
+    """posed_pairs keeps every pair of moved parts closer than the margin (brute force: min_gap
+    of every pair) and leaves out the pairs ``keep`` refuses; pair_gaps reads the gap min_gap
+    reads, and with a congruence cache (here two copies of each shape, moved alike) measures
+    congruent pairs in one relative pose once (most of the copies' pairs) and returns the same gaps."""
+    from mlc.mesh.congruence import Congruence
+    from mlc.mesh.spatial import pair_gaps, posed_pairs
+    base, frames0 = _random_boxes(30, 5)
+    far = np.eye(4)
+    far[:3, 3] = [100.0, 0.0, 0.0]
+    solids = base + [transform_solid(s, far) for s in base]     # part k + 30: part k moved far away
+    frames = frames0 + [far @ F for F in frames0]
+    lo, hi = local_boxes(solids, frames)
+    wlo = np.array([np.asarray(s.bounding_box())[:3] for s in solids])
+    whi = np.array([np.asarray(s.bounding_box())[3:] for s in solids])
+    rng = np.random.default_rng(6)
+    margin = 0.3
+    for trial in range(3):
+        Tp = []
+        for k in range(30):
+            M = np.eye(4)
+            M[:3, :3] = Rotation.from_rotvec(rng.normal(0, 0.2, 3)).as_matrix()
+            M[:3, 3] = rng.normal(0, 0.3, 3)
+            Tp.append(M)
+        Tp = Tp + [far @ M @ np.linalg.inv(far) for M in Tp]      # the copies moved alike
+        plo, phi = posed_boxes(wlo, whi, Tp)
+        posed = [transform_solid(s, T) for s, T in zip(solids, Tp)]
+        n = len(solids)
+        brute = {(i, j): float(posed[i].min_gap(posed[j], margin)) for i in range(n) for j in range(i + 1, n)}
+        near = {ij for ij, g in brute.items() if g < margin - 1e-6}
+        keep = (lambda i, j: (i + j) % 3 != 0)
+        got = posed_pairs(Tp, frames, lo, hi, plo, phi, margin)
+        assert near <= set(got) and len(near) > 10
+        assert len(got) < 0.5 * len(brute)
+        got_k = posed_pairs(Tp, frames, lo, hi, plo, phi, margin, keep)
+        assert set(got_k) == {ij for ij in got if keep(*ij)} and len(got_k) < len(got)
+        gaps = pair_gaps(solids, Tp, got, margin, {})
+        assert all(abs(g - brute[ij]) < 1e-9 for ij, g in zip(got, gaps))
+        cong = Congruence(frames)
+        gaps_c = pair_gaps(solids, Tp, got, margin, {}, cong)
+        assert np.allclose(gaps_c, gaps, atol=1e-6)
+        twins = sum(1 for i, j in got if i >= 30 and (i - 30, j - 30) in set(got))
+        # (a twin whose key rounds differently, its vertices moved 100 mm, is measured again)
+        assert cong.hits + cong.misses == len(got) and twins > 10 and cong.hits >= 0.5 * twins

@@ -63,7 +63,8 @@ from mlc.errors import MlcError
 from mlc.geometry.rotation import quat_to_matrix
 from mlc.mesh.congruence import Congruence, points_key, pose_key, shape_key
 from mlc.mesh.profiles import PAPER_SLAB_MM, Profile
-from mlc.mesh.spatial import box_pairs, local_boxes, obb_overlap, part_frames, posed_boxes, solid_boxes
+from mlc.mesh.spatial import (box_pairs, local_boxes, pair_gaps, part_frames, posed_boxes, posed_pairs,
+                               solid_boxes)
 from mlc.scene.model import Scene
 
 _TOL = 1e-3  # sigma: tolerance for "same point / same line"
@@ -3699,7 +3700,7 @@ def _resolve(asm: "Assembly", protected: dict, soft_protected: dict, state_T, co
                 bi, bj = np.asarray(posed[i].bounding_box()), np.asarray(posed[j].bounding_box())
                 return bool(_bb_near(bi, bj, 0.0) and (posed[i] ^ posed[j]).volume() > 1e-6)
 
-            for i, j in obb_overlap(box_pairs(plo, phi, 0.0), [t @ f for t, f in zip(Tp, frames)], llo, lhi):
+            for i, j in posed_pairs(Tp, frames, llo, lhi, plo, phi):
                 if not wanted(i, j):
                     continue
                 if cong is None:
@@ -4043,10 +4044,7 @@ def _meeting_pairs(asm: "Assembly", Ts: list, wanted=None, boxes=None) -> list:
     out = []
     for T in Ts:
         Tp = [T[p.name] for p in parts]
-        plo, phi = posed_boxes(lo, hi, Tp)
-        cand = obb_overlap(box_pairs(plo, phi, 0.0), [t @ f for t, f in zip(Tp, frames)], llo, lhi)
-        if wanted is not None:
-            cand = [ij for ij in cand if wanted(*ij)]
+        cand = posed_pairs(Tp, frames, llo, lhi, *posed_boxes(lo, hi, Tp), 0.0, wanted)
         posed: dict = {}
 
         def vol(i, j):
@@ -4075,33 +4073,18 @@ def _meeting_pairs(asm: "Assembly", Ts: list, wanted=None, boxes=None) -> list:
 
 def _near_pairs(asm: "Assembly", Ts: list, wanted, boxes, c: float) -> list:
     """For each part-transform dict of ``Ts``, the pairs ``(i, j)`` of parts (of those ``wanted(i,
-    j)`` lets through) closer than ``c`` there (manifold3d ``min_gap``, the coarse clearance check's
-    measure and congruence cache key), as in :func:`_meeting_pairs`."""
+    j)`` lets through) closer than ``c`` there: the coarse clearance check's own candidates and
+    measure (:func:`mlc.mesh.spatial.posed_pairs`, :func:`mlc.mesh.spatial.pair_gaps`, its
+    congruence cache), as in :func:`_meeting_pairs`."""
     parts = asm.parts
-    cong = asm.congruence
+    solids = [p.solid for p in parts]
     frames, llo, lhi, lo, hi = boxes
     out = []
     for T in Ts:
         Tp = [T[p.name] for p in parts]
-        plo, phi = posed_boxes(lo, hi, Tp)
-        cand = [ij for ij in box_pairs(plo, phi, c) if wanted(*ij)]
-        cand = obb_overlap(cand, [t @ f for t, f in zip(Tp, frames)], llo, lhi, pad=0.5 * c + 1e-6)
-        posed: dict = {}
-
-        def gap(i, j):
-            for k in (i, j):
-                if k not in posed:
-                    posed[k] = transform_solid(parts[k].solid, Tp[k])
-            return float(posed[i].min_gap(posed[j], c))
-        rels = cong.rel_many(cand, Tp) if cong is not None else None
-        here = set()
-        for k, (i, j) in enumerate(cand):
-            g = (gap(i, j) if cong is None else
-                 cong.lookup(("gap", c, cong.key(i, parts[i].solid), cong.key(j, parts[j].solid), rels[k]),
-                             lambda: gap(i, j)))
-            if g < c - 1e-6:
-                here.add((i, j))
-        out.append(here)
+        cand = posed_pairs(Tp, frames, llo, lhi, *posed_boxes(lo, hi, Tp), c, wanted)
+        gaps = pair_gaps(solids, Tp, cand, c, {}, asm.congruence)
+        out.append({ij for ij, g in zip(cand, gaps) if g < c - 1e-6})
     return out
 
 
@@ -4145,7 +4128,23 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
     :data:`STROKE_STEP` times the clearance) over that stretch of the path: from the coarse pose
     before the first where they meet to the one after the last (rest and the state itself at
     the ends).  The poses between the coarse ones are interpolated, not solved: the trim's growth
-    (at least 1.25 times the clearance) is their margin."""
+    (at least 1.25 times the clearance) is their margin.
+
+    Three kinds of pair, each tagged in its trim's note:
+
+    * *meeting on the way* (above): at most :data:`STROKE_MAX_PAIRS`, trimmed in this process;
+    * *meeting in a state* (:data:`STATE_CLEAR`): two bodies that share no hinge and meet in a
+      logic state, over the stretches of the paths that end there (on the way too), at most
+      :data:`STATE_MAX_PAIRS`;
+    * *near on the way* (:data:`CLOSE_STROKES`, "within the clearance on the way to ..."): two
+      bodies that share no hinge and come within the clearance on the way to a state without
+      meeting anywhere (:func:`_near_pairs`), those printed farthest apart first (a stroke past
+      another part rather than a joint's play), at most :data:`CLOSE_MAX_PAIRS`, trimmed as
+      state pairs.
+
+    State and near pairs are trimmed in a child process capped at :data:`STATE_TRIM_SECONDS` and
+    ``TRIM_MEMORY`` (a trim that cannot settle its pair tries every growth) and kept only if the
+    trim settles the pair; the states and ``motion_clearance`` checks report what is left."""
     poses = asm.poses or {}
     names = list(poses)
     c = asm.profile.clearance

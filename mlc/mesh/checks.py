@@ -221,26 +221,17 @@ class _CoarseClearance:
     def pose(self, name, Tp, plo, phi, posed: dict) -> None:
         """Measure the pose ``name`` (``Tp``: each part's 4x4, mm; ``plo``, ``phi``: the posed
         world boxes; ``posed``: the posed solids made so far, shared with the states check)."""
-        from mlc.mesh.spatial import box_pairs, obb_overlap
-        c, parts, cong = self.c, self.asm.parts, self.cong
-        cand = [pr for pr in box_pairs(plo, phi, c) if pr not in self.partner]
-        cand = obb_overlap(cand, [t @ f for t, f in zip(Tp, self.frames)], self.llo, self.lhi, pad=0.5 * c + GAP_EPS)
+        from mlc.mesh.spatial import pair_gaps, posed_pairs
+        c, parts = self.c, self.asm.parts
+        cand = posed_pairs(Tp, self.frames, self.llo, self.lhi, plo, phi, c,
+                           lambda i, j: (i, j) not in self.partner)
         if not cand:
             return
         d = _moves(cand, Tp, self.corners)
         g0 = np.array([self.rest_gap.get(pr, 2 * c) for pr in cand])
         cand = [pr for pr, keep in zip(cand, d >= g0 - c - 1e-9) if keep]
-        rels = cong.rel_many(cand, Tp) if cong is not None else None
-
-        def gap(i, j):
-            for k in (i, j):
-                if k not in posed:
-                    posed[k] = transform_solid(parts[k].solid, Tp[k])
-            return float(posed[i].min_gap(posed[j], c))
-        for k, (i, j) in enumerate(cand):
-            g = (gap(i, j) if cong is None else
-                 cong.lookup(("gap", c, cong.key(i, parts[i].solid), cong.key(j, parts[j].solid), rels[k]),
-                             lambda: gap(i, j)))
+        gaps = pair_gaps([p.solid for p in parts], Tp, cand, c, posed, self.cong)
+        for (i, j), g in zip(cand, gaps):
             if self.smallest is None or g < self.smallest[0]:
                 self.smallest = (g, parts[i].name, parts[j].name, name)
             if g < c - GAP_EPS:
@@ -340,7 +331,7 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True,
     _log("check min_gap done")
     # -- logic states --------------------------------------------------------------------
     if poses:
-        from mlc.mesh.spatial import box_pairs, local_boxes, obb_overlap, part_frames, posed_boxes
+        from mlc.mesh.spatial import local_boxes, part_frames, posed_boxes, posed_pairs
         worst = 0.0
         fails = []
         # candidate pairs: rest boxes moved (world boxes), then each part's box in its own frame
@@ -367,7 +358,7 @@ def check_assembly(asm: Assembly, poses: dict | None = None, walls: bool = True,
             T = asm.part_transforms(pos, quat)
             Tp = [T[p.name] for p in parts]
             plo, phi = posed_boxes(rlo, rhi, Tp)
-            cand = obb_overlap(box_pairs(plo, phi, 0.0), [t @ f for t, f in zip(Tp, frames)], llo, lhi)
+            cand = posed_pairs(Tp, frames, llo, lhi, plo, phi)
             if cong is not None and cand:
                 # large assemblies: a pair that moves, relative to each other, by less than its gap
                 # as printed cannot meet (every point of j moves by at most the largest move of a

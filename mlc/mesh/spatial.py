@@ -148,6 +148,39 @@ def obb_overlap(pairs, frames, lo, hi, pad: float = 1e-6) -> list[tuple[int, int
     return [(int(x), int(y)) for x, y in P[ok]]
 
 
+def posed_pairs(Tp, frames, llo, lhi, plo, phi, margin: float = 0.0, keep=None) -> list[tuple[int, int]]:
+    """The pairs ``(i, j)`` (``i < j``) of parts moved by ``Tp`` (one 4x4 rest -> posed transform
+    each) that may come within ``margin`` (mm) of each other: their posed world boxes ``plo``,
+    ``phi`` (:func:`posed_boxes`) within it (:func:`box_pairs`), ``keep(i, j)`` true (None: every
+    pair), and their oriented boxes (local boxes ``llo``, ``lhi`` in the rest ``frames``, posed)
+    not separated with half the margin on each (:func:`obb_overlap`).  The one candidate search of
+    the mesher's trims and of the states and clearance checks: only pairs certainly farther apart
+    than ``margin`` are left out."""
+    cand = box_pairs(plo, phi, margin)
+    if keep is not None:
+        cand = [ij for ij in cand if keep(*ij)]
+    return obb_overlap(cand, [t @ f for t, f in zip(Tp, frames)], llo, lhi, pad=0.5 * margin + 1e-6)
+
+
+def pair_gaps(solids, Tp, pairs, search: float, posed: dict, cong=None) -> list[float]:
+    """The gap (mm) of each pair ``(i, j)`` of ``pairs`` between ``solids`` moved by ``Tp``:
+    manifold3d ``min_gap`` searched to ``search`` (a pair farther apart reads ``search``).
+    ``posed``: the moved solids made so far, by index (filled in here, shared with the caller).
+    ``cong`` (:class:`mlc.mesh.congruence.Congruence`, optional): congruent pairs in one relative
+    pose are measured once, cached under ``("gap", search, shape key, shape key, relative pose)``,
+    so that a trim and the check after it share their measurements."""
+    def gap(i, j):
+        for k in (i, j):
+            if k not in posed:
+                posed[k] = solids[k].transform(np.asarray(Tp[k], float)[:3, :4])
+        return float(posed[i].min_gap(posed[j], search))
+    if cong is None:
+        return [gap(i, j) for i, j in pairs]
+    rels = cong.rel_many(pairs, Tp)
+    return [cong.lookup(("gap", search, cong.key(i, solids[i]), cong.key(j, solids[j]), rels[k]),
+                        lambda: gap(i, j)) for k, (i, j) in enumerate(pairs)]
+
+
 def posed_gaps(solids, frames, lo, hi, poses, clearance: float, eps: float = 1e-6,
                only=None) -> tuple[list, tuple | None]:
     """The gaps (mm) between solids moved into each of ``poses`` (a list of lists of 4x4 rest ->
@@ -175,10 +208,8 @@ def posed_gaps(solids, frames, lo, hi, poses, clearance: float, eps: float = 1e-
     for k, Tp in enumerate(poses):
         Tp = [np.asarray(t, float) for t in Tp]
         plo, phi = posed_boxes(wlo, whi, Tp)
-        cand = box_pairs(plo, phi, clearance)
-        if only is not None:
-            cand = [(i, j) for i, j in cand if i in only or j in only]
-        pairs = obb_overlap(cand, [t @ f for t, f in zip(Tp, F)], lo, hi, pad=0.5 * clearance + eps)
+        pairs = posed_pairs(Tp, F, lo, hi, plo, phi, clearance,
+                            None if only is None else (lambda i, j: i in only or j in only))
         posed: dict = {}
         here = {}
         for i, j in pairs:
@@ -206,4 +237,5 @@ def posed_gaps(solids, frames, lo, hi, poses, clearance: float, eps: float = 1e-
     return close, smallest
 
 
-__all__ = ["box_pairs", "local_boxes", "obb_overlap", "part_frames", "posed_boxes", "posed_gaps", "solid_boxes"]
+__all__ = ["box_pairs", "local_boxes", "obb_overlap", "pair_gaps", "part_frames", "posed_boxes", "posed_gaps",
+           "posed_pairs", "solid_boxes"]
