@@ -35,6 +35,7 @@ sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "tests"))
 from fine_gaps_cost import _load  # noqa: E402  (the same cases: a scene's largest mechanism or a piece)
 from gitstate import commit  # noqa: E402  (benchmarks/gitstate.py)
+from case_plot import case_bars  # noqa: E402
 
 from mlc.io.atomic import atomic_path  # noqa: E402
 from mlc.mesh import build as B  # noqa: E402
@@ -153,20 +154,9 @@ def main(argv=None) -> int:
            "cases": cases}
     with atomic_path(args.out) as tmp:
         Path(tmp).write_text(json.dumps(out, indent=1) + "\n")
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6, 3.5))
-    x = np.arange(len(cases))
-    ax.bar(x, [c["check_ratio"] for c in cases], 0.5)
-    for k, c in enumerate(cases):
-        ax.text(k, c["check_ratio"], f"{len(c['pairs'])} pairs < c", ha="center", va="bottom", fontsize=8)
-    ax.axhline(1.0, color="k", lw=0.8)
-    ax.set_xticks(x, [Path(c["case"]).stem if c["case"].endswith(".yaml") else c["case"] for c in cases])
-    ax.set_ylabel("check time with COARSE_CLEARANCE / without")
-    fig.tight_layout()
-    with atomic_path(str(Path(args.out).with_suffix(".png"))) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
+    case_bars(args.out, cases, [([c["check_ratio"] for c in cases], "")],
+              "check time with COARSE_CLEARANCE / without", ref=1.0,
+              notes=[f"{len(c['pairs'])} pairs < c" for c in cases])
     return 0
 
 

@@ -30,6 +30,7 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "tests"))
 from gitstate import commit  # noqa: E402  (benchmarks/gitstate.py)
+from case_plot import case_bars  # noqa: E402
 
 from mlc.io.atomic import atomic_path  # noqa: E402
 from mlc.mesh import build as B  # noqa: E402
@@ -124,21 +125,9 @@ def main(argv=None) -> int:
            "cases": cases}
     with atomic_path(args.out) as tmp:
         Path(tmp).write_text(json.dumps(out, indent=1) + "\n")
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(6, 3.5))
-    x = np.arange(len(cases))
-    for k, (key, lab) in enumerate((("tests", "the two tests"), ("layout_s", "whole layout"))):
-        ax.bar(x + (k - 0.5) * 0.35, [c[f"{'tests' if key == 'tests' else 'layout'}_ratio"] for c in cases], 0.35,
-               label=lab)
-    ax.axhline(1.0, color="k", lw=0.8)
-    ax.set_xticks(x, [Path(c["case"]).stem if c["case"].endswith(".yaml") else c["case"] for c in cases])
-    ax.set_ylabel("time with FINE_GAPS / without")
-    ax.legend()
-    fig.tight_layout()
-    with atomic_path(str(Path(args.out).with_suffix(".png"))) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
+    case_bars(args.out, cases, [([c["tests_ratio"] for c in cases], "the two tests"),
+                                ([c["layout_ratio"] for c in cases], "whole layout")],
+              "time with FINE_GAPS / without", ref=1.0)
     return 0
 
 

@@ -27,7 +27,6 @@ from pathlib import Path
 
 import mlc  # noqa: F401 -- before numpy (mlc/__init__.py)
 
-import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
@@ -35,6 +34,7 @@ sys.path.insert(0, str(HERE.parent / "tests"))
 from coarse_clearance import kind_of  # noqa: E402
 from fine_gaps_cost import _load  # noqa: E402
 from gitstate import commit  # noqa: E402
+from case_plot import case_bars  # noqa: E402
 
 from mlc.io.atomic import atomic_path  # noqa: E402
 from mlc.mesh import build as B  # noqa: E402
@@ -99,20 +99,9 @@ def main(argv=None) -> int:
     out = {"benchmark": "rim_chamfer", "commit": commit(), "profile": "mjp", "cases": cases}
     with atomic_path(args.out) as tmp:
         Path(tmp).write_text(json.dumps(out, indent=1) + "\n")
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, ax = plt.subplots(figsize=(7, 3.5))
-    x = np.arange(len(cases))
-    for dx, v, lab in ((-0.2, "s66", "session 66's build"), (0.2, "s67", "session 67's")):
-        ax.bar(x + dx, [max(c.get(f"pairs_{v}", 0), 0.5) for c in cases], 0.4, label=lab)
-    ax.set_yscale("log")
-    ax.set_xticks(x, [Path(c["case"]).stem if c["case"].endswith(".yaml") else c["case"] for c in cases])
-    ax.set_ylabel("pairs of parts under the clearance")
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    with atomic_path(str(Path(args.out).with_suffix(".png"))) as tmp:
-        fig.savefig(tmp, format="png", dpi=120)
+    case_bars(args.out, cases, [([max(c.get(f"pairs_{v}", 0), 0.5) for c in cases], lab)
+                                for v, lab in (("s66", "session 66's build"), ("s67", "session 67's"))],
+              "pairs of parts under the clearance", log=True, size=(7, 3.5))
     return 0
 
 
