@@ -2,18 +2,22 @@
 across a compound junction's joint point chamfered; ``HOST_CUT_MARGIN``, the host body trimmed a
 clearance farther about the first pin; ``CLOSE_STROKES``, bodies that come within the clearance on
 the way to a state trimmed as the meeting ones) change on compiled circuits and robots, and what
-they cost.
+they cost; and session 68's ``owner_margin`` (``OWNER_CUT_MARGIN``: the hinge's other bodies, the
+stack's owner, trimmed with ``HOST_CUT_MARGIN`` too), which the pairs left after session 67 ask for.
 
 Each case (a compiled scene's largest mechanism posed by ``mlc.mesh.pipeline.state_poses``, or a
 ``tests/data_mesh`` piece with its stored print poses) is built at mjp as ``mlc stl`` builds it
-(``build_assembly(..., reuse=True)``) twice in one run, as session 66 built it (the three flags
-off) and with the defaults, alternating per case so both see the same load, and checked (``check_assembly``, with the
+(``build_assembly(..., reuse=True)``) once per variant in one run (``--variants``; by default as
+session 66 built it, the three flags off, and with the defaults), alternating the order per case so
+the builds see the same load, and checked (``check_assembly``, with the
 wall measure unless ``--no-walls``).  Recorded per build: its seconds and the check's, every check's
 result, ``motion_clearance``'s pairs under the clearance by kind (``coarse_clearance.kind_of``) with
 the smallest gap, and the wall measure's thin regions.
 
     python benchmarks/rim_chamfer.py --piece circuit_junction --piece robot_g2 --piece robot_wrist \\
         --scene out/circuit.yaml -o benchmarks/results/rim_chamfer_s67.json
+    python benchmarks/rim_chamfer.py --piece circuit_twist --piece robot_wrist --variants s67 owner_margin \\
+        -o benchmarks/results/rim_chamfer_s68_owner.json
 
 Writes the JSON and a bar plot next to it (``.png``).  Units: seconds, mm."""
 from __future__ import annotations
@@ -41,7 +45,10 @@ from mlc.mesh import build as B  # noqa: E402
 from mlc.mesh import checks as C  # noqa: E402
 from mlc.mesh.profiles import load_profile  # noqa: E402
 
-VARIANTS = {"s66": {"RIM_CHAMFER": 0.0, "HOST_CUT_MARGIN": 0.0, "CLOSE_STROKES": False}, "s67": {}}
+VARIANTS = {"s66": {"RIM_CHAMFER": 0.0, "HOST_CUT_MARGIN": 0.0, "CLOSE_STROKES": False}, "s67": {},
+            # session 68: the hinge's other bodies (the stack's owner) trimmed with the margin too
+            "owner_margin": {"OWNER_CUT_MARGIN": True}}
+LABELS = {"s66": "session 66's build", "s67": "session 67's", "owner_margin": "the owner trimmed with the margin"}
 
 
 def _run(sc, poses, flags: dict, walls: bool) -> dict:
@@ -72,15 +79,16 @@ def main(argv=None) -> int:
     ap.add_argument("--scene", action="append", default=[], help="a compiled scene (circuit.yaml, robot.yaml)")
     ap.add_argument("--piece", action="append", default=[], help="a tests/data_mesh piece by name")
     ap.add_argument("--no-walls", action="store_true", help="skip the wall measure")
-    ap.add_argument("--variants", nargs="+", default=list(VARIANTS), choices=list(VARIANTS),
-                    help="which builds (default both; one alone records no comparison)")
+    ap.add_argument("--variants", nargs="+", default=["s66", "s67"], choices=list(VARIANTS),
+                    help="which builds (default s66 s67; each against the first named, one alone records no comparison)")
     ap.add_argument("-o", "--out", required=True)
     args = ap.parse_args(argv)
     cases = []
     for scene, piece in [(None, p) for p in args.piece] + [(s, None) for s in args.scene]:
         label, sc, poses = _load(scene, piece)
         runs = {}
-        order = [v for v in (list(VARIANTS) if len(cases) % 2 == 0 else list(VARIANTS)[::-1]) if v in args.variants]
+        names = [v for v in VARIANTS if v in args.variants]
+        order = names if len(cases) % 2 == 0 else names[::-1]
         for name in order:
             runs[name] = _run(sc, poses, VARIANTS[name], not args.no_walls)
             r = runs[name]
@@ -90,17 +98,18 @@ def main(argv=None) -> int:
         case = {"case": label, "bodies": len(sc.bodies), "poses": len(poses), "runs": runs}
         for v in runs:
             case[f"pairs_{v}"] = runs[v]["pairs_under_clearance"]
-        if len(runs) == 2:
-            sq, ch = runs["s66"], runs["s67"]
-            case.update({"build_ratio": ch["build_s"] / sq["build_s"],
-                         "blocking_same": all(sq["checks"][k]["ok"] == ch["checks"][k]["ok"]
-                                              for k in sq["checks"] if sq["checks"][k]["blocking"])})
+        ref = runs[names[0]]                       # each other build against the first named
+        for v in names[1:]:
+            ch = runs[v]
+            case.update({f"build_ratio_{v}": ch["build_s"] / ref["build_s"],
+                         f"blocking_same_{v}": all(ref["checks"][k]["ok"] == ch["checks"][k]["ok"]
+                                                   for k in ref["checks"] if ref["checks"][k]["blocking"])})
         cases.append(case)
     out = {"benchmark": "rim_chamfer", "commit": commit(), "profile": "mjp", "cases": cases}
     with atomic_path(args.out) as tmp:
         Path(tmp).write_text(json.dumps(out, indent=1) + "\n")
-    case_bars(args.out, cases, [([max(c.get(f"pairs_{v}", 0), 0.5) for c in cases], lab)
-                                for v, lab in (("s66", "session 66's build"), ("s67", "session 67's"))],
+    case_bars(args.out, cases, [([max(c.get(f"pairs_{v}", 0), 0.5) for c in cases], LABELS[v])
+                                for v in VARIANTS if v in args.variants],
               "pairs of parts under the clearance", log=True, size=(7, 3.5))
     return 0
 

@@ -126,6 +126,13 @@ RIM_CHAMFER = 0.8
 #: clearances farther than the other body's yoke knuckles reach (R + c before; session 67: 0.2 mm,
 #: 0.10 in the poses)
 HOST_CUT_MARGIN = 1.0
+#: ... and the hinge's other bodies (the stack's owner, whose end knuckle stands between the joint's
+#: collar and the joint point) too: off.  Session 68 (``benchmarks/rim_chamfer.py --variants s67
+#: owner_margin``): the README circuit's remaining pairs of neighbouring half units under the
+#: clearance are that owner's cut face against the other body's yoke knuckle, which the scene's ball
+#: joint turns about the third axis (a twist the printed cardan takes up in its play); the margin
+#: clears them but leaves the end knuckle's web to the slab under the minimum wall (0.45 mm at mjp)
+OWNER_CUT_MARGIN = False
 SHAVE_THIN = True        # the thin webs the trims leave away from a body's joints, taken away (mlc.mesh.shave; session 60)
 #: where a grown stack's coarse samples (:func:`_far_clear`, :func:`_grown_near`) come nearer than the
 #: clearance plus their own reach but not nearer than the clearance, they are sampled again five
@@ -3147,7 +3154,7 @@ def _host_cut(uj: UJoint, bn: str, c: float) -> tuple:
     hinge's other bodies (with the margin it cut the slab beside their end knuckle, between it and
     the cut round the joint's knuckle, to a 0.4 mm web: the robot's wrist, session 67)."""
     h0, h1 = uj.layouts[0].cut
-    if bn == uj.bodies[0]:
+    if bn == uj.bodies[0] or OWNER_CUT_MARGIN:
         return h0, h1
     m = HOST_CUT_MARGIN * c
     return h0 + m, h1 - m
