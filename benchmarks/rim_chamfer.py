@@ -3,7 +3,8 @@ across a compound junction's joint point chamfered; ``HOST_CUT_MARGIN``, the hos
 clearance farther about the first pin; ``CLOSE_STROKES``, bodies that come within the clearance on
 the way to a state trimmed as the meeting ones) change on compiled circuits and robots, and what
 they cost; and session 68's ``owner_margin`` (``OWNER_CUT_MARGIN``: the hinge's other bodies, the
-stack's owner, trimmed with ``HOST_CUT_MARGIN`` too), which the pairs left after session 67 ask for.
+stack's owner, trimmed with ``HOST_CUT_MARGIN`` too), which the pairs left after session 67 ask for,
+and session 68's build (``JOINT_STROKES``: a body near a joint part not its own trimmed as well).
 
 Each case (a compiled scene's largest mechanism posed by ``mlc.mesh.pipeline.state_poses``, or a
 ``tests/data_mesh`` piece with its stored print poses) is built at mjp as ``mlc stl`` builds it
@@ -45,10 +46,13 @@ from mlc.mesh import build as B  # noqa: E402
 from mlc.mesh import checks as C  # noqa: E402
 from mlc.mesh.profiles import load_profile  # noqa: E402
 
-VARIANTS = {"s66": {"RIM_CHAMFER": 0.0, "HOST_CUT_MARGIN": 0.0, "CLOSE_STROKES": False}, "s67": {},
-            # session 68: the hinge's other bodies (the stack's owner) trimmed with the margin too
-            "owner_margin": {"OWNER_CUT_MARGIN": True}}
-LABELS = {"s66": "session 66's build", "s67": "session 67's", "owner_margin": "the owner trimmed with the margin"}
+VARIANTS = {"s66": {"RIM_CHAMFER": 0.0, "HOST_CUT_MARGIN": 0.0, "CLOSE_STROKES": False, "JOINT_STROKES": False},
+            "s67": {"JOINT_STROKES": False},
+            # session 68: the hinge's other bodies (the stack's owner) trimmed with the margin too (on
+            # session 67's build), and session 68's build (JOINT_STROKES)
+            "owner_margin": {"OWNER_CUT_MARGIN": True, "JOINT_STROKES": False}, "s68": {}}
+LABELS = {"s66": "session 66's build", "s67": "session 67's", "owner_margin": "the owner trimmed with the margin",
+          "s68": "session 68's"}
 
 
 def _run(sc, poses, flags: dict, walls: bool) -> dict:

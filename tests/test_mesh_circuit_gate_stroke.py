@@ -21,7 +21,7 @@ from mlc.mesh.build import build_assembly, transform_solid
 from mlc.mesh.checks import check_assembly
 from mlc.mesh.profiles import load_profile
 
-from helpers import load_piece
+from helpers import load_piece, mesh_piece, part_gaps
 
 RUBS = {"state 01@0.71: g3_b_lo intersects g3_out_hi", "state 10@0.71: g3_a_lo intersects g3_out_hi",
         "state 01@0.86: g3_b_lo intersects g3_out_hi", "state 10@0.86: g3_a_lo intersects g3_out_hi"}
@@ -63,7 +63,10 @@ def test_the_input_levers_clear_the_output_lever_on_the_way(built):
     for t in trims:
         assert t["settled"] and 0 < t["removed_mm3"] < 1.0, t
         assert any(p.startswith(("01@0.71", "10@0.71")) for p in t["poses"]), t
-    assert sum("interpolated on the way to the states" in n for n in asm.notes) == 2, asm.notes
+    # (and, since session 68's JOINT_STROKES, each lever trimmed 0.06 mm^3 clear of the joint part at d
+    # in the poses interpolated between the coarse ones: other notes)
+    assert sum("interpolated on the way to the states" in n and "from g3_out_hi" in n for n in asm.notes) == 2, \
+        asm.notes
 
 
 def test_the_tips_keep_clear_along_the_whole_stroke(built, piece):
@@ -131,7 +134,6 @@ def test_an_input_lever_that_only_comes_near_the_output_lever_is_trimmed_clear_t
     farthest apart first, kept only if it settles the pair.  Outside mlc: trimesh samples of the two
     posed parts and a k-d tree (an upper bound of the gap) read them under 0.05 mm apart before and
     at the clearance after."""
-    from helpers import mesh_piece, part_gaps
     sc, poses = load_piece("robot_g2")
     way = {k: v for k, v in poses.items() if k == "11" or k.startswith("11@")}
     old, old_rep = mesh_piece("robot_g2", walls=False, CLOSE_STROKES=False)
@@ -150,3 +152,23 @@ def test_an_input_lever_that_only_comes_near_the_output_lever_is_trimmed_clear_t
         assert rep.check(name).ok == old_rep.check(name).ok, name
     assert set(rep.check("states").failures) <= set(old_rep.check("states").failures) | {
         f for f in rep.check("states").failures if "g2_out_hi" not in f}
+
+
+def test_a_lever_passing_a_joint_part_not_its_own_is_trimmed():
+    """Session 68 (``JOINT_STROKES``): the README circuit's ``g1_b_lo`` comes to 0.105 mm of the gate's
+    joint part at d (``g1_ujoint_d``, which joins ``core_cd`` and ``out_hi``, not the lever) in row 11.
+    Joint parts are never trimmed, and the stroke trims took pairs of bodies only; now a body and a
+    joint part not its own get the same capped trim, of the body.  ``circuit_g1``: the README
+    circuit's g1 with the last three half units of both input chains, its 22 poses."""
+    _, poses = load_piece("circuit_g1")
+    old, old_rep = mesh_piece("circuit_g1", walls=False, JOINT_STROKES=False)
+    assert "11: g1_b_lo - g1_ujoint_d" in {f.rsplit(":", 1)[0] for f in old_rep.check("motion_clearance").failures}
+    assert part_gaps(old, "g1_b_lo", "g1_ujoint_d", {"11": poses["11"]})["11"] < 0.12
+    asm, rep = mesh_piece("circuit_g1", walls=True)
+    for name in ("watertight", "part_count", "min_gap", "states", "retention", "features"):
+        assert rep.check(name).ok, (name, rep.check(name).detail)
+    assert rep.check("motion_clearance").ok, rep.check("motion_clearance").failures
+    assert rep.check("wall_thickness").ok, rep.check("wall_thickness").failures
+    assert any(t["part"] == "g1_b_lo" and t["clear_of"] == "g1_ujoint_d" for t in asm.motion_trims), asm.motion_trims
+    gaps = part_gaps(asm, "g1_b_lo", "g1_ujoint_d", {k: poses[k] for k in ("11", "11@0.86")})
+    assert min(gaps.values()) > 0.19, gaps

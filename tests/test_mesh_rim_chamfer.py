@@ -139,7 +139,7 @@ def test_the_owner_cut_face_meets_the_twisted_yoke(twist, owner_margin):
     owner (``110_AB``, the hinge's other body: its end knuckle captures the joint's collar) is cut
     to ``R + c`` about the first pin, and the yoke knuckle of ``111_CD`` stands ``c`` from that face;
     the scene's ball joint turns it about the third axis in row 10 (about 3 degrees, which the
-    printed cardan takes up in its play), to 0.10 mm.  Trimming the owner with the margin too
+    printed cardan takes up in its play), to 0.10 mm, the owner not turning about the first pin there.  Trimming the owner with the margin too
     (``OWNER_CUT_MARGIN``) clears it, outside mlc as well, but leaves the owner's end knuckle on a
     web under the minimum wall: off by default."""
     asm, rep = twist
@@ -151,6 +151,15 @@ def test_the_owner_cut_face_meets_the_twisted_yoke(twist, owner_margin):
     assert not rep.check("wall_thickness").failures
     _, poses = load_piece("circuit_twist")
     assert part_gaps(asm, "w_b_1_110_AB", "w_b_1_111_CD", {"10": poses["10"]})["10"] < 0.12
+    # the scene's turn of the yoke body relative to the owner, in the junction's frame: about the
+    # second pin (the cardan's own) and about the third axis, which the printed cardan cannot make
+    (uj,) = [u for u in asm.ujoints if u.name == "w_b_1_j111_hi"]
+    T = asm.part_transforms(*poses["10"])
+    F = np.column_stack([uj.axes[0], uj.axes[1], np.cross(uj.axes[0], uj.axes[1])])
+    M = np.linalg.solve(T["w_b_1_110_AB"], T["w_b_1_111_CD"])[:3, :3]
+    Rl = F.T @ M @ F                                   # a small turn: its skew part is the rotation vector
+    turn = np.degrees([Rl[2, 1] - Rl[1, 2], Rl[0, 2] - Rl[2, 0], Rl[1, 0] - Rl[0, 1]]) / 2
+    assert abs(turn[0]) < 0.5 and 2.5 < abs(turn[2]) < 4.0, turn
 
     asm_o, rep_o = owner_margin
     for name in BLOCKING:

@@ -4024,6 +4024,12 @@ STATE_TRIM_SECONDS = 20.0
 #: CLOSE_MAX_PAIRS, each as a state pair (capped, kept only if it settles the pair)
 CLOSE_STROKES = True
 CLOSE_MAX_PAIRS = 8
+#: ... and a body and a joint part that is not its own (joint parts are never trimmed: the body is)
+#: that meet in a logic state or come within the clearance in a pose, on the way or in a state, as
+#: those pairs of bodies (session 68: the README circuit's g1_b_lo under g1_ujoint_d in row 11,
+#: 0.19 mm), at most JOINT_MAX_PAIRS of them, beside the bodies' own caps
+JOINT_STROKES = True
+JOINT_MAX_PAIRS = 4
 STROKE_EPS = 1e-6          # mm^3: the states check's VOL_EPS (mlc.mesh.checks)
 
 
@@ -4137,7 +4143,7 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
     the ends).  The poses between the coarse ones are interpolated, not solved: the trim's growth
     (at least 1.25 times the clearance) is their margin.
 
-    Three kinds of pair, each tagged in its trim's note:
+    Four kinds of pair, each tagged in its trim's note:
 
     * *meeting on the way* (above): at most :data:`STROKE_MAX_PAIRS`, trimmed in this process;
     * *meeting in a state* (:data:`STATE_CLEAR`): two bodies that share no hinge and meet in a
@@ -4147,7 +4153,10 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
       bodies that share no hinge and come within the clearance on the way to a state without
       meeting anywhere (:func:`_near_pairs`), those printed farthest apart first (a stroke past
       another part rather than a joint's play), at most :data:`CLOSE_MAX_PAIRS`, trimmed as
-      state pairs.
+      state pairs;
+    * *a body and a joint part not its own* (:data:`JOINT_STROKES`): meeting in a logic state, or
+      within the clearance in any pose, at most :data:`JOINT_MAX_PAIRS` of each, trimmed as state
+      pairs (the body: joint parts are never trimmed).
 
     State and near pairs are trimmed in a child process capped at :data:`STATE_TRIM_SECONDS` and
     ``TRIM_MEMORY`` (a trim that cannot settle its pair tries every growth) and kept only if the
@@ -4168,7 +4177,12 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
         for ij in here:
             pairs.setdefault(ij, []).append(k)
     ends = [k for k, n in enumerate(names) if "@" not in n]
-    met_end = _meeting_pairs(asm, [Ts[k] for k in ends], lambda i, j: body[i] and body[j], boxes)
+
+    def one_body(i, j):
+        # (JOINT_STROKES) a body and a joint part that is not its own
+        return JOINT_STROKES and body[i] != body[j] and parts[j].name not in parts[i].partners
+    met_end = _meeting_pairs(asm, [Ts[k] for k in ends], lambda i, j: (body[i] and body[j]) or one_body(i, j),
+                             boxes)
     in_state = set().union(*met_end)
     pairs = {ij: ks for ij, ks in pairs.items() if ij not in in_state}
     state_pairs: dict = {}
@@ -4180,7 +4194,9 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
             for i, j in here:
                 if parts[j].name not in parts[i].partners:
                     state_pairs.setdefault((i, j), []).append(k)
-        for ij in sorted(state_pairs)[STATE_MAX_PAIRS:]:
+        # (pairs of bodies and pairs with a joint part each within their own cap)
+        for ij in ([ij for ij in sorted(state_pairs) if body[ij[0]] and body[ij[1]]][STATE_MAX_PAIRS:]
+                   + [ij for ij in sorted(state_pairs) if not (body[ij[0]] and body[ij[1]])][JOINT_MAX_PAIRS:]):
             del state_pairs[ij]
         if len(in_state) > len(state_pairs):
             asm.notes.append(f"bodies that meet in a logic state: {len(in_state)} pairs, {len(state_pairs)} of them "
@@ -4202,6 +4218,22 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
             asm.notes.append(f"bodies within the clearance on the way to the states: {len(ranked)} pairs, the "
                              f"{CLOSE_MAX_PAIRS} printed farthest apart trimmed where that settles them")
         for ij in ranked[:CLOSE_MAX_PAIRS]:
+            state_pairs[ij] = close[ij]
+            near_only.add(ij)
+    if CLOSE_STROKES and JOINT_STROKES:
+        # a body and a joint part not its own within the clearance, in a state or on the way
+        taken = set(state_pairs) | set(pairs) | in_state
+        near = _near_pairs(asm, Ts, lambda i, j: one_body(i, j) and (i, j) not in taken, boxes, c)
+        close = {}
+        for k, here in enumerate(near):
+            for ij in here:
+                close.setdefault(ij, []).append(k)
+        printed = {ij: float(parts[ij[0]].solid.min_gap(parts[ij[1]].solid, 50 * c)) for ij in close}
+        ranked = sorted(close, key=lambda ij: (-printed[ij], ij))
+        if len(ranked) > JOINT_MAX_PAIRS:
+            asm.notes.append(f"bodies within the clearance of a joint part not their own: {len(ranked)} pairs, the "
+                             f"{JOINT_MAX_PAIRS} printed farthest apart trimmed where that settles them")
+        for ij in ranked[:JOINT_MAX_PAIRS]:
             state_pairs[ij] = close[ij]
             near_only.add(ij)
     if not pairs and not state_pairs:
@@ -4245,7 +4277,8 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
                                                     n_notes), STATE_TRIM_SECONDS, TRIM_MEMORY)
             where = ", ".join(names[k] for k in ks if "@" not in names[k])
             if (i, j) in near_only:
-                where = "within the clearance on the way to " + ", ".join(sorted({names[k].split("@")[0] for k in ks}))
+                where = ("within the clearance " + ("in or " if any("@" not in names[k] for k in ks) else "")
+                         + "on the way to " + ", ".join(sorted({names[k].split("@")[0] for k in ks})))
             else:
                 where = "meet in " + where
             if not isinstance(got, tuple):
