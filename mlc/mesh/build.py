@@ -4203,39 +4203,32 @@ def _clear_strokes(asm: "Assembly", protected: dict, soft_protected: dict, Ts: l
                              f"(sharing no hinge, at most {STATE_MAX_PAIRS}) trimmed where that settles them")
         for ij, ks in state_pairs.items():
             ks += [k for k, here in zip(on_way, met) if ij in here]
+
+    def take_near(ks, near, cap, what):
+        # near pairs (``near[n]``: those of pose ``ks[n]``) become state pairs, printed farthest apart first
+        close: dict = {}
+        for k, here in zip(ks, near):
+            for ij in here:
+                close.setdefault(ij, []).append(k)
+        printed = {ij: float(parts[ij[0]].solid.min_gap(parts[ij[1]].solid, 50 * c)) for ij in close}
+        ranked = sorted(close, key=lambda ij: (-printed[ij], ij))
+        if len(ranked) > cap:
+            asm.notes.append(f"{what}: {len(ranked)} pairs, the {cap} printed farthest apart trimmed where that "
+                             "settles them")
+        for ij in ranked[:cap]:
+            state_pairs[ij] = close[ij]
+            near_only.add(ij)
     if CLOSE_STROKES:
         # bodies that share no hinge and come within the clearance on the way, meeting nowhere:
         # trimmed as a state pair (capped, kept if settled), those printed farthest apart first
         near = _near_pairs(asm, [Ts[k] for k in on_way], lambda i, j: body[i] and body[j] and (i, j) not in pairs
                             and (i, j) not in in_state and parts[j].name not in parts[i].partners, boxes, c)
-        close: dict = {}
-        for k, here in zip(on_way, near):
-            for ij in here:
-                close.setdefault(ij, []).append(k)
-        printed = {ij: float(parts[ij[0]].solid.min_gap(parts[ij[1]].solid, 50 * c)) for ij in close}
-        ranked = sorted(close, key=lambda ij: (-printed[ij], ij))
-        if len(ranked) > CLOSE_MAX_PAIRS:
-            asm.notes.append(f"bodies within the clearance on the way to the states: {len(ranked)} pairs, the "
-                             f"{CLOSE_MAX_PAIRS} printed farthest apart trimmed where that settles them")
-        for ij in ranked[:CLOSE_MAX_PAIRS]:
-            state_pairs[ij] = close[ij]
-            near_only.add(ij)
+        take_near(on_way, near, CLOSE_MAX_PAIRS, "bodies within the clearance on the way to the states")
     if CLOSE_STROKES and JOINT_STROKES:
         # a body and a joint part not its own within the clearance, in a state or on the way
         taken = set(state_pairs) | set(pairs) | in_state
         near = _near_pairs(asm, Ts, lambda i, j: one_body(i, j) and (i, j) not in taken, boxes, c)
-        close = {}
-        for k, here in enumerate(near):
-            for ij in here:
-                close.setdefault(ij, []).append(k)
-        printed = {ij: float(parts[ij[0]].solid.min_gap(parts[ij[1]].solid, 50 * c)) for ij in close}
-        ranked = sorted(close, key=lambda ij: (-printed[ij], ij))
-        if len(ranked) > JOINT_MAX_PAIRS:
-            asm.notes.append(f"bodies within the clearance of a joint part not their own: {len(ranked)} pairs, the "
-                             f"{JOINT_MAX_PAIRS} printed farthest apart trimmed where that settles them")
-        for ij in ranked[:JOINT_MAX_PAIRS]:
-            state_pairs[ij] = close[ij]
-            near_only.add(ij)
+        take_near(range(len(Ts)), near, JOINT_MAX_PAIRS, "bodies within the clearance of a joint part not their own")
     if not pairs and not state_pairs:
         return
     if len(pairs) > STROKE_MAX_PAIRS:
