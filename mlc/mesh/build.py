@@ -3152,7 +3152,8 @@ def _host_cut(uj: UJoint, bn: str, c: float) -> tuple:
     body ``bn`` is trimmed clear of the other body's yoke: the layout's (``R + c`` and
     :data:`HOST_CUT_MARGIN` clearances more) for C, the junction's own body; ``R + c`` for the
     hinge's other bodies (with the margin it cut the slab beside their end knuckle, between it and
-    the cut round the joint's knuckle, to a 0.4 mm web: the robot's wrist, session 67)."""
+    the cut round the joint's knuckle, to a 0.4 mm web: the robot's wrist, session 67), unless
+    :data:`OWNER_CUT_MARGIN` gives them the margin too."""
     h0, h1 = uj.layouts[0].cut
     if bn == uj.bodies[0] or OWNER_CUT_MARGIN:
         return h0, h1

@@ -224,7 +224,7 @@ class _CoarseClearance:
         from mlc.mesh.spatial import pair_gaps, posed_pairs
         c, parts = self.c, self.asm.parts
         cand = posed_pairs(Tp, self.frames, self.llo, self.lhi, plo, phi, c,
-                           lambda i, j: (i, j) not in self.partner)
+                           lambda i, j: (i, j) not in self.partner, GAP_EPS)
         if not cand:
             return
         d = _moves(cand, Tp, self.corners)

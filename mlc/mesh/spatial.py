@@ -148,18 +148,19 @@ def obb_overlap(pairs, frames, lo, hi, pad: float = 1e-6) -> list[tuple[int, int
     return [(int(x), int(y)) for x, y in P[ok]]
 
 
-def posed_pairs(Tp, frames, llo, lhi, plo, phi, margin: float = 0.0, keep=None) -> list[tuple[int, int]]:
+def posed_pairs(Tp, frames, llo, lhi, plo, phi, margin: float = 0.0, keep=None,
+                eps: float = 1e-6) -> list[tuple[int, int]]:
     """The pairs ``(i, j)`` (``i < j``) of parts moved by ``Tp`` (one 4x4 rest -> posed transform
     each) that may come within ``margin`` (mm) of each other: their posed world boxes ``plo``,
     ``phi`` (:func:`posed_boxes`) within it (:func:`box_pairs`), ``keep(i, j)`` true (None: every
     pair), and their oriented boxes (local boxes ``llo``, ``lhi`` in the rest ``frames``, posed)
-    not separated with half the margin on each (:func:`obb_overlap`).  The one candidate search of
+    not separated with half the margin plus ``eps`` on each (:func:`obb_overlap`).  The one candidate search of
     the mesher's trims and of the states and clearance checks: only pairs certainly farther apart
     than ``margin`` are left out."""
     cand = box_pairs(plo, phi, margin)
     if keep is not None:
         cand = [ij for ij in cand if keep(*ij)]
-    return obb_overlap(cand, [t @ f for t, f in zip(Tp, frames)], llo, lhi, pad=0.5 * margin + 1e-6)
+    return obb_overlap(cand, [t @ f for t, f in zip(Tp, frames)], llo, lhi, pad=0.5 * margin + eps)
 
 
 def pair_gaps(solids, Tp, pairs, search: float, posed: dict, cong=None) -> list[float]:
@@ -209,7 +210,7 @@ def posed_gaps(solids, frames, lo, hi, poses, clearance: float, eps: float = 1e-
         Tp = [np.asarray(t, float) for t in Tp]
         plo, phi = posed_boxes(wlo, whi, Tp)
         pairs = posed_pairs(Tp, F, lo, hi, plo, phi, clearance,
-                            None if only is None else (lambda i, j: i in only or j in only))
+                            None if only is None else (lambda i, j: i in only or j in only), eps)
         posed: dict = {}
         here = {}
         for i, j in pairs:
