@@ -113,6 +113,10 @@ GROWN_CLEAR = True
 #: knuckles, clear it) is built again one-sided, on the other side (:func:`_knuckles_at_plates`;
 #: session 66: the compiled (a & b) | c, the chain's first junctions on g1's two output levers)
 KNUCKLE_PLATES = True
+#: a compound junction's one-sided yoke: O is trimmed about the pin a knuckle gap past the joint
+#: part's end cap, not to its end face (:func:`_compound_yoke_layout`; session 69: O's slab past the
+#: cap was printed touching the cap, the README robot's ``w_y_3_3_CD`` - ``w_y_3_j3_hi``)
+CAP_END_CUT = True
 #: a compound junction's fin kept past the joint part's ball, clear of O's trim about the second pin, where
 #: the collar never turns round to it (:func:`_fin_keep`; session 60)
 FIN_KEPT = True
@@ -3210,10 +3214,14 @@ def _compound_yoke_layout(mode, hub, g, k, cap, W, s, turned=False) -> YokeLayou
     one-sided yoke's plate stops at the hub on the side without a knuckle, where the other arm
     passes; it ran half the body's width past the hub along the turned pin, out of the body's
     slab (the Tetris robot's gate g2: both output levers' coupling junctions, their pins turned
-    to point at each other across the levers' V, met there, 1.77 mm^3; session 55)."""
+    to point at each other across the levers' V, met there, 1.77 mm^3; session 55).  The trim
+    runs a gap ``g`` past the cap's end: it stopped at the end face, and where O's slab goes on
+    past the cap along the pin the two were printed touching (the README robot's ``w_y_3_j3_hi``,
+    one-sided by KNUCKLE_PLATES: 0.0025 mm^3 in the states; session 69)."""
     ly = _yoke_layout(mode, hub, g, k, cap, W, s)
     if ly.mode != "both":
-        ly.cut = (-(hub / 2 + g), ly.caps[0][1]) if ly.mode == "+" else (ly.caps[0][0], hub / 2 + g)
+        end = g if CAP_END_CUT else 0.0
+        ly.cut = (-(hub / 2 + g), ly.caps[0][1] + end) if ly.mode == "+" else (ly.caps[0][0] - end, hub / 2 + g)
         if turned:
             ly.plate = (max(ly.plate[0], ly.cut[0]), ly.plate[1]) if ly.mode == "+" else \
                 (ly.plate[0], min(ly.plate[1], ly.cut[1]))
