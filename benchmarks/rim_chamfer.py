@@ -4,7 +4,9 @@ clearance farther about the first pin; ``CLOSE_STROKES``, bodies that come withi
 the way to a state trimmed as the meeting ones) change on compiled circuits and robots, and what
 they cost; and session 68's ``owner_margin`` (``OWNER_CUT_MARGIN``: the hinge's other bodies, the
 stack's owner, trimmed with ``HOST_CUT_MARGIN`` too), which the pairs left after session 67 ask for,
-and session 68's build (``JOINT_STROKES``: a body near a joint part not its own trimmed as well).
+and session 68's build (``JOINT_STROKES``: a body near a joint part not its own trimmed as well);
+and session 69's (``CAP_END_CUT``: a compound junction's one-sided yoke trims its body a knuckle gap
+past the joint part's end cap).
 
 Each case (a compiled scene's largest mechanism posed by ``mlc.mesh.pipeline.state_poses``, or a
 ``tests/data_mesh`` piece with its stored print poses) is built at mjp as ``mlc stl`` builds it
@@ -19,6 +21,8 @@ the smallest gap, and the wall measure's thin regions.
         --scene out/circuit.yaml -o benchmarks/results/rim_chamfer_s67.json
     python benchmarks/rim_chamfer.py --piece circuit_twist --piece robot_wrist --variants s67 owner_margin \\
         -o benchmarks/results/rim_chamfer_s68_owner.json
+    python benchmarks/rim_chamfer.py --piece robot_plates --piece robot_skel --piece circuit_g1 \
+        --piece robot_g2 --variants s68 s69 -o benchmarks/results/rim_chamfer_s69_pieces.json
 
 Writes the JSON and a bar plot next to it (``.png``).  Units: seconds, mm."""
 from __future__ import annotations
@@ -50,9 +54,11 @@ VARIANTS = {"s66": {"RIM_CHAMFER": 0.0, "HOST_CUT_MARGIN": 0.0, "CLOSE_STROKES":
             "s67": {"JOINT_STROKES": False},
             # session 68: the hinge's other bodies (the stack's owner) trimmed with the margin too (on
             # session 67's build), and session 68's build (JOINT_STROKES)
-            "owner_margin": {"OWNER_CUT_MARGIN": True, "JOINT_STROKES": False}, "s68": {}}
+            "owner_margin": {"OWNER_CUT_MARGIN": True, "JOINT_STROKES": False},
+            # session 69: the one-sided yoke's trim past the joint part's end cap (CAP_END_CUT)
+            "s68": {"CAP_END_CUT": False}, "s69": {}}
 LABELS = {"s66": "session 66's build", "s67": "session 67's", "owner_margin": "the owner trimmed with the margin",
-          "s68": "session 68's"}
+          "s68": "session 68's", "s69": "session 69's"}
 
 
 def _run(sc, poses, flags: dict, walls: bool) -> dict:
