@@ -6,7 +6,8 @@ they cost; and session 68's ``owner_margin`` (``OWNER_CUT_MARGIN``: the hinge's 
 stack's owner, trimmed with ``HOST_CUT_MARGIN`` too), which the pairs left after session 67 ask for,
 and session 68's build (``JOINT_STROKES``: a body near a joint part not its own trimmed as well);
 and session 69's (``CAP_END_CUT``: a compound junction's one-sided yoke trims its body a knuckle gap
-past the joint part's end cap).
+past the joint part's end cap; ``s69_cap`` without ``CLIP_NEAR_PLATES``, a yoke plate off its slab's
+layer stopped short of another body).
 
 Each case (a compiled scene's largest mechanism posed by ``mlc.mesh.pipeline.state_poses``, or a
 ``tests/data_mesh`` piece with its stored print poses) is built at mjp as ``mlc stl`` builds it
@@ -23,6 +24,8 @@ the smallest gap, and the wall measure's thin regions.
         -o benchmarks/results/rim_chamfer_s68_owner.json
     python benchmarks/rim_chamfer.py --piece robot_plates --piece robot_skel --piece circuit_g1 \
         --piece robot_g2 --variants s68 s69 -o benchmarks/results/rim_chamfer_s69_pieces.json
+    python benchmarks/rim_chamfer.py --piece robot_skel --piece robot_plates --piece robot_g2 \
+        --piece circuit_g1 --variants s69_cap s69 -o benchmarks/results/rim_chamfer_s69_plates.json
 
 Writes the JSON and a bar plot next to it (``.png``).  Units: seconds, mm."""
 from __future__ import annotations
@@ -56,9 +59,9 @@ VARIANTS = {"s66": {"RIM_CHAMFER": 0.0, "HOST_CUT_MARGIN": 0.0, "CLOSE_STROKES":
             # session 67's build), and session 68's build (JOINT_STROKES)
             "owner_margin": {"OWNER_CUT_MARGIN": True, "JOINT_STROKES": False},
             # session 69: the one-sided yoke's trim past the joint part's end cap (CAP_END_CUT)
-            "s68": {"CAP_END_CUT": False}, "s69": {}}
+            "s68": {"CAP_END_CUT": False}, "s69_cap": {"CLIP_NEAR_PLATES": False}, "s69": {}}
 LABELS = {"s66": "session 66's build", "s67": "session 67's", "owner_margin": "the owner trimmed with the margin",
-          "s68": "session 68's", "s69": "session 69's"}
+          "s68": "session 68's", "s69_cap": "session 69's cap trim alone", "s69": "session 69's"}
 
 
 def _run(sc, poses, flags: dict, walls: bool) -> dict:

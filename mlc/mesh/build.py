@@ -94,6 +94,10 @@ ONE_SIDED_ABOVE = 4.0    # degrees: ... only when the least twist with both side
 ONE_SIDED_GAIN = 1.0     # degrees: ... and the one-sided yoke's twist less by at least this
 TURNED_FREE_SIDE = True  # a turned one-sided compound yoke: no plate past the hub on its free side (session 55)
 CLIP_UJ_PLATES = True    # a yoke plate past the end of another hinge of its body stops at its trim radius (session 55)
+#: large assemblies: a yoke plate that comes near a body other than its joint's two, at rest or in a
+#: logic state, stops short of it (:func:`_clip_near_plates`; session 69: the robot's skeleton)
+CLIP_NEAR_PLATES = True
+NEAR_PLATES_STATES = False
 UNTWIST_SPLIT = True     # ... not to a pin that cuts the other body in pieces (built again; session 52)
 GROW_STACKS = True       # a compound junction's stack: knuckles of the minimum wall, grown on its far side (session 57)
 #: _far_clear: where two stacks' axes come within both radii and the clearance, the solid knuckle
@@ -280,6 +284,7 @@ class SlabBox:
     size: np.ndarray     # mm, thickness already replaced
     normal_axis: int     # index of the thickness axis
     offset: float = 0.0  # mm along the normal from the scene's mid-plane (_offset_slabs)
+    off_layer: bool = False  # a yoke plate in its joint's plane, off its slab's layer (_yoke_plates)
 
 
 @dataclass
@@ -1013,16 +1018,30 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
                        for ii, _ in _close_pairs_posed(P, past(ax, samples[B]),
                                                        [_relative(bn, B, Ts) for _, Ts in states], t + c + h))
         clipped = []
-        for bn, uj, sb in uj_plates:
+        for k, (bn, uj, sb) in enumerate(uj_plates):
             nb = _clip_at_axes(sb, [ax for ax in axes if bn in ax.bodies and ax is not uj.host],
                                max(uj.R, uj.hub_r) + t, t, lambda ax, cut_sb, bn=bn: clash(bn, ax, cut_sb))
             if nb is not sb:
                 plates[bn][next(i for i, x in enumerate(plates[bn]) if x is sb)] = nb
+                uj_plates[k] = (bn, uj, nb)
                 clipped.append((bn, uj.name, float(sb.size[1] - nb.size[1])))
         if clipped:
             for bn, jn, cut in clipped:
                 notes.append(f"universal joint {jn}: {bn}'s yoke plate stops {cut:.2f} mm short, at the trim "
                              "radius of its hinge whose span it ran past")
+            shapes = {bn: slabs[bn] + plates[bn] for bn in slabs}
+            samples = {bn: _slab_samples(shapes[bn], h) for bn in shapes}
+
+    if CLIP_NEAR_PLATES and reuse and uj_plates:
+        # a yoke plate that comes near another body's material (not the joint's own bodies) in a
+        # logic state or at rest stops short of it (session 69: the README robot's skeleton)
+        cut_near = _clip_near_plates(uj_plates, samples, state_T, t, c, h)
+        for k, nb, cut, other in cut_near:
+            bn, uj, sb = uj_plates[k]
+            plates[bn][next(i for i, x in enumerate(plates[bn]) if x is sb)] = nb
+            uj_plates[k] = (bn, uj, nb)
+            notes.append(f"universal joint {uj.name}: {bn}'s yoke plate stops {cut:.2f} mm short, clear of {other}")
+        if cut_near:
             shapes = {bn: slabs[bn] + plates[bn] for bn in slabs}
             samples = {bn: _slab_samples(shapes[bn], h) for bn in shapes}
 
@@ -4931,11 +4950,78 @@ def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False, rod_reach=Non
         Rm = np.column_stack([d, w, np.cross(d, w)])
         # a slab printed from one face (_offset_slabs): its plate too, flush with it
         shift = 0.0 if rod else sb.offset * nrm
+        # a joint on a post whose plate widens a slab whose layer lies off the joint (the robot's
+        # skeleton: 3 mm over the couplings' end joints): the plate lies in the joint's plane
+        off = (post and not _is_rod(sb, t) and
+               abs(float(np.dot(rel, nrm))) > 0.5 * float(sb.size[sb.normal_axis]) + abs(sb.offset) + t)
         for a0, a1 in intervals:
             if a1 - a0 <= 0:
                 continue
             out.append(SlabBox(origin + d * 0.5 * (a0 + a1) + w * reach_b / 2 + shift, Rm,
-                               np.array([a1 - a0, reach_b, t]), 2, sb.offset))
+                               np.array([a1 - a0, reach_b, t]), 2, sb.offset, off))
+    return out
+
+
+def _clip_near_plates(uj_plates, samples, state_T, t, c, h) -> list:
+    """(CLIP_NEAR_PLATES) The universal joints' yoke plates (``uj_plates``: ``(body, joint, box)``;
+    :func:`_yoke_plates`: along ``R[:, 1]`` away from the pin over ``size[1]``) that come within
+    the slab thickness and the clearance (mid-planes ``t + c + h`` apart; ``samples``: every body's
+    slab and plate points, rest frame) of a body other than their joint's two, at rest or in a
+    logic state (``state_T``), beyond the knuckles and the hub (``max(R, hub) + t`` from the pin):
+    ``[(index, shortened box, mm cut, that body)]``, each plate stopped that far short of the
+    nearest such point, never shorter than the knuckles and the hub.  A yoke plate is laid in
+    the joint's plane as far as its slab is wide: a joint on a post under a slab (the robot's
+    skeleton, its couplings' end joints) gets a plate off the slab's layer that reached 7.3 mm
+    from its pin, over the next end joint's knuckle on the neighbouring skeleton body
+    (``skel_j3``'s over ``skel_u2``'s, printed touching; the final trims could cut neither:
+    ``skel_u2``'s knuckle is guarded, ``skel_j3`` fell in two; session 69)."""
+    from scipy.spatial import cKDTree
+    names = list(samples)
+    index = {bn: i for i, bn in enumerate(names)}
+    owner = np.concatenate([np.full(len(samples[bn]), i) for i, bn in enumerate(names)]) if names else np.zeros(0, int)
+    if not len(owner):
+        return []
+    cands = []
+    for k, (bn, uj, sb) in enumerate(uj_plates):
+        least = max(uj.R, uj.hub_r) + t
+        L = float(sb.size[1])
+        if not sb.off_layer or L <= least + h:
+            continue
+        w = sb.R[:, 1]
+        start = sb.center - w * L / 2
+        P = _slab_samples([sb], h)
+        a = (P - start) @ w
+        keep = a > least
+        if keep.any():
+            cands.append((k, bn, uj, sb, P[keep], a[keep], start, least))
+    if not cands:
+        return []
+    hit: dict = {}
+    for Ts in [None] + ([T for _, T in (state_T or [])] if NEAR_PLATES_STATES else []):
+        if Ts is None:
+            Q = np.concatenate([samples[bn] for bn in names])
+        else:
+            Q = np.concatenate([samples[bn] @ Ts[bn][:3, :3].T + Ts[bn][:3, 3] for bn in names])
+        tree = cKDTree(Q)
+        for k, bn, uj, sb, P, a, start, least in cands:
+            Pp = P if Ts is None else P @ Ts[bn][:3, :3].T + Ts[bn][:3, 3]
+            mine = {index[x] for x in (bn, *uj.bodies) if x in index}
+            for n, near in enumerate(tree.query_ball_point(Pp, t + c + h)):
+                other = [owner[i] for i in near if owner[i] not in mine]
+                if other and (k not in hit or a[n] < hit[k][0]):
+                    hit[k] = (float(a[n]), names[other[0]])
+    out = []
+    for k, bn, uj, sb, P, a, start, least in cands:
+        if k not in hit:
+            continue
+        L = float(sb.size[1])
+        r = max(least, hit[k][0] - (t + c + h))
+        if r >= L - 1e-9:
+            continue
+        size = sb.size.copy()
+        size[1] = r
+        w = sb.R[:, 1]
+        out.append((k, SlabBox(start + w * r / 2, sb.R, size, sb.normal_axis, sb.offset, True), L - r, hit[k][1]))
     return out
 
 
@@ -4980,7 +5066,7 @@ def _clip_at_axes(sb: SlabBox, axes, least, t, clash=None) -> SlabBox:
         return sb
     size = sb.size.copy()
     size[1] = reach_b
-    return SlabBox(start + w * reach_b / 2, sb.R, size, sb.normal_axis, sb.offset)
+    return SlabBox(start + w * reach_b / 2, sb.R, size, sb.normal_axis, sb.offset, sb.off_layer)
 
 
 def _on_slab(sb: SlabBox, p, w) -> float:
