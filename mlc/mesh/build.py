@@ -93,11 +93,15 @@ ONE_SIDED_TWIST = True   # ... with a one-sided yoke where both sides would not 
 ONE_SIDED_ABOVE = 4.0    # degrees: ... only when the least twist with both sides is more than this
 ONE_SIDED_GAIN = 1.0     # degrees: ... and the one-sided yoke's twist less by at least this
 TURNED_FREE_SIDE = True  # a turned one-sided compound yoke: no plate past the hub on its free side (session 55)
-CLIP_UJ_PLATES = True    # a yoke plate past the end of another hinge of its body stops at its trim radius (session 55)
-#: large assemblies: a yoke plate that comes near a body other than its joint's two, at rest or in a
-#: logic state, stops short of it (:func:`_clip_near_plates`; session 69: the robot's skeleton)
+#: large assemblies: a yoke plate off its slab's layer (a joint on a post) that comes near a body
+#: other than its joint's two as printed stops short of it (:func:`_clip_near_plates`; session 69:
+#: the robot's skeleton)
 CLIP_NEAR_PLATES = True
+#: ... near in the logic states too, not only as printed: off (session 69: on the robot's skeleton
+#: piece it stopped skel_u3's end-joint plates short of a wrist that passes in rows 01 and 11, and
+#: skel_u3, whose two end joints' knuckles those plates hold, came out in 3 pieces)
 NEAR_PLATES_STATES = False
+CLIP_UJ_PLATES = True    # a yoke plate past the end of another hinge of its body stops at its trim radius (session 55)
 UNTWIST_SPLIT = True     # ... not to a pin that cuts the other body in pieces (built again; session 52)
 GROW_STACKS = True       # a compound junction's stack: knuckles of the minimum wall, grown on its far side (session 57)
 #: _far_clear: where two stacks' axes come within both radii and the clearance, the solid knuckle
@@ -1033,8 +1037,8 @@ def _build_assembly(scene, profile, poses, resolve, reuse, motion_poses=None, un
             samples = {bn: _slab_samples(shapes[bn], h) for bn in shapes}
 
     if CLIP_NEAR_PLATES and reuse and uj_plates:
-        # a yoke plate that comes near another body's material (not the joint's own bodies) in a
-        # logic state or at rest stops short of it (session 69: the README robot's skeleton)
+        # a yoke plate off its slab's layer that comes near another body's material (not the
+        # joint's own bodies) as printed stops short of it (session 69: the README robot's skeleton)
         cut_near = _clip_near_plates(uj_plates, samples, state_T, t, c, h)
         for k, nb, cut, other in cut_near:
             bn, uj, sb = uj_plates[k]
@@ -4963,13 +4967,14 @@ def _yoke_plates(sbs, origin, d, intervals, reach, t, along=False, rod_reach=Non
 
 
 def _clip_near_plates(uj_plates, samples, state_T, t, c, h) -> list:
-    """(CLIP_NEAR_PLATES) The universal joints' yoke plates (``uj_plates``: ``(body, joint, box)``;
-    :func:`_yoke_plates`: along ``R[:, 1]`` away from the pin over ``size[1]``) that come within
-    the slab thickness and the clearance (mid-planes ``t + c + h`` apart; ``samples``: every body's
-    slab and plate points, rest frame) of a body other than their joint's two, at rest or in a
-    logic state (``state_T``), beyond the knuckles and the hub (``max(R, hub) + t`` from the pin):
-    ``[(index, shortened box, mm cut, that body)]``, each plate stopped that far short of the
-    nearest such point, never shorter than the knuckles and the hub.  A yoke plate is laid in
+    """(CLIP_NEAR_PLATES) The universal joints' yoke plates off their slab's layer (``uj_plates``:
+    ``(body, joint, box)``; :func:`_yoke_plates`: along ``R[:, 1]`` away from the pin over
+    ``size[1]``, ``SlabBox.off_layer``) that come within the slab thickness and the clearance
+    (mid-planes ``t + c + h`` apart; ``samples``: every body's slab and plate points, rest frame)
+    of a body other than their joint's two as printed (and, with ``NEAR_PLATES_STATES``, in a
+    logic state of ``state_T``), beyond the knuckles and the hub (``max(R, hub) + t`` from the
+    pin): ``[(index, shortened box, mm cut, that body)]``, each plate stopped that far short of
+    the nearest such point, never shorter than the knuckles and the hub.  A yoke plate is laid in
     the joint's plane as far as its slab is wide: a joint on a post under a slab (the robot's
     skeleton, its couplings' end joints) gets a plate off the slab's layer that reached 7.3 mm
     from its pin, over the next end joint's knuckle on the neighbouring skeleton body
