@@ -4981,11 +4981,6 @@ def _clip_near_plates(uj_plates, samples, state_T, t, c, h) -> list:
     (``skel_j3``'s over ``skel_u2``'s, printed touching; the final trims could cut neither:
     ``skel_u2``'s knuckle is guarded, ``skel_j3`` fell in two; session 69)."""
     from scipy.spatial import cKDTree
-    names = list(samples)
-    index = {bn: i for i, bn in enumerate(names)}
-    owner = np.concatenate([np.full(len(samples[bn]), i) for i, bn in enumerate(names)]) if names else np.zeros(0, int)
-    if not len(owner):
-        return []
     cands = []
     for k, (bn, uj, sb) in enumerate(uj_plates):
         least = max(uj.R, uj.hub_r) + t
@@ -4998,9 +4993,12 @@ def _clip_near_plates(uj_plates, samples, state_T, t, c, h) -> list:
         a = (P - start) @ w
         keep = a > least
         if keep.any():
-            cands.append((k, bn, uj, sb, P[keep], a[keep], start, least))
-    if not cands:
+            cands.append((k, bn, uj, sb, P[keep], a[keep], least))
+    names = list(samples)
+    if not cands or not sum(len(samples[bn]) for bn in names):
         return []
+    index = {bn: i for i, bn in enumerate(names)}
+    owner = np.concatenate([np.full(len(samples[bn]), i) for i, bn in enumerate(names)])
     hit: dict = {}
     for Ts in [None] + ([T for _, T in (state_T or [])] if NEAR_PLATES_STATES else []):
         if Ts is None:
@@ -5008,7 +5006,7 @@ def _clip_near_plates(uj_plates, samples, state_T, t, c, h) -> list:
         else:
             Q = np.concatenate([samples[bn] @ Ts[bn][:3, :3].T + Ts[bn][:3, 3] for bn in names])
         tree = cKDTree(Q)
-        for k, bn, uj, sb, P, a, start, least in cands:
+        for k, bn, uj, sb, P, a, _ in cands:
             Pp = P if Ts is None else P @ Ts[bn][:3, :3].T + Ts[bn][:3, 3]
             mine = {index[x] for x in (bn, *uj.bodies) if x in index}
             for n, near in enumerate(tree.query_ball_point(Pp, t + c + h)):
@@ -5016,18 +5014,25 @@ def _clip_near_plates(uj_plates, samples, state_T, t, c, h) -> list:
                 if other and (k not in hit or a[n] < hit[k][0]):
                     hit[k] = (float(a[n]), names[other[0]])
     out = []
-    for k, bn, uj, sb, P, a, start, least in cands:
+    for k, _, _, sb, _, _, least in cands:
         if k not in hit:
             continue
         L = float(sb.size[1])
         r = max(least, hit[k][0] - (t + c + h))
         if r >= L - 1e-9:
             continue
-        size = sb.size.copy()
-        size[1] = r
-        w = sb.R[:, 1]
-        out.append((k, SlabBox(start + w * r / 2, sb.R, size, sb.normal_axis, sb.offset, True), L - r, hit[k][1]))
+        out.append((k, _plate_cut(sb, r), L - r, hit[k][1]))
     return out
+
+
+def _plate_cut(sb: SlabBox, r: float) -> SlabBox:
+    """A yoke plate (:func:`_yoke_plates`: along ``R[:, 1]`` away from the pin over ``size[1]``)
+    stopped ``r`` mm from the pin."""
+    w = sb.R[:, 1]
+    size = sb.size.copy()
+    size[1] = r
+    return SlabBox(sb.center - w * float(sb.size[1]) / 2 + w * r / 2, sb.R, size, sb.normal_axis, sb.offset,
+                   sb.off_layer)
 
 
 def _clip_at_axes(sb: SlabBox, axes, least, t, clash=None) -> SlabBox:
@@ -5069,9 +5074,7 @@ def _clip_at_axes(sb: SlabBox, axes, least, t, clash=None) -> SlabBox:
         reach_b = r
     if reach_b >= L - 1e-9:
         return sb
-    size = sb.size.copy()
-    size[1] = reach_b
-    return SlabBox(start + w * reach_b / 2, sb.R, size, sb.normal_axis, sb.offset, sb.off_layer)
+    return _plate_cut(sb, reach_b)
 
 
 def _on_slab(sb: SlabBox, p, w) -> float:
